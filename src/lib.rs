@@ -1,0 +1,16 @@
+//! tinydem: a granular DEM simulator implementing the model of the TinyDEM paper
+//! (R. Vetter, Comput. Phys. Commun. 2025): soft frictional spheres with Hertz-Mindlin
+//! contact, sliding, rolling and twisting friction, quaternion orientations and static
+//! meshes. See `ARCHITECTURE.md` for a map of the code.
+
+pub mod contact;
+pub mod csv;
+pub mod geometry;
+pub mod integrate;
+pub mod mesh;
+pub mod neighbours;
+pub mod particles;
+pub mod run;
+pub mod scenario;
+pub mod simulation;
+pub mod spawn;

@@ -1,0 +1,238 @@
+//! Static meshes (paper Section 3.3): faces of one to four vertices are points, rounded
+//! edges, triangles and rectangles, each with its own radius R_j. Read from OFF files.
+
+use anyhow::{Result, bail};
+use glam::DVec3;
+
+use crate::geometry::{closest_on_rectangle, closest_on_segment, closest_on_triangle};
+
+/// The shape of one mesh face (Fig. 4A-D).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Primitive {
+    Point(DVec3),
+    Segment(DVec3, DVec3),
+    Triangle(DVec3, DVec3, DVec3),
+    /// Corner `o` and perpendicular edges `e1`, `e2` (vertices o, o+e1, o+e1+e2, o+e2).
+    Rectangle { o: DVec3, e1: DVec3, e2: DVec3 },
+}
+
+/// One mesh element: a primitive dilated by its radius R_j.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Face {
+    pub shape: Primitive,
+    /// R_j [L], from the scenario's `mesh_radii`.
+    pub radius: f64,
+}
+
+impl Face {
+    /// Closest point of the (undilated) primitive to `x`.
+    #[inline]
+    pub fn closest_point(&self, x: DVec3) -> DVec3 {
+        match self.shape {
+            Primitive::Point(p) => p,
+            Primitive::Segment(a, b) => closest_on_segment(x, a, b),
+            Primitive::Triangle(a, b, c) => closest_on_triangle(x, a, b, c),
+            Primitive::Rectangle { o, e1, e2 } => closest_on_rectangle(x, o, e1, e2),
+        }
+    }
+
+    /// Axis-aligned bounding box of the dilated face.
+    pub fn bounding_box(&self) -> (DVec3, DVec3) {
+        let (lo, hi) = match self.shape {
+            Primitive::Point(p) => (p, p),
+            Primitive::Segment(a, b) => (a.min(b), a.max(b)),
+            Primitive::Triangle(a, b, c) => (a.min(b).min(c), a.max(b).max(c)),
+            Primitive::Rectangle { o, e1, e2 } => {
+                let c = [o, o + e1, o + e1 + e2, o + e2];
+                (c[0].min(c[1]).min(c[2]).min(c[3]), c[0].max(c[1]).max(c[2]).max(c[3]))
+            }
+        };
+        (lo - DVec3::splat(self.radius), hi + DVec3::splat(self.radius))
+    }
+}
+
+/// A static mesh: a list of faces.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Mesh {
+    pub faces: Vec<Face>,
+    /// All vertices, for output and pictures.
+    pub vertices: Vec<DVec3>,
+}
+
+/// Strips an OFF comment (`#` to the end of the line).
+fn strip_comment(line: &str) -> &str {
+    line.split('#').next().unwrap_or("").trim()
+}
+
+fn parse_numbers<T: std::str::FromStr>(
+    file: &str,
+    lineno: usize,
+    line: &str,
+    what: &str,
+) -> Result<Vec<T>> {
+    line.split_whitespace()
+        .map(|tok| {
+            tok.parse::<T>().map_err(|_| {
+                anyhow::anyhow!("{file}:{lineno}: expected {what}, found '{tok}' in line '{line}'")
+            })
+        })
+        .collect()
+}
+
+impl Mesh {
+    /// Parses OFF text (GeomView Object File Format): a line `OFF`, a line with the numbers
+    /// of vertices, faces and edges, one line `x y z` per vertex, and one line
+    /// `k v_1 ... v_k [i]` per face with 1 <= k <= 4 vertices and an optional index `i`
+    /// into `radii` (default 0). Rectangles list their corners in order around them.
+    pub fn parse_off(text: &str, file: &str, radii: &[f64]) -> Result<Mesh> {
+        let mut lines = text
+            .lines()
+            .enumerate()
+            .map(|(k, l)| (k + 1, strip_comment(l)))
+            .filter(|(_, l)| !l.is_empty());
+        let Some((n0, header)) = lines.next() else {
+            bail!("{file}: empty file, expected an OFF mesh starting with the line 'OFF'");
+        };
+        // The counts may follow the keyword on the same line.
+        let rest = match header.strip_prefix("OFF") {
+            Some(rest) => rest.trim(),
+            None => bail!("{file}:{n0}: expected the keyword 'OFF', found '{header}'"),
+        };
+        let (n1, counts_line) = if rest.is_empty() {
+            match lines.next() {
+                Some(l) => l,
+                None => bail!("{file}: ends after 'OFF', expected the line 'vertices faces edges'"),
+            }
+        } else {
+            (n0, rest)
+        };
+        let counts: Vec<u64> = parse_numbers(file, n1, counts_line, "the counts 'vertices faces edges' (whole numbers)")?;
+        if counts.len() < 2 || counts.len() > 3 {
+            bail!("{file}:{n1}: expected the counts 'vertices faces edges', found '{counts_line}'");
+        }
+        let (nv, nf) = (counts[0] as usize, counts[1] as usize);
+        let remaining = text.len();
+        if nv > remaining || nf > remaining {
+            bail!("{file}:{n1}: the header announces {nv} vertices and {nf} faces, more than the file can hold");
+        }
+
+        let mut vertices = Vec::with_capacity(nv);
+        for k in 0..nv {
+            let Some((n, line)) = lines.next() else {
+                bail!("{file}: ends after {k} of {nv} vertices");
+            };
+            let xyz: Vec<f64> = parse_numbers(file, n, line, "a vertex 'x y z'")?;
+            if xyz.len() != 3 || xyz.iter().any(|x| !x.is_finite()) {
+                bail!("{file}:{n}: expected a vertex as three finite numbers 'x y z', found '{line}'");
+            }
+            vertices.push(DVec3::new(xyz[0], xyz[1], xyz[2]));
+        }
+
+        let mut faces = Vec::with_capacity(nf);
+        for k in 0..nf {
+            let Some((n, line)) = lines.next() else {
+                bail!("{file}: ends after {k} of {nf} faces");
+            };
+            let ints: Vec<i64> = parse_numbers(file, n, line, "a face 'k v_1 ... v_k [radius index]' (whole numbers)")?;
+            let count = ints[0];
+            if !(1..=4).contains(&count) {
+                bail!("{file}:{n}: a face has 1 to 4 vertices (point, edge, triangle, rectangle), found {count}");
+            }
+            let count = count as usize;
+            let extra = ints.len() - 1;
+            if extra < count || extra > count + 1 {
+                bail!(
+                    "{file}:{n}: expected {count} vertex indices and an optional radius index, found {extra} numbers after the vertex count"
+                );
+            }
+            let mut v = [DVec3::ZERO; 4];
+            for (slot, &idx) in v.iter_mut().zip(&ints[1..=count]) {
+                if idx < 0 || idx as usize >= nv {
+                    bail!("{file}:{n}: vertex index {idx} is out of range 0..{nv}");
+                }
+                *slot = vertices[idx as usize];
+            }
+            let ri = if extra == count + 1 { ints[count + 1] } else { 0 };
+            if ri < 0 || ri as usize >= radii.len() {
+                bail!(
+                    "{file}:{n}: radius index {ri} is out of range: mesh_radii has {} entries",
+                    radii.len()
+                );
+            }
+            let shape = match count {
+                1 => Primitive::Point(v[0]),
+                2 => Primitive::Segment(v[0], v[1]),
+                3 => {
+                    if (v[1] - v[0]).cross(v[2] - v[0]).length_squared() == 0.0 {
+                        bail!("{file}:{n}: degenerate triangle (its vertices are collinear)");
+                    }
+                    Primitive::Triangle(v[0], v[1], v[2])
+                }
+                _ => rectangle(v, file, n)?,
+            };
+            faces.push(Face { shape, radius: radii[ri as usize] });
+        }
+        if let Some((n, line)) = lines.next() {
+            bail!("{file}:{n}: unexpected line '{line}' after the {nf} faces the header announced");
+        }
+        Ok(Mesh { faces, vertices })
+    }
+
+    /// Reads an OFF file.
+    pub fn load_off(path: &std::path::Path, radii: &[f64]) -> Result<Mesh> {
+        let bytes = std::fs::read(path)
+            .map_err(|e| anyhow::anyhow!("cannot read mesh file {}: {e}", path.display()))?;
+        let text = std::str::from_utf8(&bytes).map_err(|_| {
+            anyhow::anyhow!("{}: not a text file, expected an OFF mesh", path.display())
+        })?;
+        Mesh::parse_off(text, &path.display().to_string(), radii)
+    }
+}
+
+/// Checks that four vertices, in order around the face, form a rectangle.
+fn rectangle(v: [DVec3; 4], file: &str, n: usize) -> Result<Primitive> {
+    let (o, e1, e2) = (v[0], v[1] - v[0], v[3] - v[0]);
+    let scale = e1.length().max(e2.length());
+    let tol = 1e-9 * scale;
+    if scale == 0.0 || e1.length() <= tol || e2.length() <= tol {
+        bail!("{file}:{n}: degenerate rectangle (two corners coincide)");
+    }
+    if (o + e1 + e2 - v[2]).length() > tol || e1.dot(e2).abs() > tol * scale {
+        bail!(
+            "{file}:{n}: the four vertices do not form a rectangle (v0, v1, v2, v3 in order around it); split other quadrilaterals into two triangles"
+        );
+    }
+    Ok(Primitive::Rectangle { o, e1, e2 })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hourglass_parses() {
+        let m = Mesh::parse_off(crate::scenario::HOURGLASS_OFF, "hourglass", &[0.002, 0.02, 0.01]).unwrap();
+        assert_eq!(m.faces.len(), 19);
+        assert_eq!(m.faces[17].radius, 0.02);
+        assert!(matches!(m.faces[17].shape, Primitive::Point(_)));
+        assert!(matches!(m.faces[18].shape, Primitive::Segment(..)));
+        assert!(matches!(m.faces[0].shape, Primitive::Rectangle { .. }));
+    }
+
+    fn err(text: &str) -> String {
+        format!("{:#}", Mesh::parse_off(text, "m.off", &[0.0]).unwrap_err())
+    }
+
+    #[test]
+    fn bad_faces_are_named() {
+        let base = "OFF\n4 1 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n";
+        assert!(err(&format!("{base}5 0 1 2 3 0\n")).contains("m.off:7: a face has 1 to 4"));
+        assert!(err(&format!("{base}3 0 1 9\n")).contains("vertex index 9 is out of range"));
+        assert!(err(&format!("{base}3 0 1 2 4\n")).contains("radius index 4"));
+        assert!(err(&format!("{base}4 0 1 3 2\n")).contains("do not form a rectangle"));
+        assert!(err(&format!("{base}3 0 x 2\n")).contains("found 'x'"));
+        assert!(err("OFF\n4 1 0\n0 0 0\n").contains("ends after 1 of 4 vertices"));
+        assert!(err("").contains("empty file"));
+        assert!(err("OFF\n4 1 0\n0 0 0\n1 0 nan\n").contains("m.off:4"));
+    }
+}

@@ -1,0 +1,378 @@
+//! Neighbour search (paper Section 3.3) with Verlet lists.
+//!
+//! Particles are binned into cubic cells of edge `h >= 2 R_max + skin` (a hashed grid, so
+//! memory does not grow with the spread of the particles), and every pair closer than
+//! `R_i + R_j + skin` is listed once (i < j) in a compressed list. The list stays valid
+//! until some particle has moved more than `skin / 2`, so it is rebuilt only every few
+//! steps; contacts are still decided exactly (δ > 0) at every step, so results are the same
+//! as with a fresh linked-cell search each step.
+//!
+//! Faces of the static mesh are binned once into a grid of the same kind; each particle
+//! lists the faces within `R_i + R_j + skin`.
+//!
+//! Each listed pair carries the friction springs of its contact (Table 3), which are kept
+//! across rebuilds and zeroed while the pair is not touching.
+
+use glam::{DVec3, IVec3};
+use rayon::prelude::*;
+use rustc_hash::FxHashMap;
+
+use crate::contact::Springs;
+use crate::mesh::Face;
+
+/// Below this many items a parallel loop runs on one thread (spawn overhead dominates).
+pub const MIN_PARALLEL_LEN: usize = 512;
+
+const CELL_BIAS: i32 = 1 << 20;
+
+/// Integer cell of a position; clamped so that far-flung particles share the outermost
+/// cells (still correct, as pairs are always tested by distance).
+#[inline]
+pub fn cell_of(x: DVec3, inv_h: f64) -> IVec3 {
+    let c = (x * inv_h).floor();
+    let lim = (CELL_BIAS - 2) as f64;
+    IVec3::new(
+        c.x.clamp(-lim, lim) as i32,
+        c.y.clamp(-lim, lim) as i32,
+        c.z.clamp(-lim, lim) as i32,
+    )
+}
+
+#[inline]
+pub fn key(c: IVec3) -> u64 {
+    let b = |v: i32| (v + CELL_BIAS) as u64;
+    (b(c.x) << 42) | (b(c.y) << 21) | b(c.z)
+}
+
+/// A hashed grid of cubic cells: for each occupied cell, the items in it.
+#[derive(Clone, Debug, Default)]
+pub struct CellGrid {
+    inv_h: f64,
+    /// Item indices grouped by cell.
+    items: Vec<u32>,
+    /// Cell key -> range in `items`.
+    cells: FxHashMap<u64, (u32, u32)>,
+}
+
+impl CellGrid {
+    /// Bins points into cells of edge `h`.
+    pub fn of_points(x: &[DVec3], h: f64) -> CellGrid {
+        let inv_h = 1.0 / h;
+        let mut keyed: Vec<(u64, u32)> = x
+            .par_iter()
+            .with_min_len(MIN_PARALLEL_LEN)
+            .enumerate()
+            .map(|(i, &x)| (key(cell_of(x, inv_h)), i as u32))
+            .collect();
+        keyed.par_sort_unstable();
+        let mut cells = FxHashMap::default();
+        let mut start = 0;
+        for k in 1..=keyed.len() {
+            if k == keyed.len() || keyed[k].0 != keyed[start].0 {
+                cells.insert(keyed[start].0, (start as u32, k as u32));
+                start = k;
+            }
+        }
+        CellGrid {
+            inv_h,
+            items: keyed.into_iter().map(|(_, i)| i).collect(),
+            cells,
+        }
+    }
+
+    /// Bins boxes into every cell they overlap.
+    pub fn of_boxes(boxes: &[(DVec3, DVec3)], h: f64) -> CellGrid {
+        let inv_h = 1.0 / h;
+        let mut keyed: Vec<(u64, u32)> = Vec::new();
+        for (i, &(lo, hi)) in boxes.iter().enumerate() {
+            let (a, b) = (cell_of(lo, inv_h), cell_of(hi, inv_h));
+            for z in a.z..=b.z {
+                for y in a.y..=b.y {
+                    for x in a.x..=b.x {
+                        keyed.push((key(IVec3::new(x, y, z)), i as u32));
+                    }
+                }
+            }
+        }
+        keyed.sort_unstable();
+        let mut cells = FxHashMap::default();
+        let mut start = 0;
+        for k in 1..=keyed.len() {
+            if k == keyed.len() || keyed[k].0 != keyed[start].0 {
+                cells.insert(keyed[start].0, (start as u32, k as u32));
+                start = k;
+            }
+        }
+        CellGrid {
+            inv_h,
+            items: keyed.into_iter().map(|(_, i)| i).collect(),
+            cells,
+        }
+    }
+
+    /// Items in the cell containing `x`.
+    #[inline]
+    pub fn at(&self, x: DVec3) -> &[u32] {
+        self.in_cell(cell_of(x, self.inv_h))
+    }
+
+    #[inline]
+    fn in_cell(&self, c: IVec3) -> &[u32] {
+        match self.cells.get(&key(c)) {
+            Some(&(a, b)) => &self.items[a as usize..b as usize],
+            None => &[],
+        }
+    }
+
+    /// Calls `f` for every item in the 27 cells around `x`.
+    #[inline]
+    pub fn for_each_near(&self, x: DVec3, mut f: impl FnMut(u32)) {
+        let c = cell_of(x, self.inv_h);
+        for dz in -1..=1 {
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    for &j in self.in_cell(c + IVec3::new(dx, dy, dz)) {
+                        f(j);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// A compressed list: for each owner `i`, a sorted run of partners, each with springs.
+#[derive(Clone, Debug, Default)]
+pub struct ContactList {
+    /// Run of owner `i` is `start[i]..start[i+1]`.
+    pub start: Vec<u32>,
+    /// Owner of each slot.
+    pub owner: Vec<u32>,
+    /// Partner of each slot (particle `j > i`, or face index).
+    pub partner: Vec<u32>,
+    /// Friction springs of each slot.
+    pub springs: Vec<Springs>,
+}
+
+impl ContactList {
+    pub fn slots(&self) -> usize {
+        self.partner.len()
+    }
+
+    fn run(&self, i: usize) -> &[u32] {
+        if i + 1 >= self.start.len() {
+            return &[];
+        }
+        &self.partner[self.start[i] as usize..self.start[i + 1] as usize]
+    }
+
+    /// A new list from per-owner sorted partner runs, carrying over the springs of pairs
+    /// that were listed before.
+    fn rebuild(&self, runs: Vec<Vec<u32>>) -> ContactList {
+        let mut start = Vec::with_capacity(runs.len() + 1);
+        let total: usize = runs.iter().map(Vec::len).sum();
+        let mut owner = Vec::with_capacity(total);
+        let mut partner = Vec::with_capacity(total);
+        start.push(0u32);
+        for (i, run) in runs.into_iter().enumerate() {
+            owner.extend(std::iter::repeat_n(i as u32, run.len()));
+            partner.extend_from_slice(&run);
+            start.push(partner.len() as u32);
+        }
+        let springs = owner
+            .par_iter()
+            .zip(partner.par_iter())
+            .with_min_len(MIN_PARALLEL_LEN)
+            .map(|(&i, &j)| {
+                let old = self.run(i as usize);
+                match old.binary_search(&j) {
+                    Ok(k) => self.springs[self.start[i as usize] as usize + k],
+                    Err(_) => Springs::default(),
+                }
+            })
+            .collect();
+        ContactList {
+            start,
+            owner,
+            partner,
+            springs,
+        }
+    }
+}
+
+/// Verlet lists of particle pairs and particle-face pairs.
+#[derive(Clone, Debug, Default)]
+pub struct Neighbours {
+    /// Extra distance listed beyond contact.
+    pub skin: f64,
+    /// Particle pairs i < j.
+    pub pairs: ContactList,
+    /// For each particle j, the pair slots in which it is the partner (sorted).
+    pub reverse_start: Vec<u32>,
+    pub reverse_slot: Vec<u32>,
+    /// Particle-face pairs.
+    pub faces: ContactList,
+    /// Positions at the last rebuild.
+    x_at_build: Vec<DVec3>,
+    /// Number of rebuilds so far.
+    pub rebuilds: u64,
+}
+
+impl Neighbours {
+    pub fn new(skin: f64) -> Self {
+        Neighbours {
+            skin,
+            ..Default::default()
+        }
+    }
+
+    /// Whether the lists must be rebuilt: the particle count changed or some particle
+    /// moved more than half the skin since the last rebuild.
+    pub fn stale(&self, x: &[DVec3]) -> bool {
+        if x.len() != self.x_at_build.len() {
+            return true;
+        }
+        let limit = (0.5 * self.skin).powi(2);
+        x.par_iter()
+            .zip(self.x_at_build.par_iter())
+            .with_min_len(4 * MIN_PARALLEL_LEN)
+            .any(|(a, b)| (*a - *b).length_squared() > limit || !a.is_finite())
+    }
+
+    /// Rebuilds both lists for particles at `x` with radii `radius`.
+    pub fn rebuild(
+        &mut self,
+        x: &[DVec3],
+        radius: &[f64],
+        faces: &[Face],
+        face_grid: &CellGrid,
+    ) {
+        let n = x.len();
+        let max_r = radius.iter().copied().fold(0.0, f64::max);
+        let skin = self.skin;
+        let h = 2.0 * max_r + skin;
+        let grid = CellGrid::of_points(x, if h > 0.0 { h } else { 1.0 });
+
+        let pair_runs: Vec<Vec<u32>> = (0..n)
+            .into_par_iter()
+            .with_min_len(MIN_PARALLEL_LEN / 8)
+            .map(|i| {
+                let mut run = Vec::new();
+                let (xi, ri) = (x[i], radius[i]);
+                grid.for_each_near(xi, |j| {
+                    let j = j as usize;
+                    if j > i {
+                        let reach = ri + radius[j] + skin;
+                        if (xi - x[j]).length_squared() < reach * reach {
+                            run.push(j as u32);
+                        }
+                    }
+                });
+                run.sort_unstable();
+                run
+            })
+            .collect();
+        self.pairs = self.pairs.rebuild(pair_runs);
+
+        // Reverse index by counting sort over partners (keeps slots in ascending order).
+        let mut count = vec![0u32; n + 1];
+        for &j in &self.pairs.partner {
+            count[j as usize + 1] += 1;
+        }
+        for k in 0..n {
+            count[k + 1] += count[k];
+        }
+        let mut fill = count.clone();
+        let mut slots = vec![0u32; self.pairs.slots()];
+        for (slot, &j) in self.pairs.partner.iter().enumerate() {
+            slots[fill[j as usize] as usize] = slot as u32;
+            fill[j as usize] += 1;
+        }
+        self.reverse_start = count;
+        self.reverse_slot = slots;
+
+        let face_runs: Vec<Vec<u32>> = (0..n)
+            .into_par_iter()
+            .with_min_len(MIN_PARALLEL_LEN / 8)
+            .map(|i| {
+                let (xi, ri) = (x[i], radius[i]);
+                let mut run: Vec<u32> = face_grid
+                    .at(xi)
+                    .iter()
+                    .copied()
+                    .filter(|&f| {
+                        let face = &faces[f as usize];
+                        let reach = ri + face.radius + skin;
+                        (xi - face.closest_point(xi)).length_squared() < reach * reach
+                    })
+                    .collect();
+                run.sort_unstable();
+                run
+            })
+            .collect();
+        self.faces = self.faces.rebuild(face_runs);
+
+        self.x_at_build = x.to_vec();
+        self.rebuilds += 1;
+    }
+}
+
+/// The grid of mesh faces for particles up to radius `max_radius`: each face is binned into
+/// every cell its bounding box, grown by `max_radius + skin`, overlaps, so the cell of a
+/// particle's centre lists every face it can reach before the next rebuild.
+pub fn face_grid(faces: &[Face], max_radius: f64, skin: f64) -> CellGrid {
+    let grow = DVec3::splat(max_radius + skin);
+    let boxes: Vec<(DVec3, DVec3)> = faces
+        .iter()
+        .map(|f| {
+            let (lo, hi) = f.bounding_box();
+            (lo - grow, hi + grow)
+        })
+        .collect();
+    let h = (2.0 * max_radius + skin).max(f64::MIN_POSITIVE);
+    CellGrid::of_boxes(&boxes, h)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lists_every_pair_within_reach_once() {
+        // A small lattice with jitter; compare with brute force.
+        let mut x = Vec::new();
+        let mut s = 7u64;
+        let mut rnd = || {
+            s = s.wrapping_mul(6364136223846793005).wrapping_add(1);
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..400 {
+            x.push(DVec3::new(rnd(), rnd(), rnd()) * 0.2 - 0.1);
+        }
+        let radius: Vec<f64> = (0..x.len()).map(|i| 0.005 + 0.001 * (i % 3) as f64).collect();
+        let mut nb = Neighbours::new(0.002);
+        nb.rebuild(&x, &radius, &[], &CellGrid::default());
+        let mut brute = Vec::new();
+        for i in 0..x.len() {
+            for j in i + 1..x.len() {
+                if x[i].distance(x[j]) < radius[i] + radius[j] + 0.002 {
+                    brute.push((i as u32, j as u32));
+                }
+            }
+        }
+        let listed: Vec<(u32, u32)> = nb
+            .pairs
+            .owner
+            .iter()
+            .copied()
+            .zip(nb.pairs.partner.iter().copied())
+            .collect();
+        assert_eq!(listed, brute);
+        // The reverse index names every slot once, under its partner.
+        for j in 0..x.len() {
+            for &slot in &nb.reverse_slot[nb.reverse_start[j] as usize..nb.reverse_start[j + 1] as usize] {
+                assert_eq!(nb.pairs.partner[slot as usize] as usize, j);
+            }
+        }
+        assert_eq!(nb.reverse_slot.len(), brute.len());
+    }
+}

@@ -1,0 +1,390 @@
+//! Scenario files: every parameter of the paper's Table 2, parsed and validated in one
+//! place. Physics code receives a [`Scenario`] and never parses.
+//!
+//! ```toml
+//! [geometry]   radius_min, radius_max, mesh, mesh_radii, spawn_min, spawn_max
+//! [material]   density, youngs_modulus, poisson_ratio, restitution, friction_sliding,
+//!              friction_rolling, friction_twisting, viscosity
+//! [kinetics]   initial_velocity, initial_angular_velocity, gravity
+//! [simulation] timestep, max_particles, frames, steps_per_frame, spawn_attempts, seed
+//! [input]      particles
+//! [output]     dir
+//! ```
+//! Paths are relative to the scenario file. Unknown keys and values outside Table 2's
+//! "Requirements" column are errors naming the key and the allowed range.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use glam::DVec3;
+use serde::Deserialize;
+
+/// The geometry of the paper's default hourglass (Fig. 5A), embedded so that `tinydem`
+/// runs with no files.
+pub const HOURGLASS_OFF: &str = include_str!("../assets/hourglass.off");
+
+/// Where the static mesh comes from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum MeshSource {
+    None,
+    File(PathBuf),
+    /// Text compiled into the binary, with a name for messages.
+    Embedded { name: &'static str, text: &'static str },
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Geometry {
+    /// R_min [L]
+    pub radius_min: f64,
+    /// R_max [L]
+    pub radius_max: f64,
+    pub mesh: MeshSource,
+    /// R_mesh [L], selected per face by the OFF colour index.
+    pub mesh_radii: Vec<f64>,
+    /// s_min, s_max [L]: the spawn box.
+    pub spawn_min: DVec3,
+    pub spawn_max: DVec3,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    /// ρ [M/L³]
+    pub density: f64,
+    /// E [M/LT²]
+    pub youngs_modulus: f64,
+    /// ν [-]
+    pub poisson_ratio: f64,
+    /// e_n [-]
+    pub restitution: f64,
+    /// μ_s, μ_r, μ_t [-]
+    pub friction_sliding: f64,
+    pub friction_rolling: f64,
+    pub friction_twisting: f64,
+    /// η [M/LT]
+    pub viscosity: f64,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Kinetics {
+    /// v_0 [L/T]
+    pub initial_velocity: DVec3,
+    /// ω_0 [1/T]
+    pub initial_angular_velocity: DVec3,
+    /// g [L/T²]
+    pub gravity: DVec3,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Simulation {
+    /// Δt [T]
+    pub timestep: f64,
+    /// N_max
+    pub max_particles: u64,
+    /// N_frames
+    pub frames: u64,
+    /// N_steps
+    pub steps_per_frame: u64,
+    /// N_spawn
+    pub spawn_attempts: u64,
+    /// Seed of the random stream used for spawning.
+    pub seed: u64,
+}
+
+/// A complete, validated scenario.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scenario {
+    pub geometry: Geometry,
+    pub material: Material,
+    pub kinetics: Kinetics,
+    pub simulation: Simulation,
+    /// Initial particles (CSV), if any.
+    pub particles: Option<PathBuf>,
+    /// Output directory.
+    pub output_dir: PathBuf,
+}
+
+/// Default time step, Eq. (50): Δt = R_min sqrt(ρ (1 - ν²) / E).
+pub fn default_timestep(radius_min: f64, material: &Material) -> f64 {
+    let nu = material.poisson_ratio;
+    radius_min * (material.density * (1.0 - nu * nu) / material.youngs_modulus).sqrt()
+}
+
+// ---- The file format: every key optional, unknown keys rejected. -------------------
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawScenario {
+    #[serde(default)]
+    geometry: RawGeometry,
+    #[serde(default)]
+    material: RawMaterial,
+    #[serde(default)]
+    kinetics: RawKinetics,
+    #[serde(default)]
+    simulation: RawSimulation,
+    #[serde(default)]
+    input: RawInput,
+    #[serde(default)]
+    output: RawOutput,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawGeometry {
+    radius_min: Option<f64>,
+    radius_max: Option<f64>,
+    mesh: Option<PathBuf>,
+    mesh_radii: Option<Vec<f64>>,
+    spawn_min: Option<[f64; 3]>,
+    spawn_max: Option<[f64; 3]>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawMaterial {
+    density: Option<f64>,
+    youngs_modulus: Option<f64>,
+    poisson_ratio: Option<f64>,
+    restitution: Option<f64>,
+    friction_sliding: Option<f64>,
+    friction_rolling: Option<f64>,
+    friction_twisting: Option<f64>,
+    viscosity: Option<f64>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawKinetics {
+    initial_velocity: Option<[f64; 3]>,
+    initial_angular_velocity: Option<[f64; 3]>,
+    gravity: Option<[f64; 3]>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawSimulation {
+    timestep: Option<f64>,
+    max_particles: Option<u64>,
+    frames: Option<u64>,
+    steps_per_frame: Option<u64>,
+    spawn_attempts: Option<u64>,
+    seed: Option<u64>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawInput {
+    particles: Option<PathBuf>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawOutput {
+    dir: Option<PathBuf>,
+}
+
+/// A range check of Table 2's "Requirements" column.
+#[derive(Clone, Copy)]
+enum Range {
+    Positive,
+    NonNegative,
+    /// Any finite value.
+    Finite,
+    /// (lo, hi]
+    OpenClosed(f64, f64),
+    /// [lo, hi]
+    Closed(f64, f64),
+}
+
+impl Range {
+    fn contains(self, x: f64) -> bool {
+        x.is_finite()
+            && match self {
+                Range::Positive => x > 0.0,
+                Range::NonNegative => x >= 0.0,
+                Range::Finite => true,
+                Range::OpenClosed(lo, hi) => x > lo && x <= hi,
+                Range::Closed(lo, hi) => x >= lo && x <= hi,
+            }
+    }
+
+    fn describe(self) -> String {
+        match self {
+            Range::Positive => "a finite number > 0".into(),
+            Range::NonNegative => "a finite number >= 0".into(),
+            Range::Finite => "a finite number".into(),
+            Range::OpenClosed(lo, hi) => format!("in ({lo}, {hi}]"),
+            Range::Closed(lo, hi) => format!("in [{lo}, {hi}]"),
+        }
+    }
+}
+
+fn check(key: &str, x: f64, range: Range) -> Result<f64> {
+    if !range.contains(x) {
+        bail!("{key} = {x} is not allowed: it must be {}", range.describe());
+    }
+    Ok(x)
+}
+
+fn check_vec(key: &str, v: [f64; 3]) -> Result<DVec3> {
+    for (c, x) in ["x", "y", "z"].iter().zip(v) {
+        check(&format!("{key}.{c}"), x, Range::Finite)?;
+    }
+    Ok(DVec3::from_array(v))
+}
+
+impl Default for Scenario {
+    /// The paper's default simulation (Table 2): 1000 particles falling through the
+    /// hourglass of Fig. 5A.
+    fn default() -> Self {
+        let mut s = Scenario::from_raw(RawScenario::default(), Path::new("."))
+            .expect("Table 2 defaults are valid");
+        s.geometry.mesh = MeshSource::Embedded {
+            name: "hourglass.off (built in)",
+            text: HOURGLASS_OFF,
+        };
+        s
+    }
+}
+
+impl Scenario {
+    /// Reads and validates a scenario file.
+    pub fn load(path: &Path) -> Result<Scenario> {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read scenario file {}", path.display()))?;
+        Scenario::parse(&text, path)
+    }
+
+    /// Parses and validates scenario text; `path` names the file in messages and anchors
+    /// relative paths.
+    pub fn parse(text: &str, path: &Path) -> Result<Scenario> {
+        let raw: RawScenario = toml::from_str(text)
+            .map_err(|e| anyhow::anyhow!("{}: {}", path.display(), e.to_string().trim_end()))?;
+        let base = path.parent().unwrap_or(Path::new("."));
+        Scenario::from_raw(raw, base).with_context(|| format!("{}: invalid scenario", path.display()))
+    }
+
+    fn from_raw(raw: RawScenario, base: &Path) -> Result<Scenario> {
+        let g = raw.geometry;
+        let radius_min = check("[geometry] radius_min", g.radius_min.unwrap_or(0.002), Range::Positive)?;
+        let radius_max = check("[geometry] radius_max", g.radius_max.unwrap_or(0.01), Range::Positive)?;
+        if radius_max < radius_min {
+            bail!("[geometry] radius_max = {radius_max} must be >= radius_min = {radius_min}");
+        }
+        let mesh_radii = g.mesh_radii.unwrap_or_else(|| vec![0.002, 0.02, 0.01]);
+        if mesh_radii.is_empty() {
+            bail!("[geometry] mesh_radii must hold at least one radius");
+        }
+        for (k, &r) in mesh_radii.iter().enumerate() {
+            check(&format!("[geometry] mesh_radii[{k}]"), r, Range::NonNegative)?;
+        }
+        let spawn_min = check_vec("[geometry] spawn_min", g.spawn_min.unwrap_or([-0.1, -0.1, 0.3]))?;
+        let spawn_max = check_vec("[geometry] spawn_max", g.spawn_max.unwrap_or([0.1, 0.1, 0.4]))?;
+        if spawn_max.cmplt(spawn_min).any() {
+            bail!("[geometry] spawn_max = {spawn_max} must be >= spawn_min = {spawn_min} in every component");
+        }
+        let geometry = Geometry {
+            radius_min,
+            radius_max,
+            mesh: g.mesh.map_or(MeshSource::None, |p| MeshSource::File(base.join(p))),
+            mesh_radii,
+            spawn_min,
+            spawn_max,
+        };
+
+        let m = raw.material;
+        let friction_sliding = check("[material] friction_sliding", m.friction_sliding.unwrap_or(0.3), Range::NonNegative)?;
+        let material = Material {
+            density: check("[material] density", m.density.unwrap_or(1e3), Range::Positive)?,
+            youngs_modulus: check("[material] youngs_modulus", m.youngs_modulus.unwrap_or(1e6), Range::Positive)?,
+            poisson_ratio: check("[material] poisson_ratio", m.poisson_ratio.unwrap_or(0.3), Range::OpenClosed(-1.0, 0.5))?,
+            restitution: check("[material] restitution", m.restitution.unwrap_or(0.5), Range::Closed(0.0, 1.0))?,
+            friction_sliding,
+            friction_rolling: check("[material] friction_rolling", m.friction_rolling.unwrap_or(0.3), Range::NonNegative)?,
+            // Eq. (41)
+            friction_twisting: check(
+                "[material] friction_twisting",
+                m.friction_twisting.unwrap_or(2.0 / 3.0 * friction_sliding),
+                Range::NonNegative,
+            )?,
+            viscosity: check("[material] viscosity", m.viscosity.unwrap_or(0.0), Range::NonNegative)?,
+        };
+
+        let k = raw.kinetics;
+        let kinetics = Kinetics {
+            initial_velocity: check_vec("[kinetics] initial_velocity", k.initial_velocity.unwrap_or([0.0, 0.0, -1.0]))?,
+            initial_angular_velocity: check_vec(
+                "[kinetics] initial_angular_velocity",
+                k.initial_angular_velocity.unwrap_or([0.0; 3]),
+            )?,
+            gravity: check_vec("[kinetics] gravity", k.gravity.unwrap_or([0.0, 0.0, -9.81]))?,
+        };
+
+        let s = raw.simulation;
+        let timestep = match s.timestep {
+            Some(dt) => check("[simulation] timestep", dt, Range::Positive)?,
+            None => default_timestep(radius_min, &material),
+        };
+        let simulation = Simulation {
+            timestep,
+            max_particles: s.max_particles.unwrap_or(1000),
+            frames: s.frames.unwrap_or(100),
+            steps_per_frame: s.steps_per_frame.unwrap_or(500),
+            spawn_attempts: s.spawn_attempts.unwrap_or(100),
+            seed: s.seed.unwrap_or(1),
+        };
+        if simulation.max_particles > u32::MAX as u64 / 2 {
+            bail!("[simulation] max_particles = {} is too large: at most {}", simulation.max_particles, u32::MAX / 2);
+        }
+
+        Ok(Scenario {
+            geometry,
+            material,
+            kinetics,
+            simulation,
+            particles: raw.input.particles.map(|p| base.join(p)),
+            output_dir: raw.output.dir.map_or_else(|| PathBuf::from("output"), |d| base.join(d)),
+        })
+    }
+
+    /// Total simulated time N_frames N_steps Δt.
+    pub fn total_time(&self) -> f64 {
+        self.simulation.frames as f64 * self.simulation.steps_per_frame as f64 * self.simulation.timestep
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_table_2() {
+        let s = Scenario::default();
+        assert_eq!(s.geometry.radius_min, 0.002);
+        assert_eq!(s.material.friction_twisting, 0.2);
+        assert_eq!(s.simulation.frames * s.simulation.steps_per_frame, 50_000);
+        // Eq. (50): 0.002 * sqrt(1000 * 0.91 / 1e6)
+        assert!((s.simulation.timestep - 6.0332412e-5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn unknown_key_is_named() {
+        let e = Scenario::parse("[material]\ndensityy = 3\n", Path::new("s.toml")).unwrap_err();
+        let msg = format!("{e:#}");
+        assert!(msg.contains("densityy") && msg.contains("s.toml"), "{msg}");
+    }
+
+    #[test]
+    fn out_of_range_value_names_key_and_range() {
+        let e = Scenario::parse("[material]\npoisson_ratio = 0.7\n", Path::new("s.toml")).unwrap_err();
+        let msg = format!("{e:#}");
+        assert!(msg.contains("poisson_ratio") && msg.contains("(-1, 0.5]"), "{msg}");
+    }
+
+    #[test]
+    fn paths_are_relative_to_the_scenario() {
+        let s = Scenario::parse("[input]\nparticles = \"p.csv\"\n", Path::new("cases/a/s.toml")).unwrap();
+        assert_eq!(s.particles, Some(PathBuf::from("cases/a/p.csv")));
+        assert_eq!(s.output_dir, PathBuf::from("output"));
+    }
+}
