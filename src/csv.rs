@@ -64,8 +64,15 @@ pub fn write_frame(dir: &Path, k: u64, p: &Particles) -> Result<PathBuf> {
 pub fn read_particles(input: impl Read, file: &str) -> Result<Particles> {
     let mut lines = BufReader::with_capacity(1 << 16, input);
     let mut header = String::new();
-    if lines.read_line(&mut header).map_err(|_| anyhow::anyhow!("{file}:1: cannot read line (not UTF-8 text?)"))? == 0 {
-        bail!("{file}: empty file, expected the header line '{}'", COLUMNS.join(","));
+    if lines
+        .read_line(&mut header)
+        .map_err(|_| anyhow::anyhow!("{file}:1: cannot read line (not UTF-8 text?)"))?
+        == 0
+    {
+        bail!(
+            "{file}: empty file, expected the header line '{}'",
+            COLUMNS.join(",")
+        );
     }
     let names: Vec<&str> = header.trim().split(',').map(str::trim).collect();
     let mut slot = [usize::MAX; 14];
@@ -82,7 +89,11 @@ pub fn read_particles(input: impl Read, file: &str) -> Result<Particles> {
         slot[k] = col;
     }
     if let Some(k) = slot.iter().position(|&s| s == usize::MAX) {
-        bail!("{file}:1: column '{}' is missing: expected the header '{}'", COLUMNS[k], COLUMNS.join(","));
+        bail!(
+            "{file}:1: column '{}' is missing: expected the header '{}'",
+            COLUMNS[k],
+            COLUMNS.join(",")
+        );
     }
 
     // Column of each of the 14 quantities, and which quantity each column holds.
@@ -116,10 +127,18 @@ pub fn read_particles(input: impl Read, file: &str) -> Result<Particles> {
             let k = quantity_of_column[col];
             let text = text.trim();
             let x: f64 = text.parse().map_err(|_| {
-                anyhow::anyhow!("{file}:{n}: column {} ('{}'): expected a number, found '{text}'", col + 1, COLUMNS[k])
+                anyhow::anyhow!(
+                    "{file}:{n}: column {} ('{}'): expected a number, found '{text}'",
+                    col + 1,
+                    COLUMNS[k]
+                )
             })?;
             if !x.is_finite() {
-                bail!("{file}:{n}: column {} ('{}'): expected a finite number, found '{text}'", col + 1, COLUMNS[k]);
+                bail!(
+                    "{file}:{n}: column {} ('{}'): expected a finite number, found '{text}'",
+                    col + 1,
+                    COLUMNS[k]
+                );
             }
             values[k] = x;
         }
@@ -133,13 +152,19 @@ pub fn read_particles(input: impl Read, file: &str) -> Result<Particles> {
         let q = DQuat::from_xyzw(v[8], v[9], v[10], v[7]);
         let norm = q.length();
         if norm == 0.0 {
-            bail!("{file}:{n}: the quaternion (q0, q1, q2, q3) is zero; use 1,0,0,0 for no rotation");
+            bail!(
+                "{file}:{n}: the quaternion (q0, q1, q2, q3) is zero; use 1,0,0,0 for no rotation"
+            );
         }
         particles.push(Particle {
             x: DVec3::new(v[0], v[1], v[2]),
             radius: v[3],
             v: DVec3::new(v[4], v[5], v[6]),
-            q: if (norm - 1.0).abs() < 1e-12 { q } else { q / norm },
+            q: if (norm - 1.0).abs() < 1e-12 {
+                q
+            } else {
+                q / norm
+            },
             w: DVec3::new(v[11], v[12], v[13]),
         });
     }
@@ -175,15 +200,24 @@ mod tests {
     }
 
     fn err(text: &str) -> String {
-        format!("{:#}", read_particles(text.as_bytes(), "p.csv").unwrap_err())
+        format!(
+            "{:#}",
+            read_particles(text.as_bytes(), "p.csv").unwrap_err()
+        )
     }
 
     #[test]
     fn bad_lines_are_named() {
         let h = "x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz\n";
-        assert!(err(&format!("{h}0,0,0,1,0,0,0,1,0,0,0,0,0\n")).contains("p.csv:2: expected 14 values, found 13"));
+        assert!(
+            err(&format!("{h}0,0,0,1,0,0,0,1,0,0,0,0,0\n"))
+                .contains("p.csv:2: expected 14 values, found 13")
+        );
         assert!(err(&format!("{h}0,0,0,1,0,0,0,1,0,0,0,0,0,abc\n")).contains("found 'abc'"));
-        assert!(err(&format!("{h}0,0,0,-1,0,0,0,1,0,0,0,0,0,0\n")).contains("radius R = -1 must be > 0"));
+        assert!(
+            err(&format!("{h}0,0,0,-1,0,0,0,1,0,0,0,0,0,0\n"))
+                .contains("radius R = -1 must be > 0")
+        );
         assert!(err(&format!("{h}0,0,NaN,1,0,0,0,1,0,0,0,0,0,0\n")).contains("finite"));
         assert!(err("x,y,z\n").contains("column 'R' is missing"));
         assert!(err("x,y,z,x\n").contains("appears twice"));

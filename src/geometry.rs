@@ -3,6 +3,9 @@
 //!
 //! Each query returns the point of the primitive nearest to `x`; the caller adds the
 //! primitive's radius `R_j` (rounded edges and vertices) when it computes the overlap.
+//! The planar faces also give the separation vector `x - closest` directly as its normal
+//! part plus the overhang beyond the edges: then a particle moving in a plane parallel to
+//! a Cartesian plane sees no rounding error across that plane (exact 2D runs).
 
 use glam::DVec3;
 
@@ -17,52 +20,86 @@ pub fn closest_on_segment(x: DVec3, a: DVec3, b: DVec3) -> DVec3 {
     a + t * ab
 }
 
-/// Closest point to `x` on the triangle `a, b, c` (Fig. 4C), by Voronoi regions of its
-/// vertices, edges and face (Ericson, Real-Time Collision Detection, Sec. 5.1.5).
-pub fn closest_on_triangle(x: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
+/// Which feature of a primitive the closest point lies on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Feature {
+    Vertex,
+    Edge,
+    Face,
+}
+
+/// Closest point to `x` on the triangle `a, b, c` (Fig. 4C) and the feature it lies on, by
+/// Voronoi regions of its vertices, edges and face (Ericson, Real-Time Collision
+/// Detection, Sec. 5.1.5).
+pub fn closest_on_triangle(x: DVec3, a: DVec3, b: DVec3, c: DVec3) -> (DVec3, Feature) {
     let ab = b - a;
     let ac = c - a;
     let ax = x - a;
     let d1 = ab.dot(ax);
     let d2 = ac.dot(ax);
     if d1 <= 0.0 && d2 <= 0.0 {
-        return a; // vertex region a
+        return (a, Feature::Vertex);
     }
     let bx = x - b;
     let d3 = ab.dot(bx);
     let d4 = ac.dot(bx);
     if d3 >= 0.0 && d4 <= d3 {
-        return b; // vertex region b
+        return (b, Feature::Vertex);
     }
     let vc = d1 * d4 - d3 * d2;
     if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return a + d1 / (d1 - d3) * ab; // edge region ab
+        return (a + d1 / (d1 - d3) * ab, Feature::Edge); // edge ab
     }
     let cx = x - c;
     let d5 = ab.dot(cx);
     let d6 = ac.dot(cx);
     if d6 >= 0.0 && d5 <= d6 {
-        return c; // vertex region c
+        return (c, Feature::Vertex);
     }
     let vb = d5 * d2 - d1 * d6;
     if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return a + d2 / (d2 - d6) * ac; // edge region ac
+        return (a + d2 / (d2 - d6) * ac, Feature::Edge); // edge ac
     }
     let va = d3 * d6 - d5 * d4;
     if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        return b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b); // edge region bc
+        let t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return (b + t * (c - b), Feature::Edge); // edge bc
     }
     let denom = 1.0 / (va + vb + vc);
-    a + ab * (vb * denom) + ac * (vc * denom) // face region
+    (a + ab * (vb * denom) + ac * (vc * denom), Feature::Face)
 }
 
-/// Closest point to `x` on the rectangle with corner `o` and perpendicular edges `e1`, `e2`
-/// (Fig. 4D): clamp the in-plane coordinates to the rectangle.
-pub fn closest_on_rectangle(x: DVec3, o: DVec3, e1: DVec3, e2: DVec3) -> DVec3 {
+/// Separation `x - closest` from the triangle `a, b, c` with unit normal `n`: in the face
+/// region exactly the normal part of `x - a`.
+pub fn separation_from_triangle(x: DVec3, a: DVec3, b: DVec3, c: DVec3, n: DVec3) -> DVec3 {
+    match closest_on_triangle(x, a, b, c) {
+        (_, Feature::Face) => (x - a).dot(n) * n,
+        (p, _) => x - p,
+    }
+}
+
+/// Separation `x - closest` from the rectangle with corner `o`, perpendicular edges `e1`,
+/// `e2` and unit normal `n` (Fig. 4D): the normal part of `x - o` plus the overhang of the
+/// in-plane coordinates beyond [0, 1].
+pub fn separation_from_rectangle(x: DVec3, o: DVec3, e1: DVec3, e2: DVec3, n: DVec3) -> DVec3 {
     let d = x - o;
-    let s = (d.dot(e1) / e1.length_squared()).clamp(0.0, 1.0);
-    let t = (d.dot(e2) / e2.length_squared()).clamp(0.0, 1.0);
-    o + s * e1 + t * e2
+    let s = d.dot(e1) / e1.length_squared();
+    let t = d.dot(e2) / e2.length_squared();
+    let overhang = |u: f64| {
+        if u < 0.0 {
+            u
+        } else if u > 1.0 {
+            u - 1.0
+        } else {
+            0.0
+        }
+    };
+    d.dot(n) * n + overhang(s) * e1 + overhang(t) * e2
+}
+
+/// Closest point to `x` on the rectangle (see [`separation_from_rectangle`]).
+pub fn closest_on_rectangle(x: DVec3, o: DVec3, e1: DVec3, e2: DVec3) -> DVec3 {
+    x - separation_from_rectangle(x, o, e1, e2, e1.cross(e2).normalize())
 }
 
 #[cfg(test)]
@@ -119,7 +156,7 @@ mod tests {
         let mut rng = Lcg(2);
         for _ in 0..50 {
             let (a, b, c, x) = (rng.vec(1.0), rng.vec(1.0), rng.vec(1.0), rng.vec(2.0));
-            let p = closest_on_triangle(x, a, b, c);
+            let (p, _) = closest_on_triangle(x, a, b, c);
             check(
                 x,
                 p,
@@ -135,7 +172,7 @@ mod tests {
         for _ in 0..50 {
             let o = rng.vec(1.0);
             let e1 = rng.vec(1.0);
-            let e2 = e1.any_orthonormal_vector() * rng.next() * 2.0;
+            let e2 = e1.normalize().any_orthonormal_vector() * rng.next() * 2.0;
             let x = rng.vec(2.0);
             let p = closest_on_rectangle(x, o, e1, e2);
             check(x, p, |s, t| Some(o + s * e1 + t * e2), 2e-2);
@@ -145,7 +182,8 @@ mod tests {
     #[test]
     fn face_region_projects_onto_plane() {
         let (a, b, c) = (DVec3::ZERO, DVec3::X, DVec3::Y);
-        let p = closest_on_triangle(DVec3::new(0.2, 0.3, 0.7), a, b, c);
+        let (p, f) = closest_on_triangle(DVec3::new(0.2, 0.3, 0.7), a, b, c);
+        assert_eq!(f, Feature::Face);
         assert!(p.distance(DVec3::new(0.2, 0.3, 0.0)) < 1e-15);
     }
 }

@@ -62,9 +62,10 @@ fn real_main(cli: Cli) -> Result<()> {
             let out = s.output_dir.clone();
             let summary = run(s, &out, Verbosity::Normal)?;
             eprintln!(
-                "done: {} particles, {} steps, {} frames in {}, {:.2} s",
+                "done: {} particles, {} steps ({} neighbour-list rebuilds), {} frames in {}, {:.2} s",
                 summary.particles,
                 summary.steps,
+                summary.rebuilds,
                 summary.frames_written,
                 out.display(),
                 summary.wall_seconds
@@ -85,9 +86,10 @@ fn real_main(cli: Cli) -> Result<()> {
             let summary = run(s, &out, verbosity)?;
             if !quiet {
                 eprintln!(
-                    "done: {} particles, {} steps, {} frames in {}, {:.2} s",
+                    "done: {} particles, {} steps ({} neighbour-list rebuilds), {} frames in {}, {:.2} s",
                     summary.particles,
                     summary.steps,
+                    summary.rebuilds,
                     summary.frames_written,
                     out.display(),
                     summary.wall_seconds

@@ -4,16 +4,28 @@
 use anyhow::{Result, bail};
 use glam::DVec3;
 
-use crate::geometry::{closest_on_rectangle, closest_on_segment, closest_on_triangle};
+use crate::geometry::{closest_on_segment, separation_from_rectangle, separation_from_triangle};
 
 /// The shape of one mesh face (Fig. 4A-D).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Primitive {
     Point(DVec3),
     Segment(DVec3, DVec3),
-    Triangle(DVec3, DVec3, DVec3),
-    /// Corner `o` and perpendicular edges `e1`, `e2` (vertices o, o+e1, o+e1+e2, o+e2).
-    Rectangle { o: DVec3, e1: DVec3, e2: DVec3 },
+    /// Vertices and unit normal.
+    Triangle {
+        a: DVec3,
+        b: DVec3,
+        c: DVec3,
+        n: DVec3,
+    },
+    /// Corner `o`, perpendicular edges `e1`, `e2` (vertices o, o+e1, o+e1+e2, o+e2) and
+    /// unit normal `n`.
+    Rectangle {
+        o: DVec3,
+        e1: DVec3,
+        e2: DVec3,
+        n: DVec3,
+    },
 }
 
 /// One mesh element: a primitive dilated by its radius R_j.
@@ -25,15 +37,20 @@ pub struct Face {
 }
 
 impl Face {
-    /// Closest point of the (undilated) primitive to `x`.
+    /// Separation vector `x - p` from the closest point `p` of the (undilated) primitive.
     #[inline]
-    pub fn closest_point(&self, x: DVec3) -> DVec3 {
+    pub fn separation(&self, x: DVec3) -> DVec3 {
         match self.shape {
-            Primitive::Point(p) => p,
-            Primitive::Segment(a, b) => closest_on_segment(x, a, b),
-            Primitive::Triangle(a, b, c) => closest_on_triangle(x, a, b, c),
-            Primitive::Rectangle { o, e1, e2 } => closest_on_rectangle(x, o, e1, e2),
+            Primitive::Point(p) => x - p,
+            Primitive::Segment(a, b) => x - closest_on_segment(x, a, b),
+            Primitive::Triangle { a, b, c, n } => separation_from_triangle(x, a, b, c, n),
+            Primitive::Rectangle { o, e1, e2, n } => separation_from_rectangle(x, o, e1, e2, n),
         }
+    }
+
+    /// Closest point of the (undilated) primitive to `x`.
+    pub fn closest_point(&self, x: DVec3) -> DVec3 {
+        x - self.separation(x)
     }
 
     /// Axis-aligned bounding box of the dilated face.
@@ -41,13 +58,19 @@ impl Face {
         let (lo, hi) = match self.shape {
             Primitive::Point(p) => (p, p),
             Primitive::Segment(a, b) => (a.min(b), a.max(b)),
-            Primitive::Triangle(a, b, c) => (a.min(b).min(c), a.max(b).max(c)),
-            Primitive::Rectangle { o, e1, e2 } => {
+            Primitive::Triangle { a, b, c, .. } => (a.min(b).min(c), a.max(b).max(c)),
+            Primitive::Rectangle { o, e1, e2, .. } => {
                 let c = [o, o + e1, o + e1 + e2, o + e2];
-                (c[0].min(c[1]).min(c[2]).min(c[3]), c[0].max(c[1]).max(c[2]).max(c[3]))
+                (
+                    c[0].min(c[1]).min(c[2]).min(c[3]),
+                    c[0].max(c[1]).max(c[2]).max(c[3]),
+                )
             }
         };
-        (lo - DVec3::splat(self.radius), hi + DVec3::splat(self.radius))
+        (
+            lo - DVec3::splat(self.radius),
+            hi + DVec3::splat(self.radius),
+        )
     }
 }
 
@@ -106,14 +129,21 @@ impl Mesh {
         } else {
             (n0, rest)
         };
-        let counts: Vec<u64> = parse_numbers(file, n1, counts_line, "the counts 'vertices faces edges' (whole numbers)")?;
+        let counts: Vec<u64> = parse_numbers(
+            file,
+            n1,
+            counts_line,
+            "the counts 'vertices faces edges' (whole numbers)",
+        )?;
         if counts.len() < 2 || counts.len() > 3 {
             bail!("{file}:{n1}: expected the counts 'vertices faces edges', found '{counts_line}'");
         }
         let (nv, nf) = (counts[0] as usize, counts[1] as usize);
         let remaining = text.len();
         if nv > remaining || nf > remaining {
-            bail!("{file}:{n1}: the header announces {nv} vertices and {nf} faces, more than the file can hold");
+            bail!(
+                "{file}:{n1}: the header announces {nv} vertices and {nf} faces, more than the file can hold"
+            );
         }
 
         let mut vertices = Vec::with_capacity(nv);
@@ -123,7 +153,9 @@ impl Mesh {
             };
             let xyz: Vec<f64> = parse_numbers(file, n, line, "a vertex 'x y z'")?;
             if xyz.len() != 3 || xyz.iter().any(|x| !x.is_finite()) {
-                bail!("{file}:{n}: expected a vertex as three finite numbers 'x y z', found '{line}'");
+                bail!(
+                    "{file}:{n}: expected a vertex as three finite numbers 'x y z', found '{line}'"
+                );
             }
             vertices.push(DVec3::new(xyz[0], xyz[1], xyz[2]));
         }
@@ -133,10 +165,17 @@ impl Mesh {
             let Some((n, line)) = lines.next() else {
                 bail!("{file}: ends after {k} of {nf} faces");
             };
-            let ints: Vec<i64> = parse_numbers(file, n, line, "a face 'k v_1 ... v_k [radius index]' (whole numbers)")?;
+            let ints: Vec<i64> = parse_numbers(
+                file,
+                n,
+                line,
+                "a face 'k v_1 ... v_k [radius index]' (whole numbers)",
+            )?;
             let count = ints[0];
             if !(1..=4).contains(&count) {
-                bail!("{file}:{n}: a face has 1 to 4 vertices (point, edge, triangle, rectangle), found {count}");
+                bail!(
+                    "{file}:{n}: a face has 1 to 4 vertices (point, edge, triangle, rectangle), found {count}"
+                );
             }
             let count = count as usize;
             let extra = ints.len() - 1;
@@ -152,7 +191,11 @@ impl Mesh {
                 }
                 *slot = vertices[idx as usize];
             }
-            let ri = if extra == count + 1 { ints[count + 1] } else { 0 };
+            let ri = if extra == count + 1 {
+                ints[count + 1]
+            } else {
+                0
+            };
             if ri < 0 || ri as usize >= radii.len() {
                 bail!(
                     "{file}:{n}: radius index {ri} is out of range: mesh_radii has {} entries",
@@ -163,14 +206,23 @@ impl Mesh {
                 1 => Primitive::Point(v[0]),
                 2 => Primitive::Segment(v[0], v[1]),
                 3 => {
-                    if (v[1] - v[0]).cross(v[2] - v[0]).length_squared() == 0.0 {
+                    let normal = (v[1] - v[0]).cross(v[2] - v[0]);
+                    if normal.length_squared() == 0.0 {
                         bail!("{file}:{n}: degenerate triangle (its vertices are collinear)");
                     }
-                    Primitive::Triangle(v[0], v[1], v[2])
+                    Primitive::Triangle {
+                        a: v[0],
+                        b: v[1],
+                        c: v[2],
+                        n: normal.normalize(),
+                    }
                 }
                 _ => rectangle(v, file, n)?,
             };
-            faces.push(Face { shape, radius: radii[ri as usize] });
+            faces.push(Face {
+                shape,
+                radius: radii[ri as usize],
+            });
         }
         if let Some((n, line)) = lines.next() {
             bail!("{file}:{n}: unexpected line '{line}' after the {nf} faces the header announced");
@@ -202,7 +254,12 @@ fn rectangle(v: [DVec3; 4], file: &str, n: usize) -> Result<Primitive> {
             "{file}:{n}: the four vertices do not form a rectangle (v0, v1, v2, v3 in order around it); split other quadrilaterals into two triangles"
         );
     }
-    Ok(Primitive::Rectangle { o, e1, e2 })
+    Ok(Primitive::Rectangle {
+        o,
+        e1,
+        e2,
+        n: e1.cross(e2).normalize(),
+    })
 }
 
 #[cfg(test)]
@@ -211,7 +268,12 @@ mod tests {
 
     #[test]
     fn hourglass_parses() {
-        let m = Mesh::parse_off(crate::scenario::HOURGLASS_OFF, "hourglass", &[0.002, 0.02, 0.01]).unwrap();
+        let m = Mesh::parse_off(
+            crate::scenario::HOURGLASS_OFF,
+            "hourglass",
+            &[0.002, 0.02, 0.01],
+        )
+        .unwrap();
         assert_eq!(m.faces.len(), 19);
         assert_eq!(m.faces[17].radius, 0.02);
         assert!(matches!(m.faces[17].shape, Primitive::Point(_)));

@@ -239,13 +239,7 @@ impl Neighbours {
     }
 
     /// Rebuilds both lists for particles at `x` with radii `radius`.
-    pub fn rebuild(
-        &mut self,
-        x: &[DVec3],
-        radius: &[f64],
-        faces: &[Face],
-        face_grid: &CellGrid,
-    ) {
+    pub fn rebuild(&mut self, x: &[DVec3], radius: &[f64], faces: &[Face], face_grid: &CellGrid) {
         let n = x.len();
         let max_r = radius.iter().copied().fold(0.0, f64::max);
         let skin = self.skin;
@@ -302,7 +296,7 @@ impl Neighbours {
                     .filter(|&f| {
                         let face = &faces[f as usize];
                         let reach = ri + face.radius + skin;
-                        (xi - face.closest_point(xi)).length_squared() < reach * reach
+                        face.separation(xi).length_squared() < reach * reach
                     })
                     .collect();
                 run.sort_unstable();
@@ -348,7 +342,9 @@ mod tests {
         for _ in 0..400 {
             x.push(DVec3::new(rnd(), rnd(), rnd()) * 0.2 - 0.1);
         }
-        let radius: Vec<f64> = (0..x.len()).map(|i| 0.005 + 0.001 * (i % 3) as f64).collect();
+        let radius: Vec<f64> = (0..x.len())
+            .map(|i| 0.005 + 0.001 * (i % 3) as f64)
+            .collect();
         let mut nb = Neighbours::new(0.002);
         nb.rebuild(&x, &radius, &[], &CellGrid::default());
         let mut brute = Vec::new();
@@ -369,7 +365,9 @@ mod tests {
         assert_eq!(listed, brute);
         // The reverse index names every slot once, under its partner.
         for j in 0..x.len() {
-            for &slot in &nb.reverse_slot[nb.reverse_start[j] as usize..nb.reverse_start[j + 1] as usize] {
+            for &slot in
+                &nb.reverse_slot[nb.reverse_start[j] as usize..nb.reverse_start[j + 1] as usize]
+            {
                 assert_eq!(nb.pairs.partner[slot as usize] as usize, j);
             }
         }

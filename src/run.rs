@@ -26,6 +26,8 @@ pub struct Summary {
     pub frames_written: u64,
     pub particles: usize,
     pub steps: u64,
+    /// Neighbour-list rebuilds.
+    pub rebuilds: u64,
     pub wall_seconds: f64,
 }
 
@@ -59,7 +61,12 @@ pub fn run(scenario: Scenario, output_dir: &Path, verbosity: Verbosity) -> Resul
         None => eprintln!("{line}"),
     };
     if verbosity == Verbosity::Normal {
-        status(format!("frame {:>6}  t = {:.6e} s  particles {}", 0, sim.time, sim.particles.len()));
+        status(format!(
+            "frame {:>6}  t = {:.6e} s  particles {}",
+            0,
+            sim.time,
+            sim.particles.len()
+        ));
     }
 
     for frame in 1..=frames {
@@ -85,6 +92,7 @@ pub fn run(scenario: Scenario, output_dir: &Path, verbosity: Verbosity) -> Resul
         frames_written: frames + 1,
         particles: sim.particles.len(),
         steps: sim.steps,
+        rebuilds: sim.rebuilds(),
         wall_seconds: start.elapsed().as_secs_f64(),
     })
 }
@@ -119,7 +127,7 @@ pub fn describe(s: &Scenario) -> Result<String> {
          stiffness k_n at 10%   {k_10:.6e} N/m (two R_min particles, delta = 0.1 R_min)\n\
          half contact period    {period:.6e} s = {:.1} time steps\n\
          total simulated time   {:.6} s ({} frames x {} steps)\n\
-         output                 {} files, up to {:.1} MB each, {:.1} MB in all\n",
+         output                 {} files, up to {} each, {} in all\n",
         sim.mesh.faces.len(),
         sim.particles.len(),
         dt / default_dt,
@@ -128,7 +136,16 @@ pub fn describe(s: &Scenario) -> Result<String> {
         s.simulation.frames,
         s.simulation.steps_per_frame,
         s.simulation.frames + 1,
-        frame_bytes as f64 / 1e6,
-        frame_bytes as f64 * (s.simulation.frames + 1) as f64 / 1e6,
+        human_bytes(frame_bytes as f64),
+        human_bytes(frame_bytes as f64 * (s.simulation.frames + 1) as f64),
     ))
+}
+
+/// A byte count in kB, MB or GB.
+fn human_bytes(b: f64) -> String {
+    match b {
+        b if b < 1e6 => format!("{:.1} kB", b / 1e3),
+        b if b < 1e9 => format!("{:.1} MB", b / 1e6),
+        b => format!("{:.2} GB", b / 1e9),
+    }
 }

@@ -178,8 +178,8 @@ impl Simulation {
                     v: p.v[i],
                     w: p.w[i],
                 };
-                let closest = face.closest_point(body.x);
-                *force = match Kinematics::with_wall(&body, closest, face.radius) {
+                let d = face.separation(body.x);
+                *force = match Kinematics::with_wall(&body, d, face.radius) {
                     Some(kin) => {
                         let m_i = Inertia::mass(p.radius[i], density);
                         law.evaluate(p.radius[i], m_i, Other::Wall, &kin, springs)

@@ -21,7 +21,11 @@ pub struct Spawner {
 
 /// Uniform in [lo, hi]; exactly `lo` for a degenerate interval (2D and 1D spawn regions).
 fn uniform(rng: &mut ChaCha8Rng, lo: f64, hi: f64) -> f64 {
-    if hi > lo { rng.random_range(lo..=hi) } else { lo }
+    if hi > lo {
+        rng.random_range(lo..=hi)
+    } else {
+        lo
+    }
 }
 
 impl Spawner {
@@ -52,7 +56,10 @@ impl Spawner {
         let inv_h = 1.0 / h;
         let mut cells: FxHashMap<u64, Vec<u32>> = FxHashMap::default();
         for (i, &x) in particles.x.iter().enumerate() {
-            cells.entry(key(cell_of(x, inv_h))).or_default().push(i as u32);
+            cells
+                .entry(key(cell_of(x, inv_h)))
+                .or_default()
+                .push(i as u32);
         }
 
         let before = particles.len();
@@ -92,14 +99,17 @@ impl Spawner {
                 && face_grid.at(x).iter().all(|&f| {
                     let face = &faces[f as usize];
                     let reach = radius + face.radius;
-                    (x - face.closest_point(x)).length_squared() >= reach * reach
+                    face.separation(x).length_squared() >= reach * reach
                 });
             if !free {
                 self.pending_radius = Some(radius);
                 continue;
             }
             self.pending_radius = None;
-            cells.entry(key(c)).or_default().push(particles.len() as u32);
+            cells
+                .entry(key(c))
+                .or_default()
+                .push(particles.len() as u32);
             particles.push(Particle {
                 x,
                 radius,

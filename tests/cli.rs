@@ -1,0 +1,257 @@
+//! The command line: error paths exit non-zero with a clear message and never panic;
+//! results do not depend on the number of threads.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn tinydem(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_tinydem"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("binary runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// Asserts a failed run whose message contains every one of `expected`.
+fn fails_with(o: &Output, expected: &[&str]) {
+    let err = stderr(o);
+    assert!(!o.status.success(), "should fail: {err}");
+    assert!(!err.contains("panicked"), "panicked: {err}");
+    for e in expected {
+        assert!(err.contains(e), "message\n  {err}\nlacks\n  {e}");
+    }
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+const HEADER: &str = "x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz\n";
+
+#[test]
+fn missing_scenario_file() {
+    let t = tempfile::tempdir().unwrap();
+    fails_with(
+        &tinydem(&["run", "nope.toml"], t.path()),
+        &["cannot read scenario file nope.toml"],
+    );
+    fails_with(&tinydem(&["check", "nope.toml"], t.path()), &["nope.toml"]);
+}
+
+#[test]
+fn missing_mesh_and_particle_files() {
+    let t = tempfile::tempdir().unwrap();
+    write(t.path(), "m.toml", "[geometry]\nmesh = \"absent.off\"\n");
+    fails_with(
+        &tinydem(&["run", "m.toml"], t.path()),
+        &["cannot read mesh file", "absent.off"],
+    );
+    write(t.path(), "p.toml", "[input]\nparticles = \"absent.csv\"\n");
+    fails_with(
+        &tinydem(&["run", "p.toml"], t.path()),
+        &["cannot read particle file", "absent.csv"],
+    );
+}
+
+#[test]
+fn malformed_off_files() {
+    let t = tempfile::tempdir().unwrap();
+    write(
+        t.path(),
+        "s.toml",
+        "[geometry]\nmesh = \"m.off\"\nmesh_radii = [0.0]\n",
+    );
+    let cases: &[(&str, &[&str])] = &[
+        (
+            "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n5 0 1 2 0 1\n",
+            &["m.off:6", "1 to 4 vertices"],
+        ),
+        (
+            "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n",
+            &["m.off:6", "vertex index 7 is out of range"],
+        ),
+        (
+            "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2 3\n",
+            &["m.off:6", "radius index 3"],
+        ),
+        (
+            "OFF\n3 1 0\n0 0 0\n1 zero 0\n",
+            &["m.off:4", "found 'zero'"],
+        ),
+        (
+            "OFF\n3 1 0\n0 0 0\n1 0\n",
+            &["m.off:4", "three finite numbers"],
+        ),
+        (
+            "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+            &["ends after 1 of 2 faces"],
+        ),
+        (
+            "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n0\n",
+            &["m.off:6", "1 to 4 vertices"],
+        ),
+        ("PLY\n", &["m.off:1", "expected the keyword 'OFF'"]),
+        ("OFF\n999999999999 1 0\n", &["more than the file can hold"]),
+    ];
+    for (off, expected) in cases {
+        write(t.path(), "m.off", off);
+        fails_with(&tinydem(&["run", "s.toml"], t.path()), expected);
+    }
+    std::fs::write(t.path().join("m.off"), [0xffu8, 0xfe, 0x00, 0x12]).unwrap();
+    fails_with(&tinydem(&["run", "s.toml"], t.path()), &["not a text file"]);
+}
+
+#[test]
+fn malformed_csv_files() {
+    let t = tempfile::tempdir().unwrap();
+    write(t.path(), "s.toml", "[input]\nparticles = \"p.csv\"\n");
+    let row = "0,0,0.1,0.005,0,0,0,1,0,0,0,0,0,0\n";
+    let cases: Vec<(String, &[&str])> = vec![
+        (
+            format!("{HEADER}0,0,0.1,-0.005,0,0,0,1,0,0,0,0,0,0\n"),
+            &["p.csv:2", "radius R = -0.005 must be > 0"],
+        ),
+        (
+            format!("{HEADER}{row}0,0,nan,0.005,0,0,0,1,0,0,0,0,0,0\n"),
+            &["p.csv:3", "finite"],
+        ),
+        (
+            format!("{HEADER}0,0,0.1,0.005\n"),
+            &["p.csv:2", "expected 14 values, found 4"],
+        ),
+        (
+            format!("{HEADER}0,0,0.1,0.005,0,0,0,1,0,0,0,0,0,x\n"),
+            &["p.csv:2", "column 14 ('wz')", "found 'x'"],
+        ),
+        (
+            "x,y,z,R\n".to_string(),
+            &["p.csv:1", "column 'vx' is missing"],
+        ),
+        (String::new(), &["p.csv", "empty file"]),
+        (
+            format!("{HEADER}0,0,0.1,0.005,0,0,0,0,0,0,0,0,0,0\n"),
+            &["p.csv:2", "quaternion"],
+        ),
+    ];
+    for (csv, expected) in cases {
+        write(t.path(), "p.csv", &csv);
+        fails_with(&tinydem(&["run", "s.toml"], t.path()), expected);
+    }
+}
+
+#[test]
+fn bad_scenario_values_and_arguments() {
+    let t = tempfile::tempdir().unwrap();
+    write(t.path(), "s.toml", "[material]\nrestitution = 2.0\n");
+    fails_with(
+        &tinydem(&["run", "s.toml"], t.path()),
+        &["s.toml", "restitution = 2", "[0, 1]"],
+    );
+    fails_with(&tinydem(&["run"], t.path()), &["SCENARIO"]);
+    fails_with(&tinydem(&["frobnicate"], t.path()), &["frobnicate"]);
+    write(t.path(), "ok.toml", "[simulation]\nframes = 0\n");
+    fails_with(
+        &tinydem(&["run", "ok.toml", "--threads", "0"], t.path()),
+        &["--threads must be at least 1"],
+    );
+}
+
+#[test]
+fn unwritable_output_directory_is_reported_before_simulating() {
+    let t = tempfile::tempdir().unwrap();
+    write(t.path(), "s.toml", "[simulation]\nframes = 1\n");
+    write(t.path(), "file", "not a directory");
+    fails_with(
+        &tinydem(&["run", "s.toml", "--output", "file/sub"], t.path()),
+        &["cannot create output directory", "file/sub"],
+    );
+}
+
+#[test]
+fn check_prints_derived_quantities() {
+    let t = tempfile::tempdir().unwrap();
+    write(t.path(), "s.toml", "[simulation]\nframes = 10\n");
+    let o = tinydem(&["check", "s.toml"], t.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    for key in [
+        "time step",
+        "6.033241e-5",
+        "particle mass",
+        "stiffness",
+        "total simulated time",
+        "output",
+    ] {
+        assert!(out.contains(key), "missing {key} in\n{out}");
+    }
+}
+
+/// The frames of a short hourglass run (spawning, mesh and particle contacts).
+fn hourglass_frames(threads: &str, dir: &Path) -> Vec<Vec<u8>> {
+    let mesh = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/hourglass.off");
+    write(
+        dir,
+        "s.toml",
+        &format!(
+            "[geometry]\nmesh = \"{}\"\n[simulation]\nmax_particles = 1500\nframes = 4\nsteps_per_frame = 600\n",
+            mesh.display()
+        ),
+    );
+    let o = tinydem(
+        &[
+            "run",
+            "s.toml",
+            "-q",
+            "--threads",
+            threads,
+            "--output",
+            "out",
+        ],
+        dir,
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    (0..=4)
+        .map(|k| std::fs::read(dir.join(format!("out/particles{k:06}.csv"))).unwrap())
+        .collect()
+}
+
+#[test]
+fn output_is_identical_for_one_and_two_threads() {
+    let (a, b) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    let one = hourglass_frames("1", a.path());
+    let two = hourglass_frames("2", b.path());
+    assert!(one[4].len() > 1000 * 100, "the run spawned particles");
+    for (k, (x, y)) in one.iter().zip(&two).enumerate() {
+        assert!(x == y, "frame {k} differs between 1 and 2 threads");
+    }
+}
+
+#[test]
+fn output_format_is_the_original_one() {
+    let t = tempfile::tempdir().unwrap();
+    let frames = hourglass_frames("2", t.path());
+    let text = String::from_utf8(frames[1].clone()).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz"));
+    let row: Vec<f64> = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    assert_eq!(row.len(), 14);
+    // Frame 0 is the initial state: the hourglass run starts empty.
+    assert_eq!(
+        String::from_utf8(frames[0].clone())
+            .unwrap()
+            .lines()
+            .count(),
+        1
+    );
+}

@@ -1,0 +1,27 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+
+use tinydem::scenario::Scenario;
+use tinydem::simulation::Simulation;
+
+pub fn data(path: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(path)
+}
+
+/// A scenario from TOML text; relative paths resolve against `tests/data`.
+pub fn scenario(text: &str) -> Scenario {
+    Scenario::parse(text, &data("inline.toml")).expect("valid test scenario")
+}
+
+/// Runs `steps` steps of a scenario given as TOML text.
+pub fn simulate(text: &str, steps: u64) -> Simulation {
+    let mut sim = Simulation::new(scenario(text)).expect("simulation starts");
+    for _ in 0..steps {
+        sim.step();
+    }
+    sim
+}

@@ -1,0 +1,78 @@
+//! Scenario files good and bad (`tests/scenarios/{good,bad}`). Each bad file states on its
+//! first line, after `# error: `, text its error message must contain.
+
+use std::path::{Path, PathBuf};
+
+use tinydem::scenario::Scenario;
+use tinydem::simulation::Simulation;
+
+fn files(kind: &str) -> Vec<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/scenarios")
+        .join(kind);
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn good_scenarios_load_and_run() {
+    let good = files("good");
+    assert!(good.len() >= 2);
+    for path in good {
+        let s = Scenario::load(&path).unwrap_or_else(|e| panic!("{}: {e:#}", path.display()));
+        let steps = s.simulation.steps_per_frame;
+        let mut sim = Simulation::new(s).unwrap_or_else(|e| panic!("{}: {e:#}", path.display()));
+        for _ in 0..steps {
+            sim.step();
+        }
+    }
+}
+
+#[test]
+fn full_scenario_sets_every_key() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scenarios/good");
+    let s = Scenario::load(&dir.join("full.toml")).unwrap();
+    assert_eq!(s.geometry.mesh_radii, vec![0.0, 0.001]);
+    assert_eq!(s.material.friction_twisting, 0.2);
+    assert_eq!(s.simulation.seed, 42);
+    assert_eq!(s.particles, Some(dir.join("two.csv")));
+    assert_eq!(s.output_dir, dir.join("out"));
+    let sim = Simulation::new(s).unwrap();
+    assert_eq!(sim.mesh.faces.len(), 5);
+    assert_eq!(sim.mesh.faces[1].radius, 0.001);
+    assert_eq!(sim.particles.len(), 2);
+}
+
+#[test]
+fn bad_scenarios_fail_with_their_stated_error() {
+    let bad = files("bad");
+    assert!(bad.len() >= 10);
+    for path in bad {
+        let text = std::fs::read_to_string(&path).unwrap();
+        let expected = text
+            .lines()
+            .next()
+            .and_then(|l| l.strip_prefix("# error: "))
+            .unwrap_or_else(|| panic!("{}: first line must be '# error: ...'", path.display()));
+        let err = match Scenario::load(&path) {
+            Ok(_) => panic!("{} was accepted", path.display()),
+            Err(e) => format!("{e:#}"),
+        };
+        assert!(
+            err.contains(expected),
+            "{}: error\n  {err}\ndoes not contain\n  {expected}",
+            path.display()
+        );
+        let name = path.file_name().unwrap().to_str().unwrap();
+        assert!(
+            err.contains(name),
+            "{}: error does not name the file: {err}",
+            path.display()
+        );
+    }
+}
