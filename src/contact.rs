@@ -43,6 +43,9 @@ pub struct ContactLaw {
     g_star_pw: f64,
     /// Damping factor β, Eq. (21).
     beta: f64,
+    /// c_s / c_n = sqrt(k_s / (30 k_n)) = sqrt((1 - ν) / (10 (2 - ν))), Eqs. (18), (19), (25);
+    /// the same for particle-particle and particle-wall contacts since G*/E* is.
+    c_s_per_c_n: f64,
     mu_s: f64,
     mu_r: f64,
     mu_t: f64,
@@ -172,6 +175,7 @@ impl ContactLaw {
             e_star_pw: e / (1.0 - nu * nu),
             g_star_pw: g / (2.0 - nu),
             beta: damping_factor(material.restitution), // Eq. (21)
+            c_s_per_c_n: ((1.0 - nu) / (10.0 * (2.0 - nu))).sqrt(), // Eq. (25)
             mu_s: material.friction_sliding,
             mu_r: material.friction_rolling,
             mu_t: material.friction_twisting,
@@ -222,7 +226,7 @@ impl ContactLaw {
         let k_n = 4.0 / 3.0 * e_star * a; // Eq. (12)
         let k_s = 8.0 * g_star * a; // Eq. (13)
         let c_n = (5.0 * m_star * k_n).sqrt() * self.beta; // Eq. (18)
-        let c_s = (m_star * k_s / 6.0).sqrt() * self.beta; // Eq. (19)
+        let c_s = c_n * self.c_s_per_c_n; // Eq. (19), as Eq. (25)
 
         // Normal force.
         let v_n = v.dot(n) * n; // Eq. (27)

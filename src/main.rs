@@ -49,14 +49,19 @@ fn main() -> ExitCode {
 }
 
 fn real_main(cli: Cli) -> Result<()> {
+    let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(n) = cli.threads {
         anyhow::ensure!(n >= 1, "--threads must be at least 1");
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build_global()
-            .context("cannot start the thread pool")?;
+        pool = pool.num_threads(n);
     }
-    match cli.command {
+    // The time loop runs on a worker of the pool, so that small parallel loops run inline
+    // instead of waking another thread for every stage.
+    let pool = pool.build().context("cannot start the thread pool")?;
+    pool.install(|| execute(cli.command))
+}
+
+fn execute(command: Option<Command>) -> Result<()> {
+    match command {
         None => {
             let s = Scenario::default();
             let out = s.output_dir.clone();

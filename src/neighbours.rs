@@ -52,6 +52,8 @@ pub struct CellGrid {
     items: Vec<u32>,
     /// Cell key -> range in `items`.
     cells: FxHashMap<u64, (u32, u32)>,
+    /// Occupied cells in key order: cell coordinates and range in `items`.
+    occupied: Vec<(IVec3, u32, u32)>,
 }
 
 impl CellGrid {
@@ -66,10 +68,13 @@ impl CellGrid {
             .collect();
         keyed.par_sort_unstable();
         let mut cells = FxHashMap::default();
+        let mut occupied = Vec::new();
         let mut start = 0;
         for k in 1..=keyed.len() {
             if k == keyed.len() || keyed[k].0 != keyed[start].0 {
                 cells.insert(keyed[start].0, (start as u32, k as u32));
+                let first = x[keyed[start].1 as usize];
+                occupied.push((cell_of(first, inv_h), start as u32, k as u32));
                 start = k;
             }
         }
@@ -77,6 +82,7 @@ impl CellGrid {
             inv_h,
             items: keyed.into_iter().map(|(_, i)| i).collect(),
             cells,
+            occupied,
         }
     }
 
@@ -107,6 +113,7 @@ impl CellGrid {
             inv_h,
             items: keyed.into_iter().map(|(_, i)| i).collect(),
             cells,
+            occupied: Vec::new(),
         }
     }
 
@@ -165,18 +172,12 @@ impl ContactList {
         &self.partner[self.start[i] as usize..self.start[i + 1] as usize]
     }
 
-    /// A new list from per-owner sorted partner runs, carrying over the springs of pairs
-    /// that were listed before.
-    fn rebuild(&self, runs: Vec<Vec<u32>>) -> ContactList {
-        let mut start = Vec::with_capacity(runs.len() + 1);
-        let total: usize = runs.iter().map(Vec::len).sum();
-        let mut owner = Vec::with_capacity(total);
-        let mut partner = Vec::with_capacity(total);
-        start.push(0u32);
-        for (i, run) in runs.into_iter().enumerate() {
-            owner.extend(std::iter::repeat_n(i as u32, run.len()));
-            partner.extend_from_slice(&run);
-            start.push(partner.len() as u32);
+    /// A new list from per-owner partner runs (`start`, `partner` in compressed form, each
+    /// run sorted), carrying over the springs of pairs that were listed before.
+    fn rebuild(&self, start: Vec<u32>, partner: Vec<u32>) -> ContactList {
+        let mut owner = Vec::with_capacity(partner.len());
+        for (i, w) in start.windows(2).enumerate() {
+            owner.extend(std::iter::repeat_n(i as u32, (w[1] - w[0]) as usize));
         }
         let springs = owner
             .par_iter()
@@ -197,6 +198,25 @@ impl ContactList {
             springs,
         }
     }
+}
+
+/// Compressed form of `(owner, partner)` pairs: a counting sort by owner that keeps the
+/// order of each owner's partners.
+fn compress(n: usize, pairs: impl Iterator<Item = (u32, u32)> + Clone) -> (Vec<u32>, Vec<u32>) {
+    let mut start = vec![0u32; n + 1];
+    for (i, _) in pairs.clone() {
+        start[i as usize + 1] += 1;
+    }
+    for k in 0..n {
+        start[k + 1] += start[k];
+    }
+    let mut fill = start.clone();
+    let mut partner = vec![0u32; start[n] as usize];
+    for (i, j) in pairs {
+        partner[fill[i as usize] as usize] = j;
+        fill[i as usize] += 1;
+    }
+    (start, partner)
 }
 
 /// Verlet lists of particle pairs and particle-face pairs.
@@ -246,26 +266,42 @@ impl Neighbours {
         let h = 2.0 * max_r + skin;
         let grid = CellGrid::of_points(x, if h > 0.0 { h } else { 1.0 });
 
-        let pair_runs: Vec<Vec<u32>> = (0..n)
-            .into_par_iter()
-            .with_min_len(MIN_PARALLEL_LEN / 8)
-            .map(|i| {
-                let mut run = Vec::new();
-                let (xi, ri) = (x[i], radius[i]);
-                grid.for_each_near(xi, |j| {
-                    let j = j as usize;
-                    if j > i {
-                        let reach = ri + radius[j] + skin;
-                        if (xi - x[j]).length_squared() < reach * reach {
-                            run.push(j as u32);
+        // Per occupied cell: its 27 neighbour ranges are looked up once, then every
+        // particle of the cell is tested against them. Each cell yields its pairs sorted.
+        let per_cell: Vec<Vec<(u32, u32)>> = grid
+            .occupied
+            .par_iter()
+            .with_min_len(MIN_PARALLEL_LEN / 16)
+            .map(|&(c, a, b)| {
+                let mut near: [&[u32]; 27] = [&[]; 27];
+                let mut k = 0;
+                for dz in -1..=1 {
+                    for dy in -1..=1 {
+                        for dx in -1..=1 {
+                            near[k] = grid.in_cell(c + IVec3::new(dx, dy, dz));
+                            k += 1;
                         }
                     }
-                });
-                run.sort_unstable();
-                run
+                }
+                let mut pairs = Vec::new();
+                for &i in &grid.items[a as usize..b as usize] {
+                    let first = pairs.len();
+                    let (xi, ri) = (x[i as usize], radius[i as usize]);
+                    for &j in near.iter().flat_map(|r| r.iter()) {
+                        if j > i {
+                            let reach = ri + radius[j as usize] + skin;
+                            if (xi - x[j as usize]).length_squared() < reach * reach {
+                                pairs.push((i, j));
+                            }
+                        }
+                    }
+                    pairs[first..].sort_unstable();
+                }
+                pairs
             })
             .collect();
-        self.pairs = self.pairs.rebuild(pair_runs);
+        let (start, partner) = compress(n, per_cell.iter().flatten().copied());
+        self.pairs = self.pairs.rebuild(start, partner);
 
         // Reverse index by counting sort over partners (keeps slots in ascending order).
         let mut count = vec![0u32; n + 1];
@@ -303,7 +339,14 @@ impl Neighbours {
                 run
             })
             .collect();
-        self.faces = self.faces.rebuild(face_runs);
+        let (start, partner) = compress(
+            n,
+            face_runs
+                .iter()
+                .enumerate()
+                .flat_map(|(i, run)| run.iter().map(move |&f| (i as u32, f))),
+        );
+        self.faces = self.faces.rebuild(start, partner);
 
         self.x_at_build = x.to_vec();
         self.rebuilds += 1;

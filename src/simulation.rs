@@ -17,7 +17,7 @@ use crate::scenario::{MeshSource, Scenario};
 use crate::spawn::Spawner;
 
 /// Verlet skin as a fraction of R_min.
-const SKIN_PER_RADIUS: f64 = 0.25;
+const SKIN_PER_RADIUS: f64 = 2.5;
 
 /// A running simulation.
 pub struct Simulation {
