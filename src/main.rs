@@ -6,7 +6,7 @@ use std::process::ExitCode;
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 
-use tinydem::run::{Verbosity, describe, run};
+use tinydem::run::{Summary, Verbosity, describe, run};
 use tinydem::scenario::Scenario;
 
 /// A granular DEM simulator (the model of the TinyDEM paper). With no arguments, runs the
@@ -66,15 +66,7 @@ fn execute(command: Option<Command>) -> Result<()> {
             let s = Scenario::default();
             let out = s.output_dir.clone();
             let summary = run(s, &out, Verbosity::Normal)?;
-            eprintln!(
-                "done: {} particles, {} steps ({} neighbour-list rebuilds), {} frames in {}, {:.2} s",
-                summary.particles,
-                summary.steps,
-                summary.rebuilds,
-                summary.frames_written,
-                out.display(),
-                summary.wall_seconds
-            );
+            report(&summary, &out);
         }
         Some(Command::Run {
             scenario,
@@ -90,15 +82,7 @@ fn execute(command: Option<Command>) -> Result<()> {
             };
             let summary = run(s, &out, verbosity)?;
             if !quiet {
-                eprintln!(
-                    "done: {} particles, {} steps ({} neighbour-list rebuilds), {} frames in {}, {:.2} s",
-                    summary.particles,
-                    summary.steps,
-                    summary.rebuilds,
-                    summary.frames_written,
-                    out.display(),
-                    summary.wall_seconds
-                );
+                report(&summary, &out);
             }
         }
         Some(Command::Check { scenario }) => {
@@ -107,4 +91,17 @@ fn execute(command: Option<Command>) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// The closing line of a run.
+fn report(summary: &Summary, out: &std::path::Path) {
+    eprintln!(
+        "done: {} particles, {} steps ({} neighbour-list rebuilds), {} frames in {}, {:.2} s",
+        summary.particles,
+        summary.steps,
+        summary.rebuilds,
+        summary.frames_written,
+        out.display(),
+        summary.wall_seconds
+    );
 }

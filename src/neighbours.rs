@@ -67,14 +67,25 @@ impl CellGrid {
             .map(|(i, &x)| (key(cell_of(x, inv_h)), i as u32))
             .collect();
         keyed.par_sort_unstable();
+        CellGrid::from_sorted(keyed, inv_h, |i| Some(cell_of(x[i as usize], inv_h)))
+    }
+
+    /// The grid of `(cell key, item)` pairs sorted by key; `cell` gives an item's cell
+    /// coordinates where the list of occupied cells is wanted.
+    fn from_sorted(
+        keyed: Vec<(u64, u32)>,
+        inv_h: f64,
+        cell: impl Fn(u32) -> Option<IVec3>,
+    ) -> CellGrid {
         let mut cells = FxHashMap::default();
         let mut occupied = Vec::new();
         let mut start = 0;
         for k in 1..=keyed.len() {
             if k == keyed.len() || keyed[k].0 != keyed[start].0 {
                 cells.insert(keyed[start].0, (start as u32, k as u32));
-                let first = x[keyed[start].1 as usize];
-                occupied.push((cell_of(first, inv_h), start as u32, k as u32));
+                if let Some(c) = cell(keyed[start].1) {
+                    occupied.push((c, start as u32, k as u32));
+                }
                 start = k;
             }
         }
@@ -101,20 +112,7 @@ impl CellGrid {
             }
         }
         keyed.sort_unstable();
-        let mut cells = FxHashMap::default();
-        let mut start = 0;
-        for k in 1..=keyed.len() {
-            if k == keyed.len() || keyed[k].0 != keyed[start].0 {
-                cells.insert(keyed[start].0, (start as u32, k as u32));
-                start = k;
-            }
-        }
-        CellGrid {
-            inv_h,
-            items: keyed.into_iter().map(|(_, i)| i).collect(),
-            cells,
-            occupied: Vec::new(),
-        }
+        CellGrid::from_sorted(keyed, inv_h, |_| None)
     }
 
     /// Items in the cell containing `x`.
