@@ -208,18 +208,19 @@ impl ContactLaw {
             v,
             omega,
         } = *kin;
-        // Effective quantities; for a wall R_j = m_j = ∞.
-        let (r_star, m_star, e_star, g_star) = match other {
+        // Effective quantities; for a wall R_j = m_j = r_j = ∞.
+        let (r_star, m_star, e_star, g_star, r_roll) = match other {
             Other::Particle {
                 r: radius_j,
                 m: m_j,
             } => (
-                1.0 / (1.0 / radius_i + 1.0 / radius_j), // Eq. (17)
-                1.0 / (1.0 / m_i + 1.0 / m_j),           // Eq. (20)
+                radius_i * radius_j / (radius_i + radius_j), // Eq. (17)
+                m_i * m_j / (m_i + m_j),                     // Eq. (20)
                 self.e_star_pp,
                 self.g_star_pp,
+                r_i * r_j / (r_i + r_j), // (1/r_i + 1/r_j)^-1 of Eq. (36)
             ),
-            Other::Wall => (radius_i, m_i, self.e_star_pw, self.g_star_pw),
+            Other::Wall => (radius_i, m_i, self.e_star_pw, self.g_star_pw, r_i),
         };
 
         let a = (r_star * delta).sqrt(); // Eq. (14)
@@ -228,12 +229,13 @@ impl ContactLaw {
         let c_n = (5.0 * m_star * k_n).sqrt() * self.beta; // Eq. (18)
         let c_s = c_n * self.c_s_per_c_n; // Eq. (19), as Eq. (25)
 
-        // Normal force.
-        let v_n = v.dot(n) * n; // Eq. (27)
+        // Normal force, along n̂: f_n = -k_n u_n - c_n v_n with u_n = -δ n̂ (Eqs. 5, 10).
+        let v_dot_n = v.dot(n);
+        let v_n = v_dot_n * n; // Eq. (27)
         let v_s = v - v_n; // Eq. (28)
-        let u_n = -delta * n; // Eq. (10)
-        let f_n = -k_n * u_n - c_n * v_n; // Eq. (5)
-        let f_n_norm = f_n.length();
+        let f_n_scalar = k_n * delta - c_n * v_dot_n;
+        let f_n = f_n_scalar * n; // Eq. (5)
+        let f_n_norm = f_n_scalar.abs();
 
         // Sliding friction.
         springs.u_s = project_onto_tangent_plane(springs.u_s, n); // Eq. (52)
@@ -248,7 +250,6 @@ impl ContactLaw {
         let tau_s = r_i * f_s.cross(n); // Eq. (31)
 
         // Rolling friction, k_r = k_n and c_r = c_n.
-        let r_roll = 1.0 / (1.0 / r_i + 1.0 / r_j); // r_j = ∞ for a wall
         let v_r = r_roll * omega.cross(n); // Eq. (36)
         springs.u_r = project_onto_tangent_plane(springs.u_r, n); // Eq. (52)
         let f_r = coulomb_spring(
@@ -288,16 +289,16 @@ impl ContactLaw {
 /// Eq. (52): rotate a spring back into the tangent plane of the current normal, keeping its
 /// length (unless it is zero or parallel to the normal).
 fn project_onto_tangent_plane(u: DVec3, n: DVec3) -> DVec3 {
-    let length = u.length();
-    if length == 0.0 {
+    let length2 = u.length_squared();
+    if length2 == 0.0 {
         return u;
     }
     let tangential = u - u.dot(n) * n;
-    let t = tangential.length();
-    if t == 0.0 {
+    let t2 = tangential.length_squared();
+    if t2 == 0.0 {
         DVec3::ZERO
     } else {
-        tangential * (length / t)
+        tangential * (length2 / t2).sqrt()
     }
 }
 
@@ -308,18 +309,18 @@ trait Displacement:
     + std::ops::Neg<Output = Self>
     + std::ops::Mul<f64, Output = Self>
 {
-    fn norm(self) -> f64;
+    fn norm_squared(self) -> f64;
 }
 
 impl Displacement for DVec3 {
-    fn norm(self) -> f64 {
-        self.length()
+    fn norm_squared(self) -> f64 {
+        self.length_squared()
     }
 }
 
 impl Displacement for f64 {
-    fn norm(self) -> f64 {
-        self.abs()
+    fn norm_squared(self) -> f64 {
+        self * self
     }
 }
 
@@ -328,12 +329,12 @@ impl Displacement for f64 {
 /// is scaled to the Coulomb limit (Eq. 54) and the spring set to match it (Eq. 55).
 fn coulomb_spring<V: Displacement>(u: &mut V, v: V, k: f64, c: f64, f_max: f64, dt: f64) -> V {
     let f = -(*u * k) + -(v * c);
-    let f_norm = f.norm();
-    if f_norm <= f_max {
+    let f_norm2 = f.norm_squared();
+    if f_norm2 <= f_max * f_max {
         *u = *u + v * dt; // Eq. (53)
         f
     } else {
-        let f = f * (f_max / f_norm); // Eq. (54)
+        let f = f * (f_max / f_norm2.sqrt()); // Eq. (54)
         *u = -(f + v * c) * (1.0 / k); // Eq. (55)
         f
     }

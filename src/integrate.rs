@@ -36,10 +36,25 @@ impl Inertia {
     }
 }
 
+/// sin φ and cos φ; for |φ| <= 0.1 (every time step of a resolved run) by their Taylor
+/// series, whose truncation error there is below 1e-17 relative, at a fraction of the cost
+/// of the library call.
+#[inline]
+pub fn sin_cos(phi: f64) -> (f64, f64) {
+    if phi.abs() > 0.1 {
+        return phi.sin_cos();
+    }
+    let p2 = phi * phi;
+    let s = phi * (1.0 - p2 / 6.0 * (1.0 - p2 / 20.0 * (1.0 - p2 / 42.0 * (1.0 - p2 / 72.0))));
+    let c = 1.0
+        - p2 / 2.0 * (1.0 - p2 / 12.0 * (1.0 - p2 / 30.0 * (1.0 - p2 / 56.0 * (1.0 - p2 / 90.0))));
+    (s, c)
+}
+
 /// The rotation quaternion (cos φ, sin φ â) by angle 2φ about the direction of `a`.
 #[inline]
 fn rotation(a: DVec3, norm: f64, phi: f64) -> DQuat {
-    let (s, c) = phi.sin_cos();
+    let (s, c) = sin_cos(phi);
     let axis = a * (s / norm);
     DQuat::from_xyzw(axis.x, axis.y, axis.z, c)
 }
@@ -86,6 +101,20 @@ pub fn advance(s: State, body: &Inertia, f: DVec3, tau: DVec3, g: DVec3, dt: f64
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn small_angle_sin_cos_matches_the_library() {
+        for k in 0..=2000 {
+            let phi = (k as f64 - 1000.0) * 1e-4 * 1.0001;
+            let (s, c) = sin_cos(phi);
+            assert!(
+                (s - phi.sin()).abs() <= 2.0 * f64::EPSILON * phi.abs(),
+                "{phi}"
+            );
+            assert!((c - phi.cos()).abs() <= 2.0 * f64::EPSILON, "{phi}");
+        }
+        assert_eq!(sin_cos(0.5), 0.5f64.sin_cos());
+    }
 
     #[test]
     fn spiral_about_a_fixed_axis_is_exact() {

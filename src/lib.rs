@@ -3,6 +3,7 @@
 //! contact, sliding, rolling and twisting friction, quaternion orientations and static
 //! meshes. See `ARCHITECTURE.md` for a map of the code.
 
+pub mod bench;
 pub mod contact;
 pub mod csv;
 pub mod geometry;

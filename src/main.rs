@@ -35,6 +35,28 @@ enum Command {
     },
     /// Validate a scenario and print derived quantities.
     Check { scenario: PathBuf },
+    /// The dense-packing benchmark of the paper's Section 5: timed steps in settled
+    /// packings; each size and thread count runs in its own process.
+    Bench {
+        /// Particle counts (1000, 10000, 100000, 1000000, 10000000).
+        #[arg(long, value_delimiter = ',', default_values_t = [1_000, 10_000, 100_000, 1_000_000])]
+        sizes: Vec<usize>,
+        /// Also run 10^7 particles (about 3 GB of memory).
+        #[arg(long)]
+        huge: bool,
+        /// Thread counts to run each size with (default: 1 and all cores).
+        #[arg(long = "workers", value_delimiter = ',')]
+        workers: Vec<usize>,
+        /// Steps per timed segment (default: about 10^7 particle-steps, at least 10).
+        #[arg(long)]
+        steps: Option<u64>,
+        /// Timed segments per configuration; the median is reported.
+        #[arg(long, default_value_t = 3)]
+        repeats: usize,
+        /// Run one configuration in this process (used by the benchmark itself).
+        #[arg(long, hide = true)]
+        single: bool,
+    },
 }
 
 fn main() -> ExitCode {
@@ -85,6 +107,30 @@ fn execute(command: Option<Command>) -> Result<()> {
                 report(&summary, &out);
             }
         }
+        Some(Command::Bench {
+            mut sizes,
+            huge,
+            workers,
+            steps,
+            repeats,
+            single,
+        }) => {
+            if huge && !sizes.contains(&10_000_000) {
+                sizes.push(10_000_000);
+            }
+            anyhow::ensure!(repeats >= 1, "--repeats must be at least 1");
+            if single {
+                let n = sizes[0];
+                let m = tinydem::bench::measure(
+                    n,
+                    steps.unwrap_or(tinydem::bench::default_steps(n)),
+                    repeats,
+                )?;
+                println!("{}", m.row());
+                return Ok(());
+            }
+            bench(&sizes, &workers, steps, repeats)?;
+        }
         Some(Command::Check { scenario }) => {
             let s = Scenario::load(&scenario)?;
             print!("{}", describe(&s)?);
@@ -104,4 +150,45 @@ fn report(summary: &Summary, out: &std::path::Path) {
         out.display(),
         summary.wall_seconds
     );
+}
+
+/// Runs every (size, workers) configuration in a child process, so that each reports its
+/// own peak memory, and prints the table.
+fn bench(sizes: &[usize], workers: &[usize], steps: Option<u64>, repeats: usize) -> Result<()> {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let workers: Vec<usize> = if workers.is_empty() {
+        let mut w = vec![1, cores];
+        w.dedup();
+        w
+    } else {
+        workers.to_vec()
+    };
+    let exe = std::env::current_exe().context("cannot locate the tinydem executable")?;
+    println!("{}", tinydem::bench::Measurement::HEADER);
+    for &n in sizes {
+        for &t in &workers {
+            let mut cmd = std::process::Command::new(&exe);
+            cmd.args([
+                "bench",
+                "--single",
+                "--sizes",
+                &n.to_string(),
+                "--threads",
+                &t.to_string(),
+            ]);
+            cmd.args(["--repeats", &repeats.to_string()]);
+            if let Some(s) = steps {
+                cmd.args(["--steps", &s.to_string()]);
+            }
+            let out = cmd.output().context("cannot run the benchmark process")?;
+            if !out.status.success() {
+                anyhow::bail!(
+                    "benchmark N = {n}, {t} threads failed: {}",
+                    String::from_utf8_lossy(&out.stderr).trim()
+                );
+            }
+            print!("{}", String::from_utf8_lossy(&out.stdout));
+        }
+    }
+    Ok(())
 }

@@ -8,7 +8,7 @@ use anyhow::{Result, bail};
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::contact::{Body, ContactForce, ContactLaw, Kinematics, Other};
+use crate::contact::{Body, ContactForce, ContactLaw, Kinematics, Other, Springs};
 use crate::integrate::{Inertia, State, advance};
 use crate::mesh::Mesh;
 use crate::neighbours::{CellGrid, MIN_PARALLEL_LEN, Neighbours, face_grid};
@@ -16,8 +16,16 @@ use crate::particles::Particles;
 use crate::scenario::{MeshSource, Scenario};
 use crate::spawn::Spawner;
 
+/// Resets the springs of a pair that is not touching (writing only if needed).
+#[inline]
+fn forget(springs: &mut Springs) {
+    if *springs != Springs::default() {
+        *springs = Springs::default();
+    }
+}
+
 /// Verlet skin as a fraction of R_min.
-const SKIN_PER_RADIUS: f64 = 2.5;
+const SKIN_PER_RADIUS: f64 = 0.25;
 
 /// A running simulation.
 pub struct Simulation {
@@ -79,6 +87,11 @@ impl Simulation {
     /// Number of neighbour-list rebuilds so far.
     pub fn rebuilds(&self) -> u64 {
         self.neighbours.rebuilds
+    }
+
+    /// Number of listed particle pairs and particle-face pairs (Verlet list slots).
+    pub fn list_slots(&self) -> (usize, usize) {
+        (self.neighbours.pairs.slots(), self.neighbours.faces.slots())
     }
 
     /// Number of particle-particle and particle-face contacts in the last step.
@@ -148,7 +161,7 @@ impl Simulation {
                         law.evaluate(p.radius[i], m_i, other, &kin, springs)
                     }
                     None => {
-                        *springs = Default::default(); // the contact ended: forget its history
+                        forget(springs); // the contact ended: forget its history
                         ContactForce::default()
                     }
                 };
@@ -185,7 +198,7 @@ impl Simulation {
                         law.evaluate(p.radius[i], m_i, Other::Wall, &kin, springs)
                     }
                     None => {
-                        *springs = Default::default();
+                        forget(springs);
                         ContactForce::default()
                     }
                 };
