@@ -192,6 +192,7 @@ impl ContactLaw {
 
     /// Evaluates the contact of particle `i` (radius `radius_i`, mass `m_i`) with body
     /// `other`, updating the friction springs for the next time step.
+    #[inline(always)]
     pub fn evaluate(
         &self,
         radius_i: f64,
@@ -288,6 +289,7 @@ impl ContactLaw {
 
 /// Eq. (52): rotate a spring back into the tangent plane of the current normal, keeping its
 /// length (unless it is zero or parallel to the normal).
+#[inline(always)]
 fn project_onto_tangent_plane(u: DVec3, n: DVec3) -> DVec3 {
     let length2 = u.length_squared();
     if length2 == 0.0 {
@@ -327,6 +329,7 @@ impl Displacement for f64 {
 /// One friction mode m ∈ {s, r, t}: the Kelvin-Voigt force -k u - c v, clipped by Coulomb's
 /// law to `f_max` = μ_m |f_n|. Static: the spring grows by Δt v (Eq. 53). Kinetic: the force
 /// is scaled to the Coulomb limit (Eq. 54) and the spring set to match it (Eq. 55).
+#[inline(always)]
 fn coulomb_spring<V: Displacement>(u: &mut V, v: V, k: f64, c: f64, f_max: f64, dt: f64) -> V {
     let f = -(*u * k) + -(v * c);
     let f_norm2 = f.norm_squared();

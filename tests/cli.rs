@@ -259,16 +259,40 @@ fn output_format_is_the_original_one() {
 #[test]
 fn bench_runs_a_small_configuration() {
     let t = tempfile::tempdir().unwrap();
-    let o = tinydem(&["bench", "--sizes", "1000", "--workers", "1", "--steps", "5", "--repeats", "1"], t.path());
+    let o = tinydem(
+        &[
+            "bench",
+            "--sizes",
+            "1000",
+            "--workers",
+            "1",
+            "--steps",
+            "5",
+            "--repeats",
+            "1",
+        ],
+        t.path(),
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     let out = String::from_utf8_lossy(&o.stdout);
-    let row: Vec<&str> = out.lines().nth(1).expect("a result row").split_whitespace().collect();
+    let row: Vec<&str> = out
+        .lines()
+        .nth(1)
+        .expect("a result row")
+        .split_whitespace()
+        .collect();
     assert_eq!(row[0], "1000");
     let cundall: f64 = row[3].parse().unwrap();
     let contacts: f64 = row[7].parse().unwrap();
     assert!(cundall > 0.0);
     // The settled packing: about 3.7 contacts per particle counted per particle, i.e.
     // about half that counted once per pair, plus walls.
-    assert!(contacts > 1.5 && contacts < 3.5, "contacts per particle {contacts}");
-    fails_with(&tinydem(&["bench", "--sizes", "1234", "--workers", "1"], t.path()), &["no packing for N = 1234"]);
+    assert!(
+        contacts > 1.5 && contacts < 3.5,
+        "contacts per particle {contacts}"
+    );
+    fails_with(
+        &tinydem(&["bench", "--sizes", "1234", "--workers", "1"], t.path()),
+        &["no packing for N = 1234"],
+    );
 }
