@@ -131,14 +131,14 @@ pub fn measure(n: usize, steps: u64, repeats: usize) -> Result<Measurement> {
     let rss_before = proc_status_bytes("VmRSS:");
     let mut sim = setup(n)?;
     for _ in 0..steps.min(20) {
-        sim.step(); // warm-up: first neighbour lists, caches
+        sim.step()?; // warm-up: first neighbour lists, caches
     }
     let rebuilds_before = sim.rebuilds();
     let mut times = Vec::with_capacity(repeats);
     for _ in 0..repeats {
         let t = Instant::now();
         for _ in 0..steps {
-            sim.step();
+            sim.step()?;
         }
         times.push(t.elapsed().as_secs_f64() / steps as f64);
     }

@@ -46,8 +46,13 @@ pub fn write_particles(out: &mut impl Write, p: &Particles) -> std::io::Result<(
 /// Writes a frame file atomically: to a temporary name first, then renamed, so a crash
 /// never leaves a half-written frame behind.
 pub fn write_frame(dir: &Path, k: u64, p: &Particles) -> Result<PathBuf> {
-    let path = dir.join(frame_name(k));
-    let tmp = dir.join(format!(".{}.tmp", frame_name(k)));
+    write_frame_as(dir, &frame_name(k), p)
+}
+
+/// Writes particles atomically to `dir/name`.
+pub fn write_frame_as(dir: &Path, name: &str, p: &Particles) -> Result<PathBuf> {
+    let path = dir.join(name);
+    let tmp = dir.join(format!(".{name}.tmp"));
     let write = || -> std::io::Result<()> {
         let mut w = std::io::BufWriter::with_capacity(1 << 20, std::fs::File::create(&tmp)?);
         write_particles(&mut w, p)?;

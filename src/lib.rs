@@ -4,6 +4,7 @@
 //! meshes. See `ARCHITECTURE.md` for a map of the code.
 
 pub mod bench;
+pub mod checkpoint;
 pub mod contact;
 pub mod csv;
 pub mod geometry;

@@ -6,7 +6,9 @@ use std::process::ExitCode;
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 
-use tinydem::run::{Summary, Verbosity, describe, run};
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use tinydem::run::{Interrupted, Options, Summary, Verbosity, describe, run};
 use tinydem::scenario::Scenario;
 
 /// A granular DEM simulator (the model of the TinyDEM paper). With no arguments, runs the
@@ -32,6 +34,10 @@ enum Command {
         /// No status lines.
         #[arg(long, short)]
         quiet: bool,
+        /// Continue an interrupted run from its checkpoint (written to the output
+        /// directory on Ctrl-C/SIGTERM and every `[output] checkpoint_every` frames).
+        #[arg(long)]
+        resume: Option<PathBuf>,
     },
     /// Validate a scenario and print derived quantities.
     Check { scenario: PathBuf },
@@ -59,15 +65,28 @@ enum Command {
     },
 }
 
+/// Set on SIGINT or SIGTERM: the run stops after the current step with a checkpoint.
+static STOP: AtomicBool = AtomicBool::new(false);
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match real_main(cli) {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e) if e.downcast_ref::<Interrupted>().is_some() => {
+            eprintln!("{e:#}");
+            ExitCode::from(130)
+        }
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::FAILURE
         }
     }
+}
+
+/// Installs the handler that turns SIGINT/SIGTERM into a clean stop.
+fn catch_signals() -> Result<()> {
+    ctrlc::set_handler(|| STOP.store(true, Ordering::Relaxed))
+        .context("cannot install the signal handler")
 }
 
 fn real_main(cli: Cli) -> Result<()> {
@@ -87,13 +106,20 @@ fn execute(command: Option<Command>) -> Result<()> {
         None => {
             let s = Scenario::default();
             let out = s.output_dir.clone();
-            let summary = run(s, &out, Verbosity::Normal)?;
+            catch_signals()?;
+            let options = Options {
+                verbosity: Verbosity::Normal,
+                resume: None,
+                stop: Some(&STOP),
+            };
+            let summary = run(s, &out, options)?;
             report(&summary, &out);
         }
         Some(Command::Run {
             scenario,
             output,
             quiet,
+            resume,
         }) => {
             let s = Scenario::load(&scenario)?;
             let out = output.unwrap_or_else(|| s.output_dir.clone());
@@ -102,7 +128,13 @@ fn execute(command: Option<Command>) -> Result<()> {
             } else {
                 Verbosity::Normal
             };
-            let summary = run(s, &out, verbosity)?;
+            catch_signals()?;
+            let options = Options {
+                verbosity,
+                resume: resume.as_deref(),
+                stop: Some(&STOP),
+            };
+            let summary = run(s, &out, options)?;
             if !quiet {
                 report(&summary, &out);
             }

@@ -163,6 +163,27 @@ impl ContactList {
         self.partner.len()
     }
 
+    /// Every slot with non-zero springs: the contact history.
+    pub fn history(&self) -> Vec<(u32, u32, Springs)> {
+        (0..self.slots())
+            .filter(|&k| self.springs[k] != Springs::default())
+            .map(|k| (self.owner[k], self.partner[k], self.springs[k]))
+            .collect()
+    }
+
+    /// Puts back a contact history saved by [`ContactList::history`]; every pair in it must
+    /// be listed (it was touching when saved).
+    pub fn restore(&mut self, history: &[(u32, u32, Springs)]) -> Result<(), String> {
+        for &(i, j, springs) in history {
+            let run = self.run(i as usize);
+            match run.binary_search(&j) {
+                Ok(k) => self.springs[self.start[i as usize] as usize + k] = springs,
+                Err(_) => return Err(format!("contact ({i}, {j}) is not within reach")),
+            }
+        }
+        Ok(())
+    }
+
     fn run(&self, i: usize) -> &[u32] {
         if i + 1 >= self.start.len() {
             return &[];

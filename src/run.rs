@@ -1,16 +1,26 @@
-//! Running a scenario: frames written to the output directory, status on stderr.
+//! Running a scenario: frames and checkpoints written to the output directory, status on
+//! stderr, a clean stop on SIGINT/SIGTERM and a loud one when the run becomes unstable.
 
 use std::io::IsTerminal;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use anyhow::{Context, Result};
 
+use crate::checkpoint;
 use crate::contact::ContactLaw;
-use crate::csv::write_frame;
+use crate::csv::{frame_name, write_frame};
 use crate::integrate::Inertia;
 use crate::scenario::{MeshSource, Scenario};
 use crate::simulation::Simulation;
+
+/// Name of the checkpoint file in the output directory.
+pub const CHECKPOINT: &str = "checkpoint.bin";
+/// Name of the frame written when a run is interrupted between frames.
+pub const INTERRUPTED: &str = "interrupted.csv";
+/// Name of the frame written when a run becomes unstable.
+pub const UNSTABLE: &str = "unstable.csv";
 
 /// How much to tell the user while running.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -18,6 +28,16 @@ pub enum Verbosity {
     Quiet,
     /// One status line per frame, and a progress bar on a terminal.
     Normal,
+}
+
+/// How to run.
+#[derive(Clone, Copy, Debug)]
+pub struct Options<'a> {
+    pub verbosity: Verbosity,
+    /// Continue from this checkpoint instead of starting afresh.
+    pub resume: Option<&'a Path>,
+    /// Set (by a signal handler) to stop after the current step with a checkpoint.
+    pub stop: Option<&'a AtomicBool>,
 }
 
 /// Summary of a finished run.
@@ -31,70 +51,168 @@ pub struct Summary {
     pub wall_seconds: f64,
 }
 
-/// Runs `scenario`, writing frames 0..=N_frames into `output_dir`.
-pub fn run(scenario: Scenario, output_dir: &Path, verbosity: Verbosity) -> Result<Summary> {
-    std::fs::create_dir_all(output_dir)
-        .with_context(|| format!("cannot create output directory {}", output_dir.display()))?;
-    let probe = output_dir.join(".tinydem-write-test");
-    std::fs::write(&probe, b"")
-        .with_context(|| format!("output directory {} is not writable", output_dir.display()))?;
-    let _ = std::fs::remove_file(&probe);
+/// A run stopped on request, with its checkpoint written.
+#[derive(Clone, Debug)]
+pub struct Interrupted {
+    pub step: u64,
+    pub time: f64,
+    pub checkpoint: PathBuf,
+}
 
+impl std::fmt::Display for Interrupted {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "interrupted after step {} (t = {:.6e} s); checkpoint written to {}: continue with --resume {}",
+            self.step,
+            self.time,
+            self.checkpoint.display(),
+            self.checkpoint.display()
+        )
+    }
+}
+
+impl std::error::Error for Interrupted {}
+
+/// Fails early, before simulating, if the output directory cannot be written, and removes
+/// temporary files a killed run may have left.
+fn prepare_output(dir: &Path) -> Result<()> {
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("cannot create output directory {}", dir.display()))?;
+    if let Ok(entries) = std::fs::read_dir(dir) {
+        for e in entries.flatten() {
+            let name = e.file_name();
+            let name = name.to_string_lossy();
+            if name.starts_with('.') && name.ends_with(".tmp") {
+                let _ = std::fs::remove_file(e.path());
+            }
+        }
+    }
+    let probe = dir.join(".tinydem-write-test");
+    std::fs::write(&probe, b"")
+        .with_context(|| format!("output directory {} is not writable", dir.display()))?;
+    let _ = std::fs::remove_file(&probe);
+    Ok(())
+}
+
+/// Runs `scenario`, writing frames 0..=N_frames into `output_dir`.
+pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Summary> {
+    prepare_output(output_dir)?;
     let frames = scenario.simulation.frames;
     let steps_per_frame = scenario.simulation.steps_per_frame;
-    let mut sim = Simulation::new(scenario)?;
-    let start = Instant::now();
-    write_frame(output_dir, 0, &sim.particles)?;
-
-    let bar = (verbosity == Verbosity::Normal && std::io::stderr().is_terminal()).then(|| {
-        let bar = indicatif::ProgressBar::new(frames * steps_per_frame);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{bar:40} {pos}/{len} steps  {per_sec}  ETA {eta}  {msg}",
-            )
-            .expect("valid template"),
-        );
-        bar
-    });
-    let status = |line: String| match &bar {
-        Some(bar) => bar.println(line),
-        None => eprintln!("{line}"),
+    let checkpoint_every = scenario.checkpoint_every;
+    let mut sim = match options.resume {
+        None => Simulation::new(scenario)?,
+        Some(path) => {
+            let fresh = Simulation::new(Scenario {
+                particles: None,
+                ..scenario.clone()
+            })?;
+            let snapshot = checkpoint::load(path, fingerprint(&fresh))?;
+            Simulation::restore(scenario, snapshot)?
+        }
     };
-    if verbosity == Verbosity::Normal {
-        status(format!(
-            "frame {:>6}  t = {:.6e} s  particles {}",
-            0,
-            sim.time,
-            sim.particles.len()
-        ));
+    let start = Instant::now();
+    let mut frames_written = 0;
+    if options.resume.is_none() {
+        write_frame(output_dir, 0, &sim.particles)?;
+        frames_written += 1;
     }
 
-    for frame in 1..=frames {
-        for _ in 0..steps_per_frame {
-            sim.step();
-        }
-        write_frame(output_dir, frame, &sim.particles)?;
-        if verbosity == Verbosity::Normal {
-            status(format!(
+    let total_steps = frames * steps_per_frame;
+    let bar =
+        (options.verbosity == Verbosity::Normal && std::io::stderr().is_terminal()).then(|| {
+            let bar = indicatif::ProgressBar::new(total_steps);
+            bar.set_style(
+                indicatif::ProgressStyle::with_template(
+                    "{bar:40} {pos}/{len} steps  {per_sec}  ETA {eta}  {msg}",
+                )
+                .expect("valid template"),
+            );
+            bar.set_position(sim.steps);
+            bar
+        });
+    let status = |sim: &Simulation, frame: u64| {
+        if options.verbosity == Verbosity::Normal {
+            let line = format!(
                 "frame {frame:>6}  t = {:.6e} s  particles {}",
                 sim.time,
                 sim.particles.len()
-            ));
+            );
+            match &bar {
+                Some(bar) => bar.println(line),
+                None => eprintln!("{line}"),
+            }
         }
-        if let Some(bar) = &bar {
-            bar.set_position(frame * steps_per_frame);
+    };
+    if options.resume.is_none() {
+        status(&sim, 0);
+    }
+
+    while sim.steps < total_steps {
+        if let Err(unstable) = sim.step() {
+            let last = sim.steps.saturating_sub(1) / steps_per_frame.max(1);
+            let written = crate::csv::write_frame_as(output_dir, UNSTABLE, &sim.particles).is_ok();
+            anyhow::bail!(
+                "{unstable}.\nThe last complete frame is {}{}.",
+                output_dir.join(frame_name(last)).display(),
+                if written {
+                    format!(
+                        "; the state at the failure is in {}",
+                        output_dir.join(UNSTABLE).display()
+                    )
+                } else {
+                    String::new()
+                }
+            );
+        }
+        if sim.steps.is_multiple_of(steps_per_frame) {
+            let frame = sim.steps / steps_per_frame;
+            write_frame(output_dir, frame, &sim.particles)?;
+            frames_written += 1;
+            status(&sim, frame);
+            if checkpoint_every > 0 && frame.is_multiple_of(checkpoint_every) {
+                checkpoint::save(
+                    &output_dir.join(CHECKPOINT),
+                    &sim.snapshot(),
+                    fingerprint(&sim),
+                )?;
+            }
+        }
+        if let Some(bar) = bar.as_ref().filter(|_| sim.steps.is_multiple_of(100)) {
+            bar.set_position(sim.steps);
+        }
+        if options.stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
+            let path = output_dir.join(CHECKPOINT);
+            checkpoint::save(&path, &sim.snapshot(), fingerprint(&sim))?;
+            crate::csv::write_frame_as(output_dir, INTERRUPTED, &sim.particles)?;
+            if let Some(bar) = &bar {
+                bar.abandon();
+            }
+            return Err(Interrupted {
+                step: sim.steps,
+                time: sim.time,
+                checkpoint: path,
+            }
+            .into());
         }
     }
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }
+    let _ = std::fs::remove_file(output_dir.join(INTERRUPTED));
     Ok(Summary {
-        frames_written: frames + 1,
+        frames_written,
         particles: sim.particles.len(),
         steps: sim.steps,
         rebuilds: sim.rebuilds(),
         wall_seconds: start.elapsed().as_secs_f64(),
     })
+}
+
+/// The fingerprint of a simulation's scenario and mesh, for checkpoints.
+fn fingerprint(sim: &Simulation) -> u64 {
+    checkpoint::fingerprint(&sim.scenario, &sim.mesh)
 }
 
 /// The derived quantities `tinydem check` prints.

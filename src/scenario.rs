@@ -8,7 +8,7 @@
 //! [kinetics]   initial_velocity, initial_angular_velocity, gravity
 //! [simulation] timestep, max_particles, frames, steps_per_frame, spawn_attempts, seed
 //! [input]      particles
-//! [output]     dir
+//! [output]     dir, checkpoint_every
 //! ```
 //! Paths are relative to the scenario file. Unknown keys and values outside Table 2's
 //! "Requirements" column are errors naming the key and the allowed range.
@@ -104,6 +104,8 @@ pub struct Scenario {
     pub particles: Option<PathBuf>,
     /// Output directory.
     pub output_dir: PathBuf,
+    /// Write a checkpoint every this many frames (0: only when interrupted).
+    pub checkpoint_every: u64,
 }
 
 /// Default time step, Eq. (50): Δt = R_min sqrt(ρ (1 - ν²) / E).
@@ -184,6 +186,7 @@ struct RawInput {
 #[serde(deny_unknown_fields)]
 struct RawOutput {
     dir: Option<PathBuf>,
+    checkpoint_every: Option<u64>,
 }
 
 /// A range check of Table 2's "Requirements" column.
@@ -411,6 +414,7 @@ impl Scenario {
                 .output
                 .dir
                 .map_or_else(|| PathBuf::from("output"), |d| base.join(d)),
+            checkpoint_every: raw.output.checkpoint_every.unwrap_or(0),
         })
     }
 

@@ -4,6 +4,8 @@
 //! step:  spawn -> update neighbours -> particle contacts -> mesh contacts -> integrate
 //! ```
 
+use std::sync::Mutex;
+
 use anyhow::{Result, bail};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -13,8 +15,8 @@ use crate::integrate::{Inertia, State, advance};
 use crate::mesh::Mesh;
 use crate::neighbours::{CellGrid, MIN_PARALLEL_LEN, Neighbours, face_grid};
 use crate::particles::Particles;
-use crate::scenario::{MeshSource, Scenario};
-use crate::spawn::Spawner;
+use crate::scenario::{MeshSource, Scenario, default_timestep};
+use crate::spawn::{Spawner, SpawnerState};
 
 /// Resets the springs of a pair that is not touching (writing only if needed).
 #[inline]
@@ -26,6 +28,59 @@ fn forget(springs: &mut Springs) {
 
 /// Verlet skin as a fraction of R_min.
 const SKIN_PER_RADIUS: f64 = 0.25;
+
+/// Everything needed to continue a run bit for bit: particles, step count, the spawner's
+/// place in its random stream, and the contact history (the friction springs of every
+/// touching pair, Table 3).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Snapshot {
+    pub steps: u64,
+    pub particles: Particles,
+    pub spawner: SpawnerState,
+    pub pair_history: Vec<(u32, u32, Springs)>,
+    pub face_history: Vec<(u32, u32, Springs)>,
+}
+
+/// The partner of a particle in a contact.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Partner {
+    Particle(usize),
+    Face(usize),
+}
+
+/// An overlap deeper than `limit` (the smaller radius): a sign of instability.
+#[derive(Clone, Copy, Debug)]
+pub struct Deep {
+    i: usize,
+    other: Partner,
+    delta: f64,
+    limit: f64,
+}
+
+/// A run that has become numerically unstable.
+#[derive(Clone, Debug)]
+pub struct Unstable {
+    pub step: u64,
+    pub time: f64,
+    /// The offending particles and contacts (at most five).
+    pub what: Vec<String>,
+    /// The likely cause and what to try.
+    pub advice: String,
+}
+
+impl std::fmt::Display for Unstable {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "the run became unstable at step {} (t = {:.6e} s): ",
+            self.step, self.time
+        )?;
+        write!(f, "{}", self.what.join("; "))?;
+        write!(f, ". Likely cause: {}", self.advice)
+    }
+}
+
+impl std::error::Error for Unstable {}
 
 /// A running simulation.
 pub struct Simulation {
@@ -58,6 +113,45 @@ impl Simulation {
             None => Particles::default(),
         };
         Simulation::from_parts(scenario, mesh, particles)
+    }
+
+    /// Continues a run from a snapshot taken by [`Simulation::snapshot`] with the same
+    /// scenario: the result is bitwise the same as if the run had not stopped.
+    pub fn restore(scenario: Scenario, snapshot: Snapshot) -> Result<Simulation> {
+        let mut sim = Simulation::new(Scenario {
+            particles: None,
+            ..scenario
+        })?;
+        sim.particles = snapshot.particles;
+        sim.steps = snapshot.steps;
+        sim.time = sim.steps as f64 * sim.scenario.simulation.timestep;
+        sim.spawner = Spawner::resume(sim.scenario.simulation.seed, snapshot.spawner);
+        let max_radius = sim
+            .scenario
+            .geometry
+            .radius_max
+            .max(sim.particles.max_radius());
+        sim.face_grid = face_grid(&sim.mesh.faces, max_radius, sim.neighbours.skin);
+        let p = &sim.particles;
+        sim.neighbours
+            .rebuild(&p.x, &p.radius, &sim.mesh.faces, &sim.face_grid);
+        sim.neighbours
+            .pairs
+            .restore(&snapshot.pair_history)
+            .and_then(|()| sim.neighbours.faces.restore(&snapshot.face_history))
+            .map_err(|e| anyhow::anyhow!("the checkpoint does not fit its particles: {e}"))?;
+        Ok(sim)
+    }
+
+    /// The complete state of the run.
+    pub fn snapshot(&self) -> Snapshot {
+        Snapshot {
+            steps: self.steps,
+            particles: self.particles.clone(),
+            spawner: self.spawner.state(),
+            pair_history: self.neighbours.pairs.history(),
+            face_history: self.neighbours.faces.history(),
+        }
     }
 
     /// Sets up a simulation from a mesh and particles already in memory.
@@ -102,14 +196,80 @@ impl Simulation {
     }
 
     /// Advances the simulation by one time step Δt.
-    pub fn step(&mut self) {
+    ///
+    /// Fails, leaving the state as computed, when the run has become unstable: an overlap
+    /// deeper than the smaller radius, or a non-finite position or velocity.
+    pub fn step(&mut self) -> Result<(), Unstable> {
         self.spawn();
         self.update_neighbours();
-        self.particle_contacts();
-        self.mesh_contacts();
+        let mut deep = self.particle_contacts();
+        deep.extend(self.mesh_contacts());
         self.integrate();
         self.steps += 1;
         self.time = self.steps as f64 * self.scenario.simulation.timestep;
+        self.check_stability(deep)
+    }
+
+    /// Stage 6: stop loudly rather than continue a run that has blown up. `deep` lists the
+    /// overlaps deeper than the smaller radius found in this step's contact stages.
+    fn check_stability(&self, mut deep: Vec<Deep>) -> Result<(), Unstable> {
+        let p = &self.particles;
+        let non_finite =
+            |k: usize| !(p.x[k].is_finite() && p.v[k].is_finite() && p.w[k].is_finite());
+        let bad = (0..p.len())
+            .into_par_iter()
+            .with_min_len(4 * MIN_PARALLEL_LEN)
+            .any(non_finite);
+        if !bad && deep.is_empty() {
+            return Ok(());
+        }
+        let mut what = Vec::new();
+        for k in (0..p.len()).filter(|&k| non_finite(k)).take(5) {
+            what.push(format!(
+                "particle {k} has a non-finite state (x = {}, v = {}, w = {})",
+                p.x[k], p.v[k], p.w[k]
+            ));
+        }
+        deep.sort_by_key(|d| (d.i, d.other));
+        for d in deep.iter().take(5 - what.len().min(5)) {
+            what.push(match d.other {
+                Partner::Particle(j) => format!(
+                    "particles {} and {j} overlap by {:.3e} m, more than the smaller radius {:.3e} m",
+                    d.i, d.delta, d.limit
+                ),
+                Partner::Face(f) => format!(
+                    "particle {} overlaps mesh face {f} by {:.3e} m, more than its radius {:.3e} m",
+                    d.i, d.delta, d.limit
+                ),
+            });
+        }
+        Err(Unstable {
+            step: self.steps,
+            time: self.time,
+            what,
+            advice: self.advice(),
+        })
+    }
+
+    /// The likely cause of an instability, from the time step and the material.
+    fn advice(&self) -> String {
+        let s = &self.scenario;
+        let dt = s.simulation.timestep;
+        let eq50 = default_timestep(s.geometry.radius_min, &s.material);
+        if dt > eq50 {
+            format!(
+                "timestep {dt:.3e} s exceeds Eq. 50's {eq50:.3e} s for this stiffness and density \
+                 ({:.1} x): try timestep <= {eq50:.3e} s (or leave it unset)",
+                dt / eq50
+            )
+        } else {
+            format!(
+                "timestep {dt:.3e} s is within Eq. 50's {eq50:.3e} s: check for particles \
+                 created overlapping each other or the mesh, radii below radius_min, very \
+                 high impact speeds or strong friction (try a smaller timestep, e.g. {:.3e} s)",
+                dt / 5.0
+            )
+        }
     }
 
     /// Stage 1 (Section 3.1): new particles in the spawn box.
@@ -131,7 +291,9 @@ impl Simulation {
     }
 
     /// Stage 3 (Section 2.2): the force of every touching particle pair, once per pair.
-    fn particle_contacts(&mut self) {
+    /// Returns the overlaps deeper than the smaller radius (a sign of instability).
+    fn particle_contacts(&mut self) -> Vec<Deep> {
+        let deep = Mutex::new(Vec::new());
         let p = &self.particles;
         let law = &self.law;
         let density = self.scenario.material.density;
@@ -153,6 +315,15 @@ impl Simulation {
                 };
                 *force = match Kinematics::between_particles(&body(i), &body(j)) {
                     Some(kin) => {
+                        let limit = p.radius[i].min(p.radius[j]);
+                        if kin.delta > limit {
+                            deep.lock().expect("not poisoned").push(Deep {
+                                i,
+                                other: Partner::Particle(j),
+                                delta: kin.delta,
+                                limit,
+                            });
+                        }
                         let other = Other::Particle {
                             r: p.radius[j],
                             m: Inertia::mass(p.radius[j], density),
@@ -166,10 +337,13 @@ impl Simulation {
                     }
                 };
             });
+        deep.into_inner().expect("not poisoned")
     }
 
     /// Stage 4 (Sections 2.2, 3.3): the force of every touching particle-face pair.
-    fn mesh_contacts(&mut self) {
+    /// Returns the overlaps deeper than the particle's radius.
+    fn mesh_contacts(&mut self) -> Vec<Deep> {
+        let deep = Mutex::new(Vec::new());
         let p = &self.particles;
         let law = &self.law;
         let faces = &self.mesh.faces;
@@ -194,6 +368,14 @@ impl Simulation {
                 let d = face.separation(body.x);
                 *force = match Kinematics::with_wall(&body, d, face.radius) {
                     Some(kin) => {
+                        if kin.delta > p.radius[i] {
+                            deep.lock().expect("not poisoned").push(Deep {
+                                i,
+                                other: Partner::Face(f as usize),
+                                delta: kin.delta,
+                                limit: p.radius[i],
+                            });
+                        }
                         let m_i = Inertia::mass(p.radius[i], density);
                         law.evaluate(p.radius[i], m_i, Other::Wall, &kin, springs)
                     }
@@ -203,6 +385,7 @@ impl Simulation {
                     }
                 };
             });
+        deep.into_inner().expect("not poisoned")
     }
 
     /// Stage 5 (Section 2.3): sum each particle's contact forces and torques (Eqs. 1-2,

@@ -28,7 +28,29 @@ fn uniform(rng: &mut ChaCha8Rng, lo: f64, hi: f64) -> f64 {
     }
 }
 
+/// The position of a spawner in its random stream, for checkpoints.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpawnerState {
+    pub word_pos: u128,
+    pub pending_radius: Option<f64>,
+}
+
 impl Spawner {
+    pub fn state(&self) -> SpawnerState {
+        SpawnerState {
+            word_pos: self.rng.get_word_pos(),
+            pending_radius: self.pending_radius,
+        }
+    }
+
+    /// A spawner for `seed` continued at `state`.
+    pub fn resume(seed: u64, state: SpawnerState) -> Self {
+        let mut s = Spawner::new(seed);
+        s.rng.set_word_pos(state.word_pos);
+        s.pending_radius = state.pending_radius;
+        s
+    }
+
     pub fn new(seed: u64) -> Self {
         Spawner {
             rng: ChaCha8Rng::seed_from_u64(seed),

@@ -77,11 +77,11 @@ fn head_on(e_n: f64, v0: f64) -> (f64, f64) {
     let touching = |s: &Simulation| s.particles.x[1].x - s.particles.x[0].x < 2.0 * R;
     let mut steps_in_contact = 0u64;
     while !touching(&s) {
-        s.step();
+        s.step().unwrap();
     }
     let mut last_touch = 0;
     for k in 0..200_000 {
-        s.step();
+        s.step().unwrap();
         if touching(&s) {
             steps_in_contact += 1;
             last_touch = k;
@@ -185,7 +185,7 @@ fn elastic_frictionless_gas_conserves_energy_without_drift() {
     let mut samples = Vec::new();
     for _ in 0..200 {
         for _ in 0..100 {
-            s.step();
+            s.step().unwrap();
         }
         samples.push(energy(&s));
     }
@@ -216,7 +216,7 @@ fn sliding_sphere_ends_rolling_at_five_sevenths_of_its_speed() {
         )],
     );
     for _ in 0..40_000 {
-        s.step();
+        s.step().unwrap();
     }
     let v = s.particles.v[0];
     let w = s.particles.w[0];
@@ -246,11 +246,11 @@ fn incline(theta_deg: f64, mu_s: f64, mu_r: f64) -> f64 {
         )],
     );
     for _ in 0..20_000 {
-        s.step();
+        s.step().unwrap();
     }
     let x_half = s.particles.x[0].x;
     for _ in 0..20_000 {
-        s.step();
+        s.step().unwrap();
     }
     s.particles.x[0].x - x_half
 }
@@ -293,7 +293,7 @@ fn twisting_spin_decays_and_stops() {
     // Kinetic phase: the spin falls steadily to near zero.
     let mut previous: f64 = 50.0;
     while s.particles.w[0].z > 1.0 {
-        s.step();
+        s.step().unwrap();
         let w = s.particles.w[0].z;
         assert!(w < previous, "spin grew: {w} after {previous}");
         previous = w;
@@ -302,7 +302,7 @@ fn twisting_spin_decays_and_stops() {
     let envelope = |s: &mut Simulation| {
         let mut m: f64 = 0.0;
         for _ in 0..4000 {
-            s.step();
+            s.step().unwrap();
             m = m.max(s.particles.w[0].z.abs());
         }
         m
@@ -333,7 +333,7 @@ fn stokes_drag_decays_velocity_and_spin_at_their_rates() {
     let dt = s.scenario.simulation.timestep;
     let steps = 5000;
     for _ in 0..steps {
-        s.step();
+        s.step().unwrap();
     }
     let t = steps as f64 * dt;
     let c = 9.0 * eta / (2.0 * RHO * R * R); // Eq. (3)
@@ -392,7 +392,7 @@ fn orientation_stays_unit_and_composes_world_spin_from_the_left() {
     let mut s = sim("", DVec3::ZERO, None, None, vec![p]);
     let steps = 20_000;
     for _ in 0..steps {
-        s.step();
+        s.step().unwrap();
         assert!((s.particles.q[0].length() - 1.0).abs() < 1e-14);
     }
     let t = steps as f64 * s.scenario.simulation.timestep;

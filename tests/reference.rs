@@ -50,7 +50,7 @@ fn check_case(case: &str) -> f64 {
     for (f, tol) in tols.iter().enumerate() {
         if f > 0 {
             for _ in 0..steps {
-                sim.step();
+                sim.step().unwrap();
             }
         }
         let Some(tol) = tol.as_f64() else { continue };

@@ -28,7 +28,7 @@ fn good_scenarios_load_and_run() {
         let steps = s.simulation.steps_per_frame;
         let mut sim = Simulation::new(s).unwrap_or_else(|e| panic!("{}: {e:#}", path.display()));
         for _ in 0..steps {
-            sim.step();
+            sim.step().unwrap();
         }
     }
 }

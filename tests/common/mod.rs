@@ -21,7 +21,7 @@ pub fn scenario(text: &str) -> Scenario {
 pub fn simulate(text: &str, steps: u64) -> Simulation {
     let mut sim = Simulation::new(scenario(text)).expect("simulation starts");
     for _ in 0..steps {
-        sim.step();
+        sim.step().unwrap();
     }
     sim
 }

@@ -1,0 +1,296 @@
+//! Checkpoints: the complete state of a run in a versioned binary file with a checksum, so
+//! that a resumed run is bitwise identical to an uninterrupted one.
+//!
+//! Layout (little endian): magic `TINYDEM CKPT`, format version (u32), scenario fingerprint
+//! (u64), step (u64), spawner word position (u128), pending radius flag (u8) and value
+//! (f64), particle count (u64) and 14 f64 per particle (x, y, z, R, vx, vy, vz, q0..q3, wx,
+//! wy, wz), then the particle-pair and particle-face histories: count (u64) and per entry
+//! owner, partner (u32) and the springs u_s, u_r (3 f64 each), u_t (f64); last a CRC-32 of
+//! everything before it.
+
+use std::path::Path;
+
+use anyhow::{Context, Result, bail};
+use glam::{DQuat, DVec3};
+
+use crate::contact::Springs;
+use crate::mesh::Mesh;
+use crate::particles::{Particle, Particles};
+use crate::scenario::Scenario;
+use crate::simulation::Snapshot;
+use crate::spawn::SpawnerState;
+
+const MAGIC: &[u8; 12] = b"TINYDEM CKPT";
+const VERSION: u32 = 1;
+
+/// A fingerprint of everything a checkpoint's state depends on: the physics, time step,
+/// spawning and mesh. The number of frames and the output may change on resume.
+pub fn fingerprint(s: &Scenario, mesh: &Mesh) -> u64 {
+    let text = format!(
+        "{:?}|{:?}|{:?}|{:?}|{}|{}|{}|{}|{:?}",
+        s.geometry.mesh_radii,
+        s.material,
+        s.kinetics,
+        (
+            s.geometry.radius_min,
+            s.geometry.radius_max,
+            s.geometry.spawn_min,
+            s.geometry.spawn_max
+        ),
+        s.simulation.timestep,
+        s.simulation.steps_per_frame,
+        s.simulation.max_particles,
+        s.simulation.spawn_attempts,
+        (s.simulation.seed, &mesh.faces),
+    );
+    // FNV-1a, 64 bit.
+    text.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
+        (h ^ b as u64).wrapping_mul(0x100_0000_01b3)
+    })
+}
+
+fn put_f64s(out: &mut Vec<u8>, values: &[f64]) {
+    for v in values {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+}
+
+fn put_history(out: &mut Vec<u8>, h: &[(u32, u32, Springs)]) {
+    out.extend_from_slice(&(h.len() as u64).to_le_bytes());
+    for (i, j, s) in h {
+        out.extend_from_slice(&i.to_le_bytes());
+        out.extend_from_slice(&j.to_le_bytes());
+        put_f64s(
+            out,
+            &[s.u_s.x, s.u_s.y, s.u_s.z, s.u_r.x, s.u_r.y, s.u_r.z, s.u_t],
+        );
+    }
+}
+
+/// Encodes a snapshot.
+pub fn encode(snapshot: &Snapshot, fingerprint: u64) -> Vec<u8> {
+    let p = &snapshot.particles;
+    let mut out = Vec::with_capacity(64 + p.len() * 112);
+    out.extend_from_slice(MAGIC);
+    out.extend_from_slice(&VERSION.to_le_bytes());
+    out.extend_from_slice(&fingerprint.to_le_bytes());
+    out.extend_from_slice(&snapshot.steps.to_le_bytes());
+    out.extend_from_slice(&snapshot.spawner.word_pos.to_le_bytes());
+    out.push(snapshot.spawner.pending_radius.is_some() as u8);
+    put_f64s(&mut out, &[snapshot.spawner.pending_radius.unwrap_or(0.0)]);
+    out.extend_from_slice(&(p.len() as u64).to_le_bytes());
+    for q in p.iter() {
+        put_f64s(
+            &mut out,
+            &[
+                q.x.x, q.x.y, q.x.z, q.radius, q.v.x, q.v.y, q.v.z, q.q.w, q.q.x, q.q.y, q.q.z,
+                q.w.x, q.w.y, q.w.z,
+            ],
+        );
+    }
+    put_history(&mut out, &snapshot.pair_history);
+    put_history(&mut out, &snapshot.face_history);
+    let crc = crc32fast::hash(&out);
+    out.extend_from_slice(&crc.to_le_bytes());
+    out
+}
+
+/// A cursor over the checkpoint bytes that reports truncation clearly.
+struct Reader<'a> {
+    bytes: &'a [u8],
+    at: usize,
+}
+
+impl Reader<'_> {
+    fn take(&mut self, n: usize) -> Result<&[u8]> {
+        if self.bytes.len() - self.at < n {
+            bail!(
+                "truncated: ends at byte {} while reading {n} more bytes",
+                self.bytes.len()
+            );
+        }
+        self.at += n;
+        Ok(&self.bytes[self.at - n..self.at])
+    }
+    fn u8(&mut self) -> Result<u8> {
+        Ok(self.take(1)?[0])
+    }
+    fn u32(&mut self) -> Result<u32> {
+        Ok(u32::from_le_bytes(self.take(4)?.try_into()?))
+    }
+    fn u64(&mut self) -> Result<u64> {
+        Ok(u64::from_le_bytes(self.take(8)?.try_into()?))
+    }
+    fn u128(&mut self) -> Result<u128> {
+        Ok(u128::from_le_bytes(self.take(16)?.try_into()?))
+    }
+    fn f64(&mut self) -> Result<f64> {
+        Ok(f64::from_le_bytes(self.take(8)?.try_into()?))
+    }
+    fn vec3(&mut self) -> Result<DVec3> {
+        Ok(DVec3::new(self.f64()?, self.f64()?, self.f64()?))
+    }
+    /// A count of records of `size` bytes each, checked against the bytes left.
+    fn count(&mut self, size: usize) -> Result<usize> {
+        let n = self.u64()?;
+        if n > ((self.bytes.len() - self.at) / size) as u64 {
+            bail!("corrupt: announces {n} records, more than the file holds");
+        }
+        Ok(n as usize)
+    }
+    fn history(&mut self) -> Result<Vec<(u32, u32, Springs)>> {
+        let n = self.count(8 + 56)?;
+        (0..n)
+            .map(|_| {
+                Ok((
+                    self.u32()?,
+                    self.u32()?,
+                    Springs {
+                        u_s: self.vec3()?,
+                        u_r: self.vec3()?,
+                        u_t: self.f64()?,
+                    },
+                ))
+            })
+            .collect()
+    }
+}
+
+/// Decodes a checkpoint, checking magic, version, checksum and fingerprint.
+pub fn decode(bytes: &[u8], expected_fingerprint: u64) -> Result<Snapshot> {
+    if bytes.len() < MAGIC.len() + 4 || &bytes[..MAGIC.len()] != MAGIC {
+        bail!("not a tinydem checkpoint (no 'TINYDEM CKPT' header)");
+    }
+    let (body, crc) = bytes.split_at(bytes.len() - 4);
+    let version = u32::from_le_bytes(bytes[12..16].try_into()?);
+    if version != VERSION {
+        bail!("checkpoint format version {version}; this tinydem reads version {VERSION}");
+    }
+    if crc32fast::hash(body).to_le_bytes() != crc {
+        bail!("corrupt checkpoint: the checksum does not match (truncated or damaged file)");
+    }
+    let mut r = Reader {
+        bytes: body,
+        at: 16,
+    };
+    if r.u64()? != expected_fingerprint {
+        bail!(
+            "the checkpoint was written for a different scenario or mesh (material, time step, \
+             spawning, geometry): resume it with the scenario it was written with"
+        );
+    }
+    let steps = r.u64()?;
+    let word_pos = r.u128()?;
+    let has_pending = r.u8()? != 0;
+    let pending = r.f64()?;
+    let n = r.count(14 * 8)?;
+    let mut particles = Particles::default();
+    for _ in 0..n {
+        let x = r.vec3()?;
+        let radius = r.f64()?;
+        let v = r.vec3()?;
+        let (w0, q1, q2, q3) = (r.f64()?, r.f64()?, r.f64()?, r.f64()?);
+        let w = r.vec3()?;
+        particles.push(Particle {
+            x,
+            radius,
+            v,
+            q: DQuat::from_xyzw(q1, q2, q3, w0),
+            w,
+        });
+    }
+    let pair_history = r.history()?;
+    let face_history = r.history()?;
+    if r.at != body.len() {
+        bail!(
+            "corrupt checkpoint: {} unexpected bytes at the end",
+            body.len() - r.at
+        );
+    }
+    Ok(Snapshot {
+        steps,
+        particles,
+        spawner: SpawnerState {
+            word_pos,
+            pending_radius: has_pending.then_some(pending),
+        },
+        pair_history,
+        face_history,
+    })
+}
+
+/// Writes a checkpoint atomically (temporary file, then rename).
+pub fn save(path: &Path, snapshot: &Snapshot, fingerprint: u64) -> Result<()> {
+    let name = path
+        .file_name()
+        .map_or_else(|| "checkpoint".into(), |n| n.to_string_lossy());
+    let tmp = path.with_file_name(format!(".{name}.tmp"));
+    let write = || -> std::io::Result<()> {
+        let file = std::fs::File::create(&tmp)?;
+        let mut w = std::io::BufWriter::new(file);
+        std::io::Write::write_all(&mut w, &encode(snapshot, fingerprint))?;
+        w.into_inner().map_err(|e| e.into_error())?.sync_all()?;
+        std::fs::rename(&tmp, path)
+    };
+    write().with_context(|| format!("cannot write checkpoint {}", path.display()))
+}
+
+/// Reads a checkpoint for `scenario` with its `mesh`.
+pub fn load(path: &Path, fingerprint: u64) -> Result<Snapshot> {
+    let bytes = std::fs::read(path)
+        .with_context(|| format!("cannot read checkpoint {}", path.display()))?;
+    decode(&bytes, fingerprint).with_context(|| format!("cannot resume from {}", path.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn snapshot() -> Snapshot {
+        let mut particles = Particles::default();
+        particles.push(Particle {
+            x: DVec3::new(0.1, 0.2, 0.3),
+            radius: 0.004,
+            v: DVec3::new(-1.0, 1e-300, 2.5),
+            q: DQuat::from_rotation_y(0.7),
+            w: DVec3::new(1.0, 2.0, 3.0),
+        });
+        let s = Springs {
+            u_s: DVec3::new(1e-5, 2e-6, 0.0),
+            u_r: DVec3::ZERO,
+            u_t: -3e-7,
+        };
+        Snapshot {
+            steps: 12345,
+            particles,
+            spawner: SpawnerState {
+                word_pos: 987654321,
+                pending_radius: Some(0.0042),
+            },
+            pair_history: vec![(0, 1, s)],
+            face_history: vec![(0, 3, s)],
+        }
+    }
+
+    #[test]
+    fn round_trip_is_exact() {
+        let s = snapshot();
+        assert_eq!(decode(&encode(&s, 7), 7).unwrap(), s);
+    }
+
+    #[test]
+    fn damage_is_refused() {
+        let bytes = encode(&snapshot(), 7);
+        let msg = |b: &[u8], f| format!("{:#}", decode(b, f).unwrap_err());
+        assert!(msg(&bytes, 8).contains("different scenario"));
+        assert!(msg(&bytes[..bytes.len() - 9], 7).contains("checksum"));
+        let mut flipped = bytes.clone();
+        flipped[40] ^= 1;
+        assert!(msg(&flipped, 7).contains("checksum"));
+        let mut version = bytes.clone();
+        version[12] = 9;
+        assert!(msg(&version, 7).contains("version 9"));
+        assert!(msg(b"hello world, not a checkpoint", 7).contains("not a tinydem checkpoint"));
+        assert!(msg(b"", 7).contains("not a tinydem checkpoint"));
+    }
+}

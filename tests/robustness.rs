@@ -1,0 +1,251 @@
+//! Faults: unstable runs stop loudly, interrupted runs resume bit for bit, killed runs
+//! leave only complete files.
+
+use std::path::Path;
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+use tinydem::checkpoint;
+use tinydem::csv::load_particles;
+
+fn tinydem(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_tinydem"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("binary runs")
+}
+
+const HEADER: &str = "x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz\n";
+
+#[test]
+fn too_large_timestep_is_caught_and_explained() {
+    let t = tempfile::tempdir().unwrap();
+    std::fs::write(
+        t.path().join("p.csv"),
+        format!(
+            "{HEADER}-0.0052,0,0,0.005,2,0,0,1,0,0,0,0,0,0\n0.0052,0,0,0.005,-2,0,0,1,0,0,0,0,0,0\n"
+        ),
+    )
+    .unwrap();
+    std::fs::write(
+        t.path().join("s.toml"),
+        "[geometry]\nradius_min = 0.005\nradius_max = 0.005\n[kinetics]\ngravity = [0.0, 0.0, 0.0]\n\
+         [simulation]\ntimestep = 3e-3\nframes = 10\nsteps_per_frame = 10\nmax_particles = 0\n\
+         [input]\nparticles = \"p.csv\"\n",
+    )
+    .unwrap();
+    let o = tinydem(&["run", "s.toml", "-q"], t.path());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success());
+    assert!(!err.contains("panicked"), "{err}");
+    for expected in [
+        "became unstable at step",
+        "particles 0 and 1 overlap by",
+        "timestep 3.000e-3 s exceeds Eq. 50's 1.508e-4 s",
+        "try timestep <= 1.508e-4 s",
+        "last complete frame",
+        "unstable.csv",
+    ] {
+        assert!(
+            err.contains(expected),
+            "message\n  {err}\nlacks\n  {expected}"
+        );
+    }
+    let state = load_particles(&t.path().join("output/unstable.csv")).unwrap();
+    assert_eq!(state.len(), 2);
+}
+
+/// A pile that spawns particles and keeps them in contact: spring history matters.
+fn pile(dir: &Path, frames: u64) {
+    std::fs::write(
+        dir.join("box.off"),
+        "OFF\n8 5 0\n-0.03 -0.03 0\n0.03 -0.03 0\n0.03 0.03 0\n-0.03 0.03 0\n-0.03 -0.03 0.2\n0.03 -0.03 0.2\n\
+         0.03 0.03 0.2\n-0.03 0.03 0.2\n4 0 1 2 3\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("s.toml"),
+        format!(
+            "[geometry]\nradius_min = 0.003\nradius_max = 0.005\nmesh = \"box.off\"\nmesh_radii = [0.0]\n\
+             spawn_min = [-0.02, -0.02, 0.05]\nspawn_max = [0.02, 0.02, 0.15]\n\
+             [simulation]\nmax_particles = 400\nspawn_attempts = 3\nframes = {frames}\nsteps_per_frame = 2000\n"
+        ),
+    )
+    .unwrap();
+}
+
+fn frames_of(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut v: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap())
+        .filter(|e| e.file_name().to_string_lossy().starts_with("particles"))
+        .map(|e| {
+            (
+                e.file_name().to_string_lossy().into_owned(),
+                std::fs::read(e.path()).unwrap(),
+            )
+        })
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn interrupted_run_resumes_bit_for_bit() {
+    let frames = 12;
+    // Uninterrupted reference.
+    let a = tempfile::tempdir().unwrap();
+    pile(a.path(), frames);
+    let o = tinydem(&["run", "s.toml", "-q", "--output", "out"], a.path());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let reference = frames_of(&a.path().join("out"));
+    assert_eq!(reference.len() as u64, frames + 1);
+
+    // Interrupted with SIGINT part-way, then resumed.
+    let b = tempfile::tempdir().unwrap();
+    pile(b.path(), frames);
+    let child = Command::new(env!("CARGO_BIN_EXE_tinydem"))
+        .args(["run", "s.toml", "-q", "--output", "out"])
+        .current_dir(b.path())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Wait until a few frames exist, so particles are piled up and in contact.
+    let start = Instant::now();
+    while !b.path().join("out/particles000004.csv").exists() {
+        assert!(start.elapsed() < Duration::from_secs(60), "run too slow");
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let status = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{err}");
+    assert!(
+        err.contains("interrupted after step") && err.contains("--resume"),
+        "{err}"
+    );
+    let ckpt = b.path().join("out/checkpoint.bin");
+    assert!(b.path().join("out/interrupted.csv").exists());
+    let snapshot = checkpoint::decode(&std::fs::read(&ckpt).unwrap(), {
+        // Any fingerprint check is done by the CLI; here only the content matters.
+        let bytes = std::fs::read(&ckpt).unwrap();
+        u64::from_le_bytes(bytes[16..24].try_into().unwrap())
+    })
+    .unwrap();
+    assert!(snapshot.steps < frames * 2000, "interrupted before the end");
+    assert!(
+        !snapshot.pair_history.is_empty(),
+        "particles were in contact"
+    );
+    assert!(
+        !snapshot.face_history.is_empty(),
+        "particles touched the box"
+    );
+
+    let o = tinydem(
+        &[
+            "run",
+            "s.toml",
+            "-q",
+            "--output",
+            "out",
+            "--resume",
+            "out/checkpoint.bin",
+        ],
+        b.path(),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(!b.path().join("out/interrupted.csv").exists());
+    let resumed = frames_of(&b.path().join("out"));
+    assert_eq!(resumed.len(), reference.len());
+    for ((name, x), (_, y)) in reference.iter().zip(&resumed) {
+        assert!(x == y, "{name} differs after resume");
+    }
+}
+
+#[test]
+fn checkpoints_of_another_scenario_or_damaged_are_refused() {
+    let t = tempfile::tempdir().unwrap();
+    pile(t.path(), 2);
+    std::fs::write(
+        t.path().join("s.toml"),
+        std::fs::read_to_string(t.path().join("s.toml")).unwrap()
+            + "[output]\ncheckpoint_every = 1\n",
+    )
+    .unwrap();
+    let o = tinydem(&["run", "s.toml", "-q"], t.path());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let ckpt = t.path().join("output/checkpoint.bin");
+    assert!(ckpt.exists(), "periodic checkpoint written");
+
+    let other = std::fs::read_to_string(t.path().join("s.toml"))
+        .unwrap()
+        .replace("max_particles = 400", "max_particles = 401");
+    std::fs::write(t.path().join("other.toml"), other).unwrap();
+    let o = tinydem(
+        &[
+            "run",
+            "other.toml",
+            "-q",
+            "--resume",
+            "output/checkpoint.bin",
+        ],
+        t.path(),
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("different scenario"),
+        "{err}"
+    );
+
+    let mut bytes = std::fs::read(&ckpt).unwrap();
+    let mid = bytes.len() / 2;
+    bytes[mid] ^= 0xff;
+    std::fs::write(t.path().join("bad.bin"), &bytes).unwrap();
+    let o = tinydem(&["run", "s.toml", "-q", "--resume", "bad.bin"], t.path());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("checksum") && err.contains("bad.bin"),
+        "{err}"
+    );
+    assert!(!err.contains("panicked"));
+}
+
+#[test]
+fn killed_run_leaves_only_complete_files() {
+    let t = tempfile::tempdir().unwrap();
+    pile(t.path(), 200);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tinydem"))
+        .args(["run", "s.toml", "-q"])
+        .current_dir(t.path())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while !t.path().join("output/particles000003.csv").exists() {
+        assert!(start.elapsed() < Duration::from_secs(60), "run too slow");
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    std::thread::sleep(Duration::from_millis(37));
+    child.kill().unwrap(); // SIGKILL
+    child.wait().unwrap();
+    let mut count = 0;
+    for e in std::fs::read_dir(t.path().join("output")).unwrap() {
+        let e = e.unwrap();
+        let name = e.file_name().to_string_lossy().into_owned();
+        if name.starts_with('.') {
+            continue; // a temporary file, never read and removed by the next run
+        }
+        let p =
+            load_particles(&e.path()).unwrap_or_else(|err| panic!("{name} incomplete: {err:#}"));
+        let text = std::fs::read_to_string(e.path()).unwrap();
+        assert!(text.ends_with('\n'), "{name} does not end with a newline");
+        assert_eq!(text.lines().count(), p.len() + 1);
+        count += 1;
+    }
+    assert!(count >= 4);
+}
