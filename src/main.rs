@@ -21,6 +21,9 @@ struct Cli {
     /// Number of worker threads (default: all cores).
     #[arg(long, global = true)]
     threads: Option<usize>,
+    /// Continue the interrupted default run from its checkpoint.
+    #[arg(long)]
+    resume: Option<PathBuf>,
 }
 
 #[derive(Subcommand)]
@@ -98,10 +101,10 @@ fn real_main(cli: Cli) -> Result<()> {
     // The time loop runs on a worker of the pool, so that small parallel loops run inline
     // instead of waking another thread for every stage.
     let pool = pool.build().context("cannot start the thread pool")?;
-    pool.install(|| execute(cli.command))
+    pool.install(|| execute(cli.command, cli.resume))
 }
 
-fn execute(command: Option<Command>) -> Result<()> {
+fn execute(command: Option<Command>, resume_default: Option<PathBuf>) -> Result<()> {
     match command {
         None => {
             let s = Scenario::default();
@@ -109,7 +112,7 @@ fn execute(command: Option<Command>) -> Result<()> {
             catch_signals()?;
             let options = Options {
                 verbosity: Verbosity::Normal,
-                resume: None,
+                resume: resume_default.as_deref(),
                 stop: Some(&STOP),
             };
             let summary = run(s, &out, options)?;

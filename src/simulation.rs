@@ -26,8 +26,8 @@ fn forget(springs: &mut Springs) {
     }
 }
 
-/// Verlet skin as a fraction of R_min.
-const SKIN_PER_RADIUS: f64 = 0.25;
+/// Verlet skin as a fraction of R_max.
+const SKIN_PER_RADIUS: f64 = 0.5;
 
 /// Everything needed to continue a run bit for bit: particles, step count, the spawner's
 /// place in its random stream, and the contact history (the friction springs of every
@@ -161,7 +161,7 @@ impl Simulation {
         if particles.len() as u64 > u32::MAX as u64 / 2 {
             bail!("too many particles: {}", particles.len());
         }
-        let skin = SKIN_PER_RADIUS * g.radius_min;
+        let skin = SKIN_PER_RADIUS * g.radius_max;
         let face_grid = face_grid(&mesh.faces, max_radius, skin);
         Ok(Simulation {
             law: ContactLaw::new(&scenario.material, scenario.simulation.timestep),
