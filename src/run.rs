@@ -12,7 +12,7 @@ use crate::checkpoint;
 use crate::contact::ContactLaw;
 use crate::csv::{frame_name, write_frame};
 use crate::integrate::Inertia;
-use crate::scenario::{MeshSource, Scenario};
+use crate::scenario::{Formats, MeshSource, Scenario};
 use crate::simulation::Simulation;
 
 /// Name of the checkpoint file in the output directory.
@@ -74,6 +74,39 @@ impl std::fmt::Display for Interrupted {
 
 impl std::error::Error for Interrupted {}
 
+/// Writes frames in the scenario's formats, and the ParaView collection.
+struct Frames<'a> {
+    dir: &'a Path,
+    formats: Formats,
+    /// Simulated time between frames.
+    frame_time: f64,
+}
+
+impl Frames<'_> {
+    /// Files that do not change during the run (the static mesh).
+    fn start(&self, sim: &Simulation) -> Result<()> {
+        if self.formats.vtk {
+            crate::vtk::write_mesh(&self.dir.join("mesh.vtu"), &sim.mesh)?;
+        }
+        Ok(())
+    }
+
+    fn write(&self, k: u64, sim: &Simulation) -> Result<()> {
+        if self.formats.csv {
+            write_frame(self.dir, k, &sim.particles)?;
+        }
+        if self.formats.vtk {
+            let name = format!("particles{k:06}.vtu");
+            crate::vtk::write_particles(&self.dir.join(&name), &sim.particles)?;
+            let entries: Vec<(f64, String)> = (0..=k)
+                .map(|f| (f as f64 * self.frame_time, format!("particles{f:06}.vtu")))
+                .collect();
+            crate::vtk::write_collection(&self.dir.join("particles.pvd"), &entries)?;
+        }
+        Ok(())
+    }
+}
+
 /// Fails early, before simulating, if the output directory cannot be written, and removes
 /// temporary files a killed run may have left.
 fn prepare_output(dir: &Path) -> Result<()> {
@@ -113,9 +146,15 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
         }
     };
     let start = Instant::now();
+    let out = Frames {
+        dir: output_dir,
+        formats: sim.scenario.formats,
+        frame_time: steps_per_frame as f64 * sim.scenario.simulation.timestep,
+    };
+    out.start(&sim)?;
     let mut frames_written = 0;
     if options.resume.is_none() {
-        write_frame(output_dir, 0, &sim.particles)?;
+        out.write(0, &sim)?;
         frames_written += 1;
     }
 
@@ -168,7 +207,7 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
         }
         if sim.steps.is_multiple_of(steps_per_frame) {
             let frame = sim.steps / steps_per_frame;
-            write_frame(output_dir, frame, &sim.particles)?;
+            out.write(frame, &sim)?;
             frames_written += 1;
             status(&sim, frame);
             if checkpoint_every > 0 && frame.is_multiple_of(checkpoint_every) {

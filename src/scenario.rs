@@ -8,7 +8,7 @@
 //! [kinetics]   initial_velocity, initial_angular_velocity, gravity
 //! [simulation] timestep, max_particles, frames, steps_per_frame, spawn_attempts, seed
 //! [input]      particles
-//! [output]     dir, checkpoint_every
+//! [output]     dir, checkpoint_every, formats
 //! ```
 //! Paths are relative to the scenario file. Unknown keys and values outside Table 2's
 //! "Requirements" column are errors naming the key and the allowed range.
@@ -106,6 +106,45 @@ pub struct Scenario {
     pub output_dir: PathBuf,
     /// Write a checkpoint every this many frames (0: only when interrupted).
     pub checkpoint_every: u64,
+    /// Frame formats to write.
+    pub formats: Formats,
+}
+
+/// The frame formats of `[output] formats`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Formats {
+    /// `particlesNNNNNN.csv`, the original program's format.
+    pub csv: bool,
+    /// `particlesNNNNNN.vtu`, `mesh.vtu` and `particles.pvd` for ParaView.
+    pub vtk: bool,
+}
+
+impl Formats {
+    fn parse(names: Option<Vec<String>>) -> Result<Formats> {
+        let Some(names) = names else {
+            return Ok(Formats {
+                csv: true,
+                vtk: false,
+            });
+        };
+        let mut f = Formats {
+            csv: false,
+            vtk: false,
+        };
+        for name in &names {
+            match name.as_str() {
+                "csv" => f.csv = true,
+                "vtk" => f.vtk = true,
+                other => bail!(
+                    "[output] formats: unknown format \"{other}\": the formats are \"csv\" and \"vtk\""
+                ),
+            }
+        }
+        if !f.csv && !f.vtk {
+            bail!("[output] formats must name at least one of \"csv\" and \"vtk\"");
+        }
+        Ok(f)
+    }
 }
 
 /// Default time step, Eq. (50): Δt = R_min sqrt(ρ (1 - ν²) / E).
@@ -187,6 +226,7 @@ struct RawInput {
 struct RawOutput {
     dir: Option<PathBuf>,
     checkpoint_every: Option<u64>,
+    formats: Option<Vec<String>>,
 }
 
 /// A range check of Table 2's "Requirements" column.
@@ -415,6 +455,7 @@ impl Scenario {
                 .dir
                 .map_or_else(|| PathBuf::from("output"), |d| base.join(d)),
             checkpoint_every: raw.output.checkpoint_every.unwrap_or(0),
+            formats: Formats::parse(raw.output.formats)?,
         })
     }
 

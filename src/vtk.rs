@@ -1,0 +1,251 @@
+//! ParaView-ready output: VTK XML unstructured grids (`.vtu`) with binary (raw appended)
+//! data, and a `.pvd` collection that lists the frames with their times.
+//!
+//! Particles are points with one vertex cell each and the point arrays `radius`,
+//! `velocity`, `angular_velocity` and `orientation` (the quaternion q0, q1, q2, q3); the mesh
+//! is its faces (vertex, line, triangle and quad cells) with the cell array `radius`.
+
+use std::io::Write;
+use std::path::Path;
+
+use anyhow::{Context, Result};
+
+use crate::mesh::{Mesh, Primitive};
+use crate::particles::Particles;
+
+/// Where an array goes in the file.
+#[derive(Clone, Copy)]
+enum Section {
+    PointData,
+    CellData,
+    Points,
+    Cells,
+}
+
+/// A `.vtu` file under construction: XML header text and the appended binary block.
+struct Vtu {
+    point_data: String,
+    cell_data: String,
+    points: String,
+    cells: String,
+    appended: Vec<u8>,
+}
+
+/// An array's element type as VTK names it.
+trait VtkType: Copy {
+    const NAME: &'static str;
+    fn put(self, out: &mut Vec<u8>);
+}
+
+impl VtkType for f64 {
+    const NAME: &'static str = "Float64";
+    fn put(self, out: &mut Vec<u8>) {
+        out.extend_from_slice(&self.to_le_bytes());
+    }
+}
+
+impl VtkType for i64 {
+    const NAME: &'static str = "Int64";
+    fn put(self, out: &mut Vec<u8>) {
+        out.extend_from_slice(&self.to_le_bytes());
+    }
+}
+
+impl VtkType for u8 {
+    const NAME: &'static str = "UInt8";
+    fn put(self, out: &mut Vec<u8>) {
+        out.push(self);
+    }
+}
+
+impl Vtu {
+    fn new() -> Vtu {
+        Vtu {
+            point_data: String::new(),
+            cell_data: String::new(),
+            points: String::new(),
+            cells: String::new(),
+            appended: Vec::new(),
+        }
+    }
+
+    /// Appends one array of `count` values (UInt64 byte count, then the values) and adds its
+    /// XML element to `section`.
+    fn array<T: VtkType>(
+        &mut self,
+        section: Section,
+        name: &str,
+        components: usize,
+        count: usize,
+        values: impl Iterator<Item = T>,
+    ) {
+        let offset = self.appended.len();
+        let bytes = count * std::mem::size_of::<T>();
+        self.appended
+            .extend_from_slice(&(bytes as u64).to_le_bytes());
+        self.appended.reserve(bytes);
+        let mut written = 0;
+        for v in values {
+            v.put(&mut self.appended);
+            written += 1;
+        }
+        debug_assert_eq!(written, count);
+        let element = format!(
+            "        <DataArray type=\"{}\" Name=\"{name}\" NumberOfComponents=\"{components}\" format=\"appended\" offset=\"{offset}\"/>\n",
+            T::NAME
+        );
+        match section {
+            Section::PointData => self.point_data += &element,
+            Section::CellData => self.cell_data += &element,
+            Section::Points => self.points += &element,
+            Section::Cells => self.cells += &element,
+        }
+    }
+
+    fn write(&self, path: &Path, points: usize, cells: usize) -> Result<()> {
+        let mut text = String::new();
+        text.push_str("<?xml version=\"1.0\"?>\n");
+        text.push_str(
+            "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n",
+        );
+        text.push_str("  <UnstructuredGrid>\n");
+        text.push_str(&format!(
+            "    <Piece NumberOfPoints=\"{points}\" NumberOfCells=\"{cells}\">\n"
+        ));
+        text.push_str(&format!(
+            "      <PointData>\n{}      </PointData>\n",
+            self.point_data
+        ));
+        text.push_str(&format!(
+            "      <CellData>\n{}      </CellData>\n",
+            self.cell_data
+        ));
+        text.push_str(&format!("      <Points>\n{}      </Points>\n", self.points));
+        text.push_str(&format!("      <Cells>\n{}      </Cells>\n", self.cells));
+        text.push_str(
+            "    </Piece>\n  </UnstructuredGrid>\n  <AppendedData encoding=\"raw\">\n   _",
+        );
+        let tail = "\n  </AppendedData>\n</VTKFile>\n";
+        atomic_write(path, &[text.as_bytes(), &self.appended, tail.as_bytes()])
+    }
+}
+
+/// Writes `parts` to a temporary file and renames it to `path`.
+fn atomic_write(path: &Path, parts: &[&[u8]]) -> Result<()> {
+    let name = path
+        .file_name()
+        .map_or_else(|| "vtk".into(), |n| n.to_string_lossy());
+    let tmp = path.with_file_name(format!(".{name}.tmp"));
+    let write = || -> std::io::Result<()> {
+        let mut w = std::io::BufWriter::with_capacity(1 << 20, std::fs::File::create(&tmp)?);
+        for p in parts {
+            w.write_all(p)?;
+        }
+        w.into_inner().map_err(|e| e.into_error())?.sync_data()?;
+        std::fs::rename(&tmp, path)
+    };
+    write().with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Writes the particles as a `.vtu` file.
+pub fn write_particles(path: &Path, p: &Particles) -> Result<()> {
+    use Section::*;
+    let n = p.len();
+    let mut v = Vtu::new();
+    v.array(PointData, "radius", 1, n, p.radius.iter().copied());
+    v.array(
+        PointData,
+        "velocity",
+        3,
+        3 * n,
+        p.v.iter().flat_map(|a| a.to_array()),
+    );
+    v.array(
+        PointData,
+        "angular_velocity",
+        3,
+        3 * n,
+        p.w.iter().flat_map(|a| a.to_array()),
+    );
+    v.array(
+        PointData,
+        "orientation",
+        4,
+        4 * n,
+        p.q.iter().flat_map(|q| [q.w, q.x, q.y, q.z]),
+    );
+    v.array(
+        Points,
+        "points",
+        3,
+        3 * n,
+        p.x.iter().flat_map(|a| a.to_array()),
+    );
+    v.array(Cells, "connectivity", 1, n, 0..n as i64);
+    v.array(Cells, "offsets", 1, n, 1..=n as i64);
+    v.array(Cells, "types", 1, n, std::iter::repeat_n(1u8, n)); // VTK_VERTEX
+    v.write(path, n, n)
+}
+
+/// Writes the mesh faces as a `.vtu` file: one cell per face, with its radius.
+pub fn write_mesh(path: &Path, mesh: &Mesh) -> Result<()> {
+    use Section::*;
+    let mut points = Vec::new();
+    let mut connectivity = Vec::new();
+    let mut offsets = Vec::new();
+    let mut types = Vec::new();
+    for face in &mesh.faces {
+        let (corners, vtk_type): (Vec<glam::DVec3>, u8) = match face.shape {
+            Primitive::Point(a) => (vec![a], 1),         // VTK_VERTEX
+            Primitive::Segment(a, b) => (vec![a, b], 3), // VTK_LINE
+            Primitive::Triangle { a, b, c, .. } => (vec![a, b, c], 5), // VTK_TRIANGLE
+            Primitive::Rectangle { o, e1, e2, .. } => (vec![o, o + e1, o + e1 + e2, o + e2], 9), // VTK_QUAD
+        };
+        for c in corners {
+            connectivity.push(points.len() as i64);
+            points.push(c);
+        }
+        offsets.push(connectivity.len() as i64);
+        types.push(vtk_type);
+    }
+    let (np, nc) = (points.len(), mesh.faces.len());
+    let mut v = Vtu::new();
+    v.array(
+        CellData,
+        "radius",
+        1,
+        nc,
+        mesh.faces.iter().map(|f| f.radius),
+    );
+    v.array(
+        Points,
+        "points",
+        3,
+        3 * np,
+        points.iter().flat_map(|a| a.to_array()),
+    );
+    v.array(
+        Cells,
+        "connectivity",
+        1,
+        connectivity.len(),
+        connectivity.into_iter(),
+    );
+    v.array(Cells, "offsets", 1, nc, offsets.into_iter());
+    v.array(Cells, "types", 1, nc, types.into_iter());
+    v.write(path, np, nc)
+}
+
+/// Writes a `.pvd` collection of `(time, file name)` entries.
+pub fn write_collection(path: &Path, entries: &[(f64, String)]) -> Result<()> {
+    let mut text = String::from(
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"1.0\" byte_order=\"LittleEndian\">\n  <Collection>\n",
+    );
+    for (time, file) in entries {
+        text.push_str(&format!(
+            "    <DataSet timestep=\"{time:e}\" part=\"0\" file=\"{file}\"/>\n"
+        ));
+    }
+    text.push_str("  </Collection>\n</VTKFile>\n");
+    atomic_write(path, &[text.as_bytes()])
+}
