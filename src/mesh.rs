@@ -230,15 +230,145 @@ impl Mesh {
         Ok(Mesh { faces, vertices })
     }
 
-    /// Reads an OFF file.
-    pub fn load_off(path: &std::path::Path, radii: &[f64]) -> Result<Mesh> {
+    /// Reads a mesh file: STL (ASCII or binary) if its name ends in `.stl`, else OFF.
+    pub fn load(path: &std::path::Path, radii: &[f64]) -> Result<Mesh> {
         let bytes = std::fs::read(path)
             .map_err(|e| anyhow::anyhow!("cannot read mesh file {}: {e}", path.display()))?;
-        let text = std::str::from_utf8(&bytes).map_err(|_| {
-            anyhow::anyhow!("{}: not a text file, expected an OFF mesh", path.display())
-        })?;
-        Mesh::parse_off(text, &path.display().to_string(), radii)
+        let name = path.display().to_string();
+        let is_stl = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("stl"));
+        if is_stl {
+            return Mesh::parse_stl(&bytes, &name, radii[0]);
+        }
+        let text = std::str::from_utf8(&bytes)
+            .map_err(|_| anyhow::anyhow!("{name}: not a text file, expected an OFF mesh"))?;
+        Mesh::parse_off(text, &name, radii)
     }
+
+    /// Parses an STL file, binary (80-byte header, triangle count, 50 bytes per triangle) or
+    /// ASCII (`solid`, then `facet normal ... outer loop vertex x y z (3x) endloop endfacet`,
+    /// `endsolid`). Every triangle gets the radius `radius` (STL has no per-face data).
+    pub fn parse_stl(bytes: &[u8], file: &str, radius: f64) -> Result<Mesh> {
+        let binary_size = |n: u64| 84 + 50 * n;
+        let looks_binary = bytes.len() >= 84
+            && binary_size(u32::from_le_bytes(bytes[80..84].try_into()?) as u64)
+                == bytes.len() as u64;
+        let triangles = if looks_binary || !bytes.trim_ascii_start().starts_with(b"solid") {
+            stl_binary(bytes, file)?
+        } else {
+            let text = std::str::from_utf8(bytes).map_err(|_| {
+                anyhow::anyhow!("{file}: starts with 'solid' but is neither ASCII STL nor binary STL of the right size")
+            })?;
+            stl_ascii(text, file)?
+        };
+        let mut mesh = Mesh::default();
+        for (k, (v, where_)) in triangles.into_iter().enumerate() {
+            let normal = (v[1] - v[0]).cross(v[2] - v[0]);
+            if normal.length_squared() == 0.0 {
+                bail!("{file}:{where_}: degenerate triangle {k} (its vertices are collinear)");
+            }
+            mesh.vertices.extend_from_slice(&v);
+            mesh.faces.push(Face {
+                shape: Primitive::Triangle {
+                    a: v[0],
+                    b: v[1],
+                    c: v[2],
+                    n: normal.normalize(),
+                },
+                radius,
+            });
+        }
+        Ok(mesh)
+    }
+}
+
+/// Triangles of a binary STL file, each with a description of where it is.
+fn stl_binary(bytes: &[u8], file: &str) -> Result<Vec<([DVec3; 3], String)>> {
+    if bytes.len() < 84 {
+        bail!(
+            "{file}: too short for binary STL ({} bytes, expected at least 84) and not ASCII STL",
+            bytes.len()
+        );
+    }
+    let n = u32::from_le_bytes(bytes[80..84].try_into()?) as u64;
+    if 84 + 50 * n != bytes.len() as u64 {
+        bail!(
+            "{file}: binary STL announces {n} triangles, which take {} bytes, but the file has {} bytes",
+            84 + 50 * n,
+            bytes.len()
+        );
+    }
+    let f = |at: usize| f32::from_le_bytes(bytes[at..at + 4].try_into().expect("4 bytes")) as f64;
+    (0..n as usize)
+        .map(|k| {
+            let base = 84 + 50 * k + 12; // skip the normal
+            let mut v = [DVec3::ZERO; 3];
+            for (i, slot) in v.iter_mut().enumerate() {
+                let at = base + 12 * i;
+                *slot = DVec3::new(f(at), f(at + 4), f(at + 8));
+            }
+            if !v.iter().all(|p| p.is_finite()) {
+                bail!(
+                    "{file}: triangle {k} (byte {}) has a non-finite vertex",
+                    84 + 50 * k
+                );
+            }
+            Ok((v, format!("byte {}", 84 + 50 * k)))
+        })
+        .collect()
+}
+
+/// Triangles of an ASCII STL file, each with its line number.
+fn stl_ascii(text: &str, file: &str) -> Result<Vec<([DVec3; 3], String)>> {
+    let mut out = Vec::new();
+    let mut vertices: Vec<DVec3> = Vec::with_capacity(3);
+    let mut facet_line = 0;
+    let mut ended = false;
+    for (k, line) in text.lines().enumerate() {
+        let n = k + 1;
+        let words: Vec<&str> = line.split_whitespace().collect();
+        match words.first().copied() {
+            None => {}
+            Some("solid") => ended = false, // files may hold several solids
+            Some("facet") => {
+                facet_line = n;
+                vertices.clear();
+            }
+            Some("outer") | Some("endloop") => {}
+            Some("vertex") => {
+                let xyz: Vec<f64> = words[1..].iter().filter_map(|w| w.parse().ok()).collect();
+                if words.len() != 4 || xyz.len() != 3 || xyz.iter().any(|x| !x.is_finite()) {
+                    bail!(
+                        "{file}:{n}: expected 'vertex x y z' with three finite numbers, found '{}'",
+                        line.trim()
+                    );
+                }
+                if vertices.len() == 3 {
+                    bail!("{file}:{n}: a facet has more than three vertices");
+                }
+                vertices.push(DVec3::new(xyz[0], xyz[1], xyz[2]));
+            }
+            Some("endfacet") => {
+                if vertices.len() != 3 {
+                    bail!(
+                        "{file}:{n}: facet of line {facet_line} has {} vertices, expected 3",
+                        vertices.len()
+                    );
+                }
+                out.push((
+                    [vertices[0], vertices[1], vertices[2]],
+                    facet_line.to_string(),
+                ));
+            }
+            Some("endsolid") => ended = true,
+            Some(other) => bail!("{file}:{n}: unexpected '{other}' in ASCII STL"),
+        }
+    }
+    if !ended {
+        bail!("{file}: ASCII STL ends without 'endsolid' (truncated?)");
+    }
+    Ok(out)
 }
 
 /// Checks that four vertices, in order around the face, form a rectangle.

@@ -105,7 +105,7 @@ impl Simulation {
         let radii = &scenario.geometry.mesh_radii;
         let mesh = match &scenario.geometry.mesh {
             MeshSource::None => Mesh::default(),
-            MeshSource::File(path) => Mesh::load_off(path, radii)?,
+            MeshSource::File(path) => Mesh::load(path, radii)?,
             MeshSource::Embedded { name, text } => Mesh::parse_off(text, name, radii)?,
         };
         let particles = match &scenario.particles {

@@ -1,4 +1,4 @@
-//! The corpus of bad input files in `tests/bad_inputs/{off,csv}`: each `NAME.ext` must make
+//! The corpus of bad input files in `tests/bad_inputs/{off,stl,csv}`: each `NAME.ext` must make
 //! `tinydem run` exit non-zero, without panicking, with a message naming the file and
 //! containing the text in `NAME.expected`. (Bad scenario files are in `tests/scenarios/bad`.)
 
@@ -57,6 +57,16 @@ fn check(kind: &str, scenario: impl Fn(&Path) -> String) {
 #[test]
 fn bad_meshes() {
     check("off", |f| {
+        format!(
+            "[geometry]\nmesh = \"{}\"\nmesh_radii = [0.0]\n",
+            f.display()
+        )
+    });
+}
+
+#[test]
+fn bad_stl_meshes() {
+    check("stl", |f| {
         format!(
             "[geometry]\nmesh = \"{}\"\nmesh_radii = [0.0]\n",
             f.display()

@@ -24,6 +24,7 @@ fn config() -> ProptestConfig {
 
 const OFF: &str = "OFF\n# box\n8 6 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n\
                    4 0 1 2 3 0\n3 4 5 6 1\n2 0 4\n1 7 1\n4 0 1 5 4\n3 2 3 7\n";
+const STL: &str = "solid t\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n   vertex 0 1 0\n  endloop\n endfacet\nendsolid t\n";
 const CSV: &str = "x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz\n0,0,0.1,0.005,0,0,-1,1,0,0,0,0,0,0\n\
                    1e-3,-2.5e-2,3,0.004,1,2,3,0.5,0.5,0.5,0.5,-1,0,1e2\n";
 const TOML: &str = "[geometry]\nradius_min = 0.004\nradius_max = 0.006\nmesh_radii = [0.0, 0.001]\n\
@@ -104,6 +105,23 @@ proptest! {
     fn off_reader_survives_mutations(bytes in mutate(OFF), t in tokens(OFF)) {
         let _ = Mesh::parse_off(&text(&bytes), "fuzz.off", &[0.0, 0.1]);
         let _ = Mesh::parse_off(&t, "fuzz.off", &[0.0, 0.1]);
+    }
+
+    #[test]
+    fn stl_reader_never_panics(bytes in prop::collection::vec(any::<u8>(), 0..400), ascii in mutate(STL)) {
+        let _ = Mesh::parse_stl(&bytes, "fuzz.stl", 0.0);
+        let _ = Mesh::parse_stl(&ascii, "fuzz.stl", 0.0);
+        // Binary: a valid file with flipped bytes.
+        let mut b = vec![0u8; 80];
+        b.extend_from_slice(&2u32.to_le_bytes());
+        for k in 0..100u8 {
+            b.push(k.wrapping_mul(37));
+        }
+        for (i, x) in bytes.iter().take(8).enumerate() {
+            let at = (*x as usize * 7 + i) % b.len();
+            b[at] ^= x;
+        }
+        let _ = Mesh::parse_stl(&b, "fuzz.stl", 0.0);
     }
 
     #[test]
