@@ -21,6 +21,7 @@
 
 use glam::DVec3;
 
+use crate::motion::RigidVelocity;
 use crate::scenario::Material;
 
 /// Displacements of the three static friction springs of one contact (Table 3):
@@ -118,10 +119,16 @@ impl Kinematics {
         })
     }
 
-    /// The contact of particle `i` with a resting mesh face of radius `face_radius`, whose
-    /// closest point lies at `d` = x_i - p from the centre, or `None` if they do not overlap.
+    /// The contact of particle `i` with a mesh face of radius `face_radius`, whose closest
+    /// point lies at `d` = x_i - p from the centre and which moves with the rigid velocity
+    /// field `wall` (zero for a static mesh), or `None` if they do not overlap.
     #[inline]
-    pub fn with_wall(i: &Body, d: DVec3, face_radius: f64) -> Option<Kinematics> {
+    pub fn with_wall(
+        i: &Body,
+        d: DVec3,
+        face_radius: f64,
+        wall: &RigidVelocity,
+    ) -> Option<Kinematics> {
         let reach = i.radius + face_radius;
         let dist2 = d.length_squared();
         if dist2 >= reach * reach {
@@ -131,13 +138,15 @@ impl Kinematics {
         let delta = reach - dist; // Eq. (7)
         let n = unit(d, dist); // Eq. (9)
         let r_i = i.radius - delta / 2.0; // Eq. (29)
+        let contact_point = i.x - r_i * n;
         Some(Kinematics {
             n,
             delta,
             r_i,
             r_j: f64::INFINITY,
-            v: i.v + n.cross(r_i * i.w), // Eq. (26) with the wall at rest
-            omega: i.w,
+            // Eq. (26) with the wall's material velocity at the contact point for v_j.
+            v: i.v + n.cross(r_i * i.w) - wall.at(contact_point),
+            omega: i.w - wall.omega, // Eq. (38)
         })
     }
 }

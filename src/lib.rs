@@ -10,6 +10,7 @@ pub mod csv;
 pub mod geometry;
 pub mod integrate;
 pub mod mesh;
+pub mod motion;
 pub mod neighbours;
 pub mod particles;
 pub mod run;

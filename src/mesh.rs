@@ -5,6 +5,7 @@ use anyhow::{Result, bail};
 use glam::DVec3;
 
 use crate::geometry::{closest_on_segment, separation_from_rectangle, separation_from_triangle};
+use crate::motion::Pose;
 
 /// The shape of one mesh face (Fig. 4A-D).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -51,6 +52,41 @@ impl Face {
     /// Closest point of the (undilated) primitive to `x`.
     pub fn closest_point(&self, x: DVec3) -> DVec3 {
         x - self.separation(x)
+    }
+
+    /// The face moved rigidly to `pose`.
+    pub fn moved(&self, pose: &Pose) -> Face {
+        let (p, v) = (|x| pose.point(x), |x| pose.vector(x));
+        let shape = match self.shape {
+            Primitive::Point(a) => Primitive::Point(p(a)),
+            Primitive::Segment(a, b) => Primitive::Segment(p(a), p(b)),
+            Primitive::Triangle { a, b, c, n } => Primitive::Triangle {
+                a: p(a),
+                b: p(b),
+                c: p(c),
+                n: v(n),
+            },
+            Primitive::Rectangle { o, e1, e2, n } => Primitive::Rectangle {
+                o: p(o),
+                e1: v(e1),
+                e2: v(e2),
+                n: v(n),
+            },
+        };
+        Face {
+            shape,
+            radius: self.radius,
+        }
+    }
+
+    /// The corner points of the primitive.
+    pub fn corners(&self) -> Vec<DVec3> {
+        match self.shape {
+            Primitive::Point(a) => vec![a],
+            Primitive::Segment(a, b) => vec![a, b],
+            Primitive::Triangle { a, b, c, .. } => vec![a, b, c],
+            Primitive::Rectangle { o, e1, e2, .. } => vec![o, o + e1, o + e1 + e2, o + e2],
+        }
     }
 
     /// Axis-aligned bounding box of the dilated face.

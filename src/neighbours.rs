@@ -264,13 +264,14 @@ impl Neighbours {
         }
     }
 
-    /// Whether the lists must be rebuilt: the particle count changed or some particle
-    /// moved more than half the skin since the last rebuild.
-    pub fn stale(&self, x: &[DVec3]) -> bool {
-        if x.len() != self.x_at_build.len() {
+    /// Whether the lists must be rebuilt: the particle count changed, or some particle moved
+    /// more than half the skin, less `mesh_drift` (how far a moving face has moved), since
+    /// the last rebuild.
+    pub fn stale(&self, x: &[DVec3], mesh_drift: f64) -> bool {
+        if x.len() != self.x_at_build.len() || mesh_drift >= 0.5 * self.skin {
             return true;
         }
-        let limit = (0.5 * self.skin).powi(2);
+        let limit = (0.5 * self.skin - mesh_drift).powi(2);
         x.par_iter()
             .zip(self.x_at_build.par_iter())
             .with_min_len(4 * MIN_PARALLEL_LEN)

@@ -85,7 +85,7 @@ struct Frames<'a> {
 impl Frames<'_> {
     /// Files that do not change during the run (the static mesh).
     fn start(&self, sim: &Simulation) -> Result<()> {
-        if self.formats.vtk {
+        if self.formats.vtk && !sim.mesh_moves() {
             crate::vtk::write_mesh(&self.dir.join("mesh.vtu"), &sim.mesh)?;
         }
         Ok(())
@@ -102,6 +102,13 @@ impl Frames<'_> {
                 .map(|f| (f as f64 * self.frame_time, format!("particles{f:06}.vtu")))
                 .collect();
             crate::vtk::write_collection(&self.dir.join("particles.pvd"), &entries)?;
+            if sim.mesh_moves() {
+                crate::vtk::write_mesh(&self.dir.join(format!("mesh{k:06}.vtu")), &sim.mesh)?;
+                let entries: Vec<(f64, String)> = (0..=k)
+                    .map(|f| (f as f64 * self.frame_time, format!("mesh{f:06}.vtu")))
+                    .collect();
+                crate::vtk::write_collection(&self.dir.join("mesh.pvd"), &entries)?;
+            }
         }
         Ok(())
     }
@@ -251,7 +258,7 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
 
 /// The fingerprint of a simulation's scenario and mesh, for checkpoints.
 fn fingerprint(sim: &Simulation) -> u64 {
-    checkpoint::fingerprint(&sim.scenario, &sim.mesh)
+    checkpoint::fingerprint(&sim.scenario, &sim.rest_mesh())
 }
 
 /// The derived quantities `tinydem check` prints.

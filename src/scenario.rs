@@ -7,6 +7,9 @@
 //!              friction_rolling, friction_twisting, viscosity
 //! [kinetics]   initial_velocity, initial_angular_velocity, gravity
 //! [simulation] timestep, max_particles, frames, steps_per_frame, spawn_attempts, seed
+//! [[meshes]]   file, radii, motion = { type = "harmonic", amplitude, frequency, direction,
+//!              phase } | { type = "velocity", velocity } | { type = "rotation", center, axis,
+//!              angular_velocity }   (any number of these)
 //! [input]      particles
 //! [output]     dir, checkpoint_every, formats
 //! ```
@@ -18,6 +21,8 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 use glam::DVec3;
 use serde::Deserialize;
+
+use crate::motion::Motion;
 
 /// The geometry of the paper's default hourglass (Fig. 5A), embedded so that `tinydem`
 /// runs with no files.
@@ -93,6 +98,15 @@ pub struct Simulation {
     pub seed: u64,
 }
 
+/// One mesh file with its radii and, optionally, a prescribed motion (`[[meshes]]`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshSpec {
+    pub file: PathBuf,
+    /// R_mesh of this file's faces, picked by the OFF colour index (STL: the first).
+    pub radii: Vec<f64>,
+    pub motion: Option<Motion>,
+}
+
 /// A complete, validated scenario.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scenario {
@@ -100,6 +114,8 @@ pub struct Scenario {
     pub material: Material,
     pub kinetics: Kinetics,
     pub simulation: Simulation,
+    /// Further meshes, each with its own radii and motion (`[[meshes]]`).
+    pub meshes: Vec<MeshSpec>,
     /// Initial particles (CSV), if any.
     pub particles: Option<PathBuf>,
     /// Output directory.
@@ -155,9 +171,38 @@ pub fn default_timestep(radius_min: f64, material: &Material) -> f64 {
 
 // ---- The file format: every key optional, unknown keys rejected. -------------------
 
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawMesh {
+    file: PathBuf,
+    radii: Option<Vec<f64>>,
+    motion: Option<RawMotion>,
+}
+
+#[derive(Deserialize)]
+#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
+enum RawMotion {
+    Harmonic {
+        amplitude: f64,
+        frequency: f64,
+        direction: [f64; 3],
+        phase: Option<f64>,
+    },
+    Velocity {
+        velocity: [f64; 3],
+    },
+    Rotation {
+        center: [f64; 3],
+        axis: [f64; 3],
+        angular_velocity: f64,
+    },
+}
+
 #[derive(Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 struct RawScenario {
+    #[serde(default)]
+    meshes: Vec<RawMesh>,
     #[serde(default)]
     geometry: RawGeometry,
     #[serde(default)]
@@ -280,6 +325,60 @@ fn check_vec(key: &str, v: [f64; 3]) -> Result<DVec3> {
         check(&format!("{key}.{c}"), x, Range::Finite)?;
     }
     Ok(DVec3::from_array(v))
+}
+
+/// Validates one `[[meshes]]` entry.
+fn mesh_spec(k: usize, m: RawMesh, base: &Path) -> Result<MeshSpec> {
+    let key = |name: &str| format!("[[meshes]] #{} {name}", k + 1);
+    let radii = m.radii.unwrap_or_else(|| vec![0.0]);
+    if radii.is_empty() {
+        bail!("{} must hold at least one radius", key("radii"));
+    }
+    for (i, &r) in radii.iter().enumerate() {
+        check(&key(&format!("radii[{i}]")), r, Range::NonNegative)?;
+    }
+    let unit = |name: &str, v: [f64; 3]| -> Result<DVec3> {
+        let v = check_vec(&key(name), v)?;
+        if v.length_squared() == 0.0 {
+            bail!("{} must not be the zero vector", key(name));
+        }
+        Ok(v.normalize())
+    };
+    let motion = match m.motion {
+        None => None,
+        Some(RawMotion::Harmonic {
+            amplitude,
+            frequency,
+            direction,
+            phase,
+        }) => Some(Motion::Harmonic {
+            amplitude: check(&key("motion.amplitude"), amplitude, Range::NonNegative)?,
+            frequency: check(&key("motion.frequency"), frequency, Range::NonNegative)?,
+            direction: unit("motion.direction", direction)?,
+            phase: check(&key("motion.phase"), phase.unwrap_or(0.0), Range::Finite)?,
+        }),
+        Some(RawMotion::Velocity { velocity }) => Some(Motion::Velocity {
+            velocity: check_vec(&key("motion.velocity"), velocity)?,
+        }),
+        Some(RawMotion::Rotation {
+            center,
+            axis,
+            angular_velocity,
+        }) => Some(Motion::Rotation {
+            center: check_vec(&key("motion.center"), center)?,
+            axis: unit("motion.axis", axis)?,
+            angular_velocity: check(
+                &key("motion.angular_velocity"),
+                angular_velocity,
+                Range::Finite,
+            )?,
+        }),
+    };
+    Ok(MeshSpec {
+        file: base.join(m.file),
+        radii,
+        motion,
+    })
 }
 
 impl Default for Scenario {
@@ -444,11 +543,19 @@ impl Scenario {
             );
         }
 
+        let meshes = raw
+            .meshes
+            .into_iter()
+            .enumerate()
+            .map(|(k, m)| mesh_spec(k, m, base))
+            .collect::<Result<Vec<_>>>()?;
+
         Ok(Scenario {
             geometry,
             material,
             kinetics,
             simulation,
+            meshes,
             particles: raw.input.particles.map(|p| base.join(p)),
             output_dir: raw
                 .output

@@ -1,7 +1,8 @@
 //! The simulation: state and the time step as named stages.
 //!
 //! ```text
-//! step:  spawn -> update neighbours -> particle contacts -> mesh contacts -> integrate
+//! step:  move meshes -> spawn -> update neighbours -> particle contacts -> mesh contacts
+//!        -> integrate -> check stability
 //! ```
 
 use std::sync::Mutex;
@@ -12,7 +13,8 @@ use rayon::prelude::*;
 
 use crate::contact::{Body, ContactForce, ContactLaw, Kinematics, Other, Springs};
 use crate::integrate::{Inertia, State, advance};
-use crate::mesh::Mesh;
+use crate::mesh::{Face, Mesh};
+use crate::motion::{Motion, Pose, RigidVelocity};
 use crate::neighbours::{CellGrid, MIN_PARALLEL_LEN, Neighbours, face_grid};
 use crate::particles::Particles;
 use crate::scenario::{MeshSource, Scenario, default_timestep};
@@ -82,6 +84,22 @@ impl std::fmt::Display for Unstable {
 
 impl std::error::Error for Unstable {}
 
+/// `face_part` of a face that does not move.
+const STATIC: u32 = u32::MAX;
+
+/// A mesh file whose faces follow a prescribed motion.
+#[derive(Clone, Debug)]
+struct MovingPart {
+    faces: std::ops::Range<usize>,
+    motion: Motion,
+    /// Velocity field at the current time.
+    velocity: RigidVelocity,
+    /// Corners of its faces at rest, to measure how far they moved.
+    corners: Vec<DVec3>,
+    /// Pose at the last neighbour-list rebuild.
+    pose_at_build: Pose,
+}
+
 /// A running simulation.
 pub struct Simulation {
     pub scenario: Scenario,
@@ -94,6 +112,14 @@ pub struct Simulation {
     /// Force of each particle pair slot and each particle-face slot, this step.
     pair_forces: Vec<ContactForce>,
     face_forces: Vec<ContactForce>,
+    /// The mesh as read (at t = 0).
+    rest_faces: Vec<Face>,
+    /// Parts of the mesh that follow a prescribed motion.
+    moving: Vec<MovingPart>,
+    /// For each face, its moving part, or `STATIC`.
+    face_part: Vec<u32>,
+    /// Largest displacement of a moving face since the last neighbour-list rebuild.
+    mesh_drift: f64,
     /// Simulated time [T] and number of steps taken.
     pub time: f64,
     pub steps: u64,
@@ -103,16 +129,44 @@ impl Simulation {
     /// Sets up a simulation: reads the mesh and the initial particles.
     pub fn new(scenario: Scenario) -> Result<Simulation> {
         let radii = &scenario.geometry.mesh_radii;
-        let mesh = match &scenario.geometry.mesh {
+        let mut mesh = match &scenario.geometry.mesh {
             MeshSource::None => Mesh::default(),
             MeshSource::File(path) => Mesh::load(path, radii)?,
             MeshSource::Embedded { name, text } => Mesh::parse_off(text, name, radii)?,
         };
+        let mut moving = Vec::new();
+        for spec in &scenario.meshes {
+            let part = Mesh::load(&spec.file, &spec.radii)?;
+            let faces = mesh.faces.len()..mesh.faces.len() + part.faces.len();
+            if let Some(motion) = spec.motion {
+                moving.push((faces, motion));
+            }
+            mesh.faces.extend(part.faces);
+            mesh.vertices.extend(part.vertices);
+        }
         let particles = match &scenario.particles {
             Some(path) => crate::csv::load_particles(path)?,
             None => Particles::default(),
         };
-        Simulation::from_parts(scenario, mesh, particles)
+        let mut sim = Simulation::from_parts(scenario, mesh, particles)?;
+        for (faces, motion) in moving {
+            for f in faces.clone() {
+                sim.face_part[f] = sim.moving.len() as u32;
+            }
+            let corners = sim.rest_faces[faces.clone()]
+                .iter()
+                .flat_map(Face::corners)
+                .collect();
+            sim.moving.push(MovingPart {
+                faces,
+                motion,
+                velocity: RigidVelocity::default(),
+                corners,
+                pose_at_build: Pose::REST,
+            });
+        }
+        sim.move_meshes();
+        Ok(sim)
     }
 
     /// Continues a run from a snapshot taken by [`Simulation::snapshot`] with the same
@@ -126,6 +180,7 @@ impl Simulation {
         sim.steps = snapshot.steps;
         sim.time = sim.steps as f64 * sim.scenario.simulation.timestep;
         sim.spawner = Spawner::resume(sim.scenario.simulation.seed, snapshot.spawner);
+        sim.move_meshes();
         let max_radius = sim
             .scenario
             .geometry
@@ -135,6 +190,7 @@ impl Simulation {
         let p = &sim.particles;
         sim.neighbours
             .rebuild(&p.x, &p.radius, &sim.mesh.faces, &sim.face_grid);
+        sim.mark_mesh_built();
         sim.neighbours
             .pairs
             .restore(&snapshot.pair_history)
@@ -170,6 +226,10 @@ impl Simulation {
             spawner: Spawner::new(scenario.simulation.seed),
             pair_forces: Vec::new(),
             face_forces: Vec::new(),
+            rest_faces: mesh.faces.clone(),
+            moving: Vec::new(),
+            face_part: vec![STATIC; mesh.faces.len()],
+            mesh_drift: 0.0,
             time: 0.0,
             steps: 0,
             scenario,
@@ -200,6 +260,7 @@ impl Simulation {
     /// Fails, leaving the state as computed, when the run has become unstable: an overlap
     /// deeper than the smaller radius, or a non-finite position or velocity.
     pub fn step(&mut self) -> Result<(), Unstable> {
+        self.move_meshes();
         self.spawn();
         self.update_neighbours();
         let mut deep = self.particle_contacts();
@@ -272,6 +333,45 @@ impl Simulation {
         }
     }
 
+    /// Stage 0: moving mesh parts to their pose at the current time, with their velocity.
+    fn move_meshes(&mut self) {
+        let t = self.time;
+        let mut drift: f64 = 0.0;
+        for part in &mut self.moving {
+            let pose = part.motion.pose(t);
+            for f in part.faces.clone() {
+                self.mesh.faces[f] = self.rest_faces[f].moved(&pose);
+            }
+            part.velocity = part.motion.velocity(t);
+            for &c in &part.corners {
+                drift = drift.max(pose.point(c).distance(part.pose_at_build.point(c)));
+            }
+        }
+        self.mesh_drift = drift;
+    }
+
+    /// Records the mesh pose at a neighbour-list rebuild, and re-bins moved faces.
+    fn mark_mesh_built(&mut self) {
+        let t = self.time;
+        for part in &mut self.moving {
+            part.pose_at_build = part.motion.pose(t);
+        }
+        self.mesh_drift = 0.0;
+    }
+
+    /// The rest geometry of the mesh (for checkpoint fingerprints).
+    pub fn rest_mesh(&self) -> Mesh {
+        Mesh {
+            faces: self.rest_faces.clone(),
+            vertices: self.mesh.vertices.clone(),
+        }
+    }
+
+    /// Whether some part of the mesh moves.
+    pub fn mesh_moves(&self) -> bool {
+        !self.moving.is_empty()
+    }
+
     /// Stage 1 (Section 3.1): new particles in the spawn box.
     fn spawn(&mut self) {
         let s = &self.scenario;
@@ -283,11 +383,18 @@ impl Simulation {
 
     /// Stage 2 (Section 3.3): rebuild the Verlet lists when they may miss a contact.
     fn update_neighbours(&mut self) {
-        let p = &self.particles;
-        if self.neighbours.stale(&p.x) {
-            self.neighbours
-                .rebuild(&p.x, &p.radius, &self.mesh.faces, &self.face_grid);
+        if !self.neighbours.stale(&self.particles.x, self.mesh_drift) {
+            return;
         }
+        if !self.moving.is_empty() {
+            let g = &self.scenario.geometry;
+            let max_radius = g.radius_max.max(self.particles.max_radius());
+            self.face_grid = face_grid(&self.mesh.faces, max_radius, self.neighbours.skin);
+        }
+        let p = &self.particles;
+        self.neighbours
+            .rebuild(&p.x, &p.radius, &self.mesh.faces, &self.face_grid);
+        self.mark_mesh_built();
     }
 
     /// Stage 3 (Section 2.2): the force of every touching particle pair, once per pair.
@@ -347,6 +454,7 @@ impl Simulation {
         let p = &self.particles;
         let law = &self.law;
         let faces = &self.mesh.faces;
+        let (face_part, moving) = (&self.face_part, &self.moving);
         let density = self.scenario.material.density;
         let list = &mut self.neighbours.faces;
         self.face_forces
@@ -366,7 +474,11 @@ impl Simulation {
                     w: p.w[i],
                 };
                 let d = face.separation(body.x);
-                *force = match Kinematics::with_wall(&body, d, face.radius) {
+                let wall = match face_part[f as usize] {
+                    STATIC => RigidVelocity::default(),
+                    k => moving[k as usize].velocity,
+                };
+                *force = match Kinematics::with_wall(&body, d, face.radius, &wall) {
                     Some(kin) => {
                         if kin.delta > p.radius[i] {
                             deep.lock().expect("not poisoned").push(Deep {

@@ -249,3 +249,46 @@ fn killed_run_leaves_only_complete_files() {
     }
     assert!(count >= 4);
 }
+
+#[test]
+fn finished_run_with_a_moving_mesh_extends_from_its_checkpoint_bit_for_bit() {
+    let scenario = |frames: u64| {
+        format!(
+            "[geometry]\nradius_min = 0.003\nradius_max = 0.005\nmesh = \"box.off\"\nmesh_radii = [0.0]\n\
+             spawn_min = [-0.02, -0.02, 0.05]\nspawn_max = [0.02, 0.02, 0.15]\n\
+             [simulation]\nmax_particles = 200\nspawn_attempts = 3\nframes = {frames}\nsteps_per_frame = 1500\n\
+             [[meshes]]\nfile = \"plate.off\"\n\
+             motion = {{ type = \"harmonic\", amplitude = 0.002, frequency = 15.0, direction = [0.0, 0.0, 1.0] }}\n\
+             [output]\ncheckpoint_every = 2\n"
+        )
+    };
+    let plate = "OFF\n4 1 0\n-0.03 -0.03 0.01\n0.03 -0.03 0.01\n0.03 0.03 0.01\n-0.03 0.03 0.01\n4 0 1 2 3\n";
+    let (a, b) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    for dir in [a.path(), b.path()] {
+        pile(dir, 1); // writes box.off
+        std::fs::write(dir.join("plate.off"), plate).unwrap();
+    }
+    std::fs::write(a.path().join("s.toml"), scenario(8)).unwrap();
+    let o = tinydem(&["run", "s.toml", "-q"], a.path());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+
+    std::fs::write(b.path().join("s.toml"), scenario(4)).unwrap();
+    let o = tinydem(&["run", "s.toml", "-q"], b.path());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    std::fs::write(b.path().join("s.toml"), scenario(8)).unwrap();
+    let o = tinydem(
+        &["run", "s.toml", "-q", "--resume", "output/checkpoint.bin"],
+        b.path(),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+
+    let (x, y) = (
+        frames_of(&a.path().join("output")),
+        frames_of(&b.path().join("output")),
+    );
+    assert_eq!(x.len(), 9);
+    assert_eq!(x.len(), y.len());
+    for ((name, p), (_, q)) in x.iter().zip(&y) {
+        assert!(p == q, "{name} differs after extending the run");
+    }
+}
