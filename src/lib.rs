@@ -13,6 +13,7 @@ pub mod mesh;
 pub mod motion;
 pub mod neighbours;
 pub mod particles;
+pub mod render;
 pub mod run;
 pub mod scenario;
 pub mod simulation;

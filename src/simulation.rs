@@ -367,6 +367,15 @@ impl Simulation {
         }
     }
 
+    /// The mesh as it is at time `t` (for pictures of frames).
+    pub fn mesh_at(&mut self, t: f64) -> &Mesh {
+        let now = self.time;
+        self.time = t;
+        self.move_meshes();
+        self.time = now;
+        &self.mesh
+    }
+
     /// Whether some part of the mesh moves.
     pub fn mesh_moves(&self) -> bool {
         !self.moving.is_empty()

@@ -296,3 +296,63 @@ fn bench_runs_a_small_configuration() {
         &["no packing for N = 1234"],
     );
 }
+
+#[test]
+fn render_draws_frames_and_directories() {
+    let t = tempfile::tempdir().unwrap();
+    let frames = hourglass_frames("2", t.path());
+    assert!(frames.len() == 5);
+    let mesh = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/hourglass.off");
+    let o = tinydem(
+        &[
+            "render",
+            "out/particles000004.csv",
+            "--mesh",
+            mesh.to_str().unwrap(),
+            "-o",
+            "f.png",
+            "--width",
+            "320",
+            "--height",
+            "200",
+        ],
+        t.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let img = image::open(t.path().join("f.png")).unwrap().to_rgb8();
+    assert_eq!(img.dimensions(), (320, 200));
+    let drawn = img.pixels().filter(|p| p.0 != [255, 255, 255]).count();
+    assert!(drawn > 320 * 200 / 50, "only {drawn} pixels drawn");
+    // A directory: one PNG per frame and an animation; the scenario supplies the mesh.
+    let o = tinydem(
+        &[
+            "render",
+            "out",
+            "--scenario",
+            "s.toml",
+            "--gif",
+            "--width",
+            "64",
+            "--height",
+            "48",
+        ],
+        t.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    for k in 0..=4 {
+        assert!(t.path().join(format!("out/particles{k:06}.png")).exists());
+    }
+    let gif = std::fs::read(t.path().join("out/animation.gif")).unwrap();
+    assert!(gif.starts_with(b"GIF89a"));
+    fails_with(
+        &tinydem(&["render", "nope.csv"], t.path()),
+        &["cannot read particle file nope.csv"],
+    );
+    fails_with(
+        &tinydem(
+            &["render", "out/particles000004.csv", "--width", "0"],
+            t.path(),
+        ),
+        &["picture size 0x600"],
+    );
+}
