@@ -196,8 +196,8 @@ pub fn render(p: &Particles, mesh: &Mesh, style: &Style) -> Result<RgbImage> {
             }
         }
     };
-    for k in 0..p.len() {
-        sphere(p.x[k], p.radius[k], colormap(norm(values[k])));
+    for ((x, r), v) in p.x.iter().zip(&p.radius).zip(&values) {
+        sphere(*x, *r, colormap(norm(*v)));
     }
     for (c, r) in balls {
         sphere(c, r, DVec3::splat(0.75));
