@@ -3,6 +3,7 @@
 //! contact, sliding, rolling and twisting friction, quaternion orientations and static
 //! meshes. See `ARCHITECTURE.md` for a map of the code.
 
+pub mod analyze;
 pub mod bench;
 pub mod checkpoint;
 pub mod contact;

@@ -45,6 +45,24 @@ enum Command {
     },
     /// Validate a scenario and print derived quantities.
     Check { scenario: PathBuf },
+    /// Measure every frame of an output directory: kinetic energy, coordination number,
+    /// packing fraction; optionally the angle of repose and the height of large particles.
+    Analyze {
+        /// Output directory with frames particlesNNNNNN.csv.
+        dir: PathBuf,
+        /// The run's scenario, for frame times and the density.
+        #[arg(long)]
+        scenario: Option<PathBuf>,
+        /// Fit the angle of repose of a pile in the x-z plane (both flanks).
+        #[arg(long)]
+        repose: bool,
+        /// Report the mean height of the particles with at least this radius.
+        #[arg(long)]
+        large: Option<f64>,
+        /// Also write the table as CSV to this file.
+        #[arg(long)]
+        csv: Option<PathBuf>,
+    },
     /// Draw a frame (CSV) as a PNG picture, or every frame of an output directory.
     Render {
         /// A frame `particlesNNNNNN.csv`, or an output directory.
@@ -213,6 +231,13 @@ fn execute(command: Option<Command>, resume_default: Option<PathBuf>) -> Result<
             };
             render_command(&path, output, scenario, &mesh, &style, gif)?;
         }
+        Some(Command::Analyze {
+            dir,
+            scenario,
+            repose,
+            large,
+            csv,
+        }) => analyze_command(&dir, scenario, repose, large, csv)?,
         Some(Command::Check { scenario }) => {
             let s = Scenario::load(&scenario)?;
             print!("{}", describe(&s)?);
@@ -362,6 +387,68 @@ fn render_command(
         let png = output.unwrap_or_else(|| path.with_extension("png"));
         draw(path, &png)?;
         eprintln!("picture in {}", png.display());
+    }
+    Ok(())
+}
+
+/// `tinydem analyze`: a table of measurements, one row per frame.
+fn analyze_command(
+    dir: &std::path::Path,
+    scenario: Option<PathBuf>,
+    repose: bool,
+    large: Option<f64>,
+    csv: Option<PathBuf>,
+) -> Result<()> {
+    use tinydem::analyze::*;
+    let s = match scenario {
+        Some(p) => Scenario::load(&p)?,
+        None => Scenario::parse("", std::path::Path::new("defaults"))?,
+    };
+    let frame_time = s.simulation.steps_per_frame as f64 * s.simulation.timestep;
+    let mut frames: Vec<(u64, PathBuf)> = std::fs::read_dir(dir)
+        .with_context(|| format!("cannot read directory {}", dir.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter_map(|p| {
+            let k = p.file_name()?.to_str()?.strip_prefix("particles")?.strip_suffix(".csv")?.parse().ok()?;
+            Some((k, p))
+        })
+        .collect();
+    frames.sort();
+    anyhow::ensure!(!frames.is_empty(), "{}: no frames particlesNNNNNN.csv", dir.display());
+    let mut header = vec!["frame", "time", "particles", "kinetic_energy", "coordination", "packing_fraction"];
+    if repose {
+        header.extend(["repose_left_deg", "repose_right_deg"]);
+    }
+    if large.is_some() {
+        header.push("large_mean_height");
+    }
+    let mut rows = Vec::new();
+    println!("{}", header.iter().map(|h| format!("{h:>17}")).collect::<String>());
+    for (k, path) in frames {
+        let p = tinydem::csv::load_particles(&path)?;
+        let mut row = vec![
+            k.to_string(),
+            format!("{:.6e}", k as f64 * frame_time),
+            p.len().to_string(),
+            format!("{:.6e}", kinetic_energy(&p, s.material.density)),
+            format!("{:.4}", coordination_number(&p)),
+            format!("{:.4}", packing_fraction(&p)),
+        ];
+        if repose {
+            match angle_of_repose(&p) {
+                Some((l, r)) => row.extend([format!("{l:.2}"), format!("{r:.2}")]),
+                None => row.extend(["nan".into(), "nan".into()]),
+            }
+        }
+        if let Some(r) = large {
+            row.push(mean_height_of_large(&p, r).map_or("nan".into(), |z| format!("{z:.6e}")));
+        }
+        println!("{}", row.iter().map(|v| format!("{v:>17}")).collect::<String>());
+        rows.push(row.join(","));
+    }
+    if let Some(path) = csv {
+        std::fs::write(&path, format!("{}\n{}\n", header.join(","), rows.join("\n")))
+            .with_context(|| format!("cannot write {}", path.display()))?;
     }
     Ok(())
 }
