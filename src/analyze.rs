@@ -42,8 +42,16 @@ pub fn packing_fraction(p: &Particles) -> f64 {
         return 0.0;
     }
     let margin = DVec3::splat(2.0 * p.max_radius());
-    let lo = p.x.iter().copied().fold(DVec3::splat(f64::INFINITY), DVec3::min) + margin;
-    let hi = p.x.iter().copied().fold(DVec3::splat(f64::NEG_INFINITY), DVec3::max) - margin;
+    let lo =
+        p.x.iter()
+            .copied()
+            .fold(DVec3::splat(f64::INFINITY), DVec3::min)
+            + margin;
+    let hi =
+        p.x.iter()
+            .copied()
+            .fold(DVec3::splat(f64::NEG_INFINITY), DVec3::max)
+            - margin;
     let size = hi - lo;
     // A flat (2D) box: use the full extent in that direction instead.
     if size.min_element() <= 0.0 {
@@ -68,7 +76,11 @@ pub fn angle_of_repose(p: &Particles) -> Option<(f64, f64)> {
     let r_mean = p.radius.iter().sum::<f64>() / p.len() as f64;
     let w = 4.0 * r_mean;
     let floor = p.x.iter().map(|x| x.z).fold(f64::INFINITY, f64::min) - r_mean;
-    let (xmin, xmax) = p.x.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(x.x), b.max(x.x)));
+    let (xmin, xmax) =
+        p.x.iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+                (a.min(x.x), b.max(x.x))
+            });
     let nbins = (((xmax - xmin) / w).ceil() as usize).max(1);
     let mut top = vec![f64::NEG_INFINITY; nbins];
     for (x, r) in p.x.iter().zip(&p.radius) {
@@ -97,7 +109,10 @@ pub fn angle_of_repose(p: &Particles) -> Option<(f64, f64)> {
 
 /// Mean height of the particles with radius at least `r` (None if there are none).
 pub fn mean_height_of_large(p: &Particles, r: f64) -> Option<f64> {
-    let z: Vec<f64> = (0..p.len()).filter(|&k| p.radius[k] >= r).map(|k| p.x[k].z).collect();
+    let z: Vec<f64> = (0..p.len())
+        .filter(|&k| p.radius[k] >= r)
+        .map(|k| p.x[k].z)
+        .collect();
     (!z.is_empty()).then(|| z.iter().sum::<f64>() / z.len() as f64)
 }
 
@@ -134,7 +149,10 @@ mod tests {
             x += 2.0 * r;
         }
         let (left, right) = angle_of_repose(&p).unwrap();
-        assert!((left - 40.0).abs() < 1.5 && (right - 50.0).abs() < 1.5, "{left} {right}");
+        assert!(
+            (left - 40.0).abs() < 1.5 && (right - 50.0).abs() < 1.5,
+            "{left} {right}"
+        );
     }
 
     #[test]

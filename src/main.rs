@@ -409,13 +409,30 @@ fn analyze_command(
         .with_context(|| format!("cannot read directory {}", dir.display()))?
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter_map(|p| {
-            let k = p.file_name()?.to_str()?.strip_prefix("particles")?.strip_suffix(".csv")?.parse().ok()?;
+            let k = p
+                .file_name()?
+                .to_str()?
+                .strip_prefix("particles")?
+                .strip_suffix(".csv")?
+                .parse()
+                .ok()?;
             Some((k, p))
         })
         .collect();
     frames.sort();
-    anyhow::ensure!(!frames.is_empty(), "{}: no frames particlesNNNNNN.csv", dir.display());
-    let mut header = vec!["frame", "time", "particles", "kinetic_energy", "coordination", "packing_fraction"];
+    anyhow::ensure!(
+        !frames.is_empty(),
+        "{}: no frames particlesNNNNNN.csv",
+        dir.display()
+    );
+    let mut header = vec![
+        "frame",
+        "time",
+        "particles",
+        "kinetic_energy",
+        "coordination",
+        "packing_fraction",
+    ];
     if repose {
         header.extend(["repose_left_deg", "repose_right_deg"]);
     }
@@ -423,7 +440,13 @@ fn analyze_command(
         header.push("large_mean_height");
     }
     let mut rows = Vec::new();
-    println!("{}", header.iter().map(|h| format!("{h:>17}")).collect::<String>());
+    println!(
+        "{}",
+        header
+            .iter()
+            .map(|h| format!("{h:>17}"))
+            .collect::<String>()
+    );
     for (k, path) in frames {
         let p = tinydem::csv::load_particles(&path)?;
         let mut row = vec![
@@ -443,12 +466,18 @@ fn analyze_command(
         if let Some(r) = large {
             row.push(mean_height_of_large(&p, r).map_or("nan".into(), |z| format!("{z:.6e}")));
         }
-        println!("{}", row.iter().map(|v| format!("{v:>17}")).collect::<String>());
+        println!(
+            "{}",
+            row.iter().map(|v| format!("{v:>17}")).collect::<String>()
+        );
         rows.push(row.join(","));
     }
     if let Some(path) = csv {
-        std::fs::write(&path, format!("{}\n{}\n", header.join(","), rows.join("\n")))
-            .with_context(|| format!("cannot write {}", path.display()))?;
+        std::fs::write(
+            &path,
+            format!("{}\n{}\n", header.join(","), rows.join("\n")),
+        )
+        .with_context(|| format!("cannot write {}", path.display()))?;
     }
     Ok(())
 }

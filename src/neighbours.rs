@@ -279,16 +279,41 @@ impl Neighbours {
     }
 
     /// Rebuilds both lists for particles at `x` with radii `radius`.
+    ///
+    /// Cells are sized for the 90th percentile of the radii, not the largest, so that a few
+    /// large particles do not make every cell hold many small ones: each pair is found by its
+    /// larger particle (ties: the lower index), which searches as many cells as its own reach
+    /// needs.
     pub fn rebuild(&mut self, x: &[DVec3], radius: &[f64], faces: &[Face], face_grid: &CellGrid) {
         let n = x.len();
-        let max_r = radius.iter().copied().fold(0.0, f64::max);
         let skin = self.skin;
-        let h = 2.0 * max_r + skin;
-        let grid = CellGrid::of_points(x, if h > 0.0 { h } else { 1.0 });
+        let typical_r = if n > 0 {
+            let mut r = radius.to_vec();
+            let k = (9 * n / 10).min(n - 1);
+            *r.select_nth_unstable_by(k, f64::total_cmp).1
+        } else {
+            0.0
+        };
+        let h = 2.0 * typical_r + skin;
+        let h = if h > 0.0 { h } else { 1.0 };
+        let grid = CellGrid::of_points(x, h);
+        // Whether i lists its pair with j: the larger radius (ties: the lower index) does.
+        let finds = |i: u32, j: u32| {
+            let (ri, rj) = (radius[i as usize], radius[j as usize]);
+            rj < ri || (rj == ri && j > i)
+        };
+        // How many cells around its own a particle must search: its partners are no larger,
+        // so they are within 2 R_i + skin.
+        let cells_needed = |i: u32| ((2.0 * radius[i as usize] + skin) / h).ceil().max(1.0) as i32;
+        let close = |i: u32, j: u32| {
+            let reach = radius[i as usize] + radius[j as usize] + skin;
+            (x[i as usize] - x[j as usize]).length_squared() < reach * reach
+        };
+        let key = |i: u32, j: u32| ((i.min(j) as u64) << 32) | i.max(j) as u64;
 
-        // Per occupied cell: its 27 neighbour ranges are looked up once, then every
-        // particle of the cell is tested against them. Each cell yields its pairs sorted.
-        let per_cell: Vec<Vec<(u32, u32)>> = grid
+        // Per occupied cell: the 27 neighbour ranges are looked up once for the cell's
+        // particles of ordinary size; larger particles search their own wider block.
+        let per_cell: Vec<Vec<u64>> = grid
             .occupied
             .par_iter()
             .with_min_len(MIN_PARALLEL_LEN / 16)
@@ -305,22 +330,33 @@ impl Neighbours {
                 }
                 let mut pairs = Vec::new();
                 for &i in &grid.items[a as usize..b as usize] {
-                    let first = pairs.len();
-                    let (xi, ri) = (x[i as usize], radius[i as usize]);
-                    for &j in near.iter().flat_map(|r| r.iter()) {
-                        if j > i {
-                            let reach = ri + radius[j as usize] + skin;
-                            if (xi - x[j as usize]).length_squared() < reach * reach {
-                                pairs.push((i, j));
+                    let m = cells_needed(i);
+                    if m == 1 {
+                        for &j in near.iter().flat_map(|r| r.iter()) {
+                            if finds(i, j) && close(i, j) {
+                                pairs.push(key(i, j));
+                            }
+                        }
+                        continue;
+                    }
+                    for dz in -m..=m {
+                        for dy in -m..=m {
+                            for dx in -m..=m {
+                                for &j in grid.in_cell(c + IVec3::new(dx, dy, dz)) {
+                                    if finds(i, j) && close(i, j) {
+                                        pairs.push(key(i, j));
+                                    }
+                                }
                             }
                         }
                     }
-                    pairs[first..].sort_unstable();
                 }
                 pairs
             })
             .collect();
-        let (start, partner) = compress(n, per_cell.iter().flatten().copied());
+        let mut pairs: Vec<u64> = per_cell.into_iter().flatten().collect();
+        pairs.par_sort_unstable();
+        let (start, partner) = compress(n, pairs.iter().map(|&k| ((k >> 32) as u32, k as u32)));
         self.pairs = self.pairs.rebuild(start, partner);
 
         // Reverse index by counting sort over partners (keeps slots in ascending order).

@@ -9,7 +9,10 @@ use tinydem::scenario::Scenario;
 fn every_example_runs_a_few_frames() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples");
     let mut count = 0;
-    let mut dirs: Vec<_> = std::fs::read_dir(&root).unwrap().map(|e| e.unwrap().path()).collect();
+    let mut dirs: Vec<_> = std::fs::read_dir(&root)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
     dirs.sort();
     for dir in dirs {
         let file = dir.join("scenario.toml");
@@ -26,7 +29,8 @@ fn every_example_runs_a_few_frames() {
             resume: None,
             stop: None,
         };
-        let summary = run(s, out.path(), options).unwrap_or_else(|e| panic!("{}: {e:#}", file.display()));
+        let summary =
+            run(s, out.path(), options).unwrap_or_else(|e| panic!("{}: {e:#}", file.display()));
         assert_eq!(summary.frames_written, 3);
         assert!(summary.particles > 0, "{}: no particles", file.display());
         count += 1;
