@@ -135,11 +135,12 @@ pub fn render(p: &Particles, mesh: &Mesh, style: &Style) -> Result<RgbImage> {
         ColorBy::Height => p.x.iter().map(|x| x.z).collect(),
         ColorBy::Radius => p.radius.clone(),
     };
-    // Colour range from the 1 % to the 99 % quantile, so that outliers do not wash it out.
+    // Colour range from the 1 % to the 99 % quantile, so that outliers do not wash it out
+    // (radii: the full range, as a few large particles are the point of such a picture).
     let (vmin, vmax) = {
         let mut sorted = values.clone();
         sorted.sort_by(f64::total_cmp);
-        let cut = sorted.len() / 100;
+        let cut = if style.color == ColorBy::Radius { 0 } else { sorted.len() / 100 };
         match sorted.len() {
             0 => (0.0, 1.0),
             n => (sorted[cut], sorted[n - 1 - cut]),
