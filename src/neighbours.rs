@@ -280,13 +280,14 @@ impl Neighbours {
 
     /// Rebuilds both lists for particles at `x` with radii `radius`.
     ///
-    /// Cells are sized for the 90th percentile of the radii, not the largest, so that a few
-    /// large particles do not make every cell hold many small ones: each pair is found by its
-    /// larger particle (ties: the lower index), which searches as many cells as its own reach
-    /// needs.
+    /// Cells are sized for the largest radius, or for the 90th percentile of the radii when
+    /// the largest is more than twice that, so that a few large particles do not make every
+    /// cell hold many small ones. Each pair is found by its larger particle (ties: the lower
+    /// index), which searches as many cells as its own reach needs.
     pub fn rebuild(&mut self, x: &[DVec3], radius: &[f64], faces: &[Face], face_grid: &CellGrid) {
         let n = x.len();
         let skin = self.skin;
+        let max_r = radius.iter().copied().fold(0.0, f64::max);
         let typical_r = if n > 0 {
             let mut r = radius.to_vec();
             let k = (9 * n / 10).min(n - 1);
@@ -294,17 +295,37 @@ impl Neighbours {
         } else {
             0.0
         };
-        let h = 2.0 * typical_r + skin;
+        // Sized for the largest particle unless it is far larger than most (then every
+        // cell would hold many small particles).
+        let cell_r = if max_r <= 2.0 * typical_r {
+            max_r
+        } else {
+            typical_r
+        };
+        let h = 2.0 * cell_r + skin;
         let h = if h > 0.0 { h } else { 1.0 };
         let grid = CellGrid::of_points(x, h);
-        // Whether i lists its pair with j: the larger radius (ties: the lower index) does.
+        let uniform = cell_r == max_r;
+        // Whether i lists its pair with j. With cells for the largest particle: the lower
+        // index, so that each owner's pairs come out together and in order. Otherwise the
+        // larger radius (ties: the lower index), searching its own reach.
         let finds = |i: u32, j: u32| {
             let (ri, rj) = (radius[i as usize], radius[j as usize]);
-            rj < ri || (rj == ri && j > i)
+            if uniform {
+                j > i
+            } else {
+                rj < ri || (rj == ri && j > i)
+            }
         };
         // How many cells around its own a particle must search: its partners are no larger,
         // so they are within 2 R_i + skin.
-        let cells_needed = |i: u32| ((2.0 * radius[i as usize] + skin) / h).ceil().max(1.0) as i32;
+        let cells_needed = |i: u32| {
+            if uniform {
+                1
+            } else {
+                ((2.0 * radius[i as usize] + skin) / h).ceil().max(1.0) as i32
+            }
+        };
         let close = |i: u32, j: u32| {
             let reach = radius[i as usize] + radius[j as usize] + skin;
             (x[i as usize] - x[j as usize]).length_squared() < reach * reach
@@ -312,7 +333,8 @@ impl Neighbours {
         let key = |i: u32, j: u32| ((i.min(j) as u64) << 32) | i.max(j) as u64;
 
         // Per occupied cell: the 27 neighbour ranges are looked up once for the cell's
-        // particles of ordinary size; larger particles search their own wider block.
+        // particles of ordinary size; larger particles search their own wider block. Each
+        // finder's pairs are sorted.
         let per_cell: Vec<Vec<u64>> = grid
             .occupied
             .par_iter()
@@ -330,6 +352,7 @@ impl Neighbours {
                 }
                 let mut pairs = Vec::new();
                 for &i in &grid.items[a as usize..b as usize] {
+                    let first = pairs.len();
                     let m = cells_needed(i);
                     if m == 1 {
                         for &j in near.iter().flat_map(|r| r.iter()) {
@@ -337,25 +360,29 @@ impl Neighbours {
                                 pairs.push(key(i, j));
                             }
                         }
-                        continue;
-                    }
-                    for dz in -m..=m {
-                        for dy in -m..=m {
-                            for dx in -m..=m {
-                                for &j in grid.in_cell(c + IVec3::new(dx, dy, dz)) {
-                                    if finds(i, j) && close(i, j) {
-                                        pairs.push(key(i, j));
+                    } else {
+                        for dz in -m..=m {
+                            for dy in -m..=m {
+                                for dx in -m..=m {
+                                    for &j in grid.in_cell(c + IVec3::new(dx, dy, dz)) {
+                                        if finds(i, j) && close(i, j) {
+                                            pairs.push(key(i, j));
+                                        }
                                     }
                                 }
                             }
                         }
                     }
+                    pairs[first..].sort_unstable();
                 }
                 pairs
             })
             .collect();
         let mut pairs: Vec<u64> = per_cell.into_iter().flatten().collect();
-        pairs.par_sort_unstable();
+        if !uniform {
+            // Pairs of one owner came from several finders: bring them together in order.
+            pairs.par_sort_unstable();
+        }
         let (start, partner) = compress(n, pairs.iter().map(|&k| ((k >> 32) as u32, k as u32)));
         self.pairs = self.pairs.rebuild(start, partner);
 
@@ -428,6 +455,45 @@ pub fn face_grid(faces: &[Face], max_radius: f64, skin: f64) -> CellGrid {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Brute-force pairs within reach, as (i, j) with i < j.
+    fn brute(x: &[DVec3], radius: &[f64], skin: f64) -> Vec<(u32, u32)> {
+        let mut v = Vec::new();
+        for i in 0..x.len() {
+            for j in i + 1..x.len() {
+                if x[i].distance(x[j]) < radius[i] + radius[j] + skin {
+                    v.push((i as u32, j as u32));
+                }
+            }
+        }
+        v
+    }
+
+    #[test]
+    fn polydisperse_lists_match_brute_force() {
+        // 600 small particles and 6 ten times larger among them.
+        let mut s = 11u64;
+        let mut rnd = || {
+            s = s.wrapping_mul(6364136223846793005).wrapping_add(1);
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let x: Vec<DVec3> = (0..606)
+            .map(|_| DVec3::new(rnd(), rnd(), rnd()) * 0.15)
+            .collect();
+        let radius: Vec<f64> = (0..606)
+            .map(|i| if i % 101 == 0 { 0.02 } else { 0.002 })
+            .collect();
+        let mut nb = Neighbours::new(0.001);
+        nb.rebuild(&x, &radius, &[], &CellGrid::default());
+        let listed: Vec<(u32, u32)> = nb
+            .pairs
+            .owner
+            .iter()
+            .copied()
+            .zip(nb.pairs.partner.iter().copied())
+            .collect();
+        assert_eq!(listed, brute(&x, &radius, 0.001));
+    }
 
     #[test]
     fn lists_every_pair_within_reach_once() {

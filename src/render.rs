@@ -140,7 +140,11 @@ pub fn render(p: &Particles, mesh: &Mesh, style: &Style) -> Result<RgbImage> {
     let (vmin, vmax) = {
         let mut sorted = values.clone();
         sorted.sort_by(f64::total_cmp);
-        let cut = if style.color == ColorBy::Radius { 0 } else { sorted.len() / 100 };
+        let cut = if style.color == ColorBy::Radius {
+            0
+        } else {
+            sorted.len() / 100
+        };
         match sorted.len() {
             0 => (0.0, 1.0),
             n => (sorted[cut], sorted[n - 1 - cut]),
