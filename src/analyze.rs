@@ -129,6 +129,7 @@ mod tests {
             v: DVec3::ZERO,
             q: DQuat::IDENTITY,
             w: DVec3::ZERO,
+            tag: 0,
         }
     }
 

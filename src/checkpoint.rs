@@ -3,8 +3,8 @@
 //!
 //! Layout (little endian): magic `TINYDEM CKPT`, format version (u32), scenario fingerprint
 //! (u64), step (u64), spawner word position (u128), pending radius flag (u8) and value
-//! (f64), particle count (u64) and 14 f64 per particle (x, y, z, R, vx, vy, vz, q0..q3, wx,
-//! wy, wz), then the particle-pair and particle-face histories: count (u64) and per entry
+//! (f64), particle count (u64) and per particle 14 f64 (x, y, z, R, vx, vy, vz, q0..q3, wx,
+//! wy, wz) and its tag (u32), then the particle-pair and particle-face histories: count (u64) and per entry
 //! owner, partner (u32) and the springs u_s, u_r (3 f64 each), u_t (f64); last a CRC-32 of
 //! everything before it.
 
@@ -87,6 +87,7 @@ pub fn encode(snapshot: &Snapshot, fingerprint: u64) -> Vec<u8> {
                 q.w.x, q.w.y, q.w.z,
             ],
         );
+        out.extend_from_slice(&q.tag.to_le_bytes());
     }
     put_history(&mut out, &snapshot.pair_history);
     put_history(&mut out, &snapshot.face_history);
@@ -183,7 +184,7 @@ pub fn decode(bytes: &[u8], expected_fingerprint: u64) -> Result<Snapshot> {
     let word_pos = r.u128()?;
     let has_pending = r.u8()? != 0;
     let pending = r.f64()?;
-    let n = r.count(14 * 8)?;
+    let n = r.count(14 * 8 + 4)?;
     let mut particles = Particles::default();
     for _ in 0..n {
         let x = r.vec3()?;
@@ -191,12 +192,14 @@ pub fn decode(bytes: &[u8], expected_fingerprint: u64) -> Result<Snapshot> {
         let v = r.vec3()?;
         let (w0, q1, q2, q3) = (r.f64()?, r.f64()?, r.f64()?, r.f64()?);
         let w = r.vec3()?;
+        let tag = r.u32()?;
         particles.push(Particle {
             x,
             radius,
             v,
             q: DQuat::from_xyzw(q1, q2, q3, w0),
             w,
+            tag,
         });
     }
     let pair_history = r.history()?;
@@ -254,6 +257,7 @@ mod tests {
             v: DVec3::new(-1.0, 1e-300, 2.5),
             q: DQuat::from_rotation_y(0.7),
             w: DVec3::new(1.0, 2.0, 3.0),
+            tag: 7,
         });
         let s = Springs {
             u_s: DVec3::new(1e-5, 2e-6, 0.0),

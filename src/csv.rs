@@ -1,6 +1,6 @@
 //! Particle frames in the original program's CSV format:
 //! header `x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz`, one particle per line, full round-trip
-//! precision, files `particlesNNNNNN.csv`.
+//! precision, files `particlesNNNNNN.csv`. Runs that tag particles add a last column `tag`.
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::path::{Path, PathBuf};
@@ -19,11 +19,11 @@ pub fn frame_name(k: u64) -> String {
     format!("particles{k:06}.csv")
 }
 
-/// Writes all particles as CSV text.
-pub fn write_particles(out: &mut impl Write, p: &Particles) -> std::io::Result<()> {
+/// Writes all particles as CSV text, with the `tag` column if `tags`.
+pub fn write_particles(out: &mut impl Write, p: &Particles, tags: bool) -> std::io::Result<()> {
     let mut line = String::with_capacity(512);
     out.write_all(COLUMNS.join(",").as_bytes())?;
-    out.write_all(b"\n")?;
+    out.write_all(if tags { b",tag\n" } else { b"\n" })?;
     let mut buf = ryu::Buffer::new();
     for q in p.iter() {
         line.clear();
@@ -37,6 +37,10 @@ pub fn write_particles(out: &mut impl Write, p: &Particles) -> std::io::Result<(
             }
             line.push_str(buf.format(*value));
         }
+        if tags {
+            line.push(',');
+            line.push_str(itoa::Buffer::new().format(q.tag));
+        }
         line.push('\n');
         out.write_all(line.as_bytes())?;
     }
@@ -45,17 +49,17 @@ pub fn write_particles(out: &mut impl Write, p: &Particles) -> std::io::Result<(
 
 /// Writes a frame file atomically: to a temporary name first, then renamed, so a crash
 /// never leaves a half-written frame behind.
-pub fn write_frame(dir: &Path, k: u64, p: &Particles) -> Result<PathBuf> {
-    write_frame_as(dir, &frame_name(k), p)
+pub fn write_frame(dir: &Path, k: u64, p: &Particles, tags: bool) -> Result<PathBuf> {
+    write_frame_as(dir, &frame_name(k), p, tags)
 }
 
 /// Writes particles atomically to `dir/name`.
-pub fn write_frame_as(dir: &Path, name: &str, p: &Particles) -> Result<PathBuf> {
+pub fn write_frame_as(dir: &Path, name: &str, p: &Particles, tags: bool) -> Result<PathBuf> {
     let path = dir.join(name);
     let tmp = dir.join(format!(".{name}.tmp"));
     let write = || -> std::io::Result<()> {
         let mut w = std::io::BufWriter::with_capacity(1 << 20, std::fs::File::create(&tmp)?);
-        write_particles(&mut w, p)?;
+        write_particles(&mut w, p, tags)?;
         w.into_inner().map_err(|e| e.into_error())?.sync_data()?;
         std::fs::rename(&tmp, &path)
     };
@@ -81,7 +85,12 @@ pub fn read_particles(input: impl Read, file: &str) -> Result<Particles> {
     }
     let names: Vec<&str> = header.trim().split(',').map(str::trim).collect();
     let mut slot = [usize::MAX; 14];
+    let mut tag_column = None;
     for (col, name) in names.iter().enumerate() {
+        if *name == "tag" && tag_column.is_none() {
+            tag_column = Some(col);
+            continue;
+        }
         let Some(k) = COLUMNS.iter().position(|c| c == name) else {
             bail!(
                 "{file}:1: unknown column '{name}': expected the header '{}'",
@@ -102,7 +111,7 @@ pub fn read_particles(input: impl Read, file: &str) -> Result<Particles> {
     }
 
     // Column of each of the 14 quantities, and which quantity each column holds.
-    let mut quantity_of_column = vec![0usize; names.len()];
+    let mut quantity_of_column = vec![usize::MAX; names.len()];
     for (k, &col) in slot.iter().enumerate() {
         quantity_of_column[col] = k;
     }
@@ -124,13 +133,20 @@ pub fn read_particles(input: impl Read, file: &str) -> Result<Particles> {
             continue;
         }
         let mut count = 0;
+        let mut tag = 0u32;
         for (col, text) in line.split(',').enumerate() {
             count += 1;
             if col >= names.len() {
                 continue;
             }
-            let k = quantity_of_column[col];
             let text = text.trim();
+            if Some(col) == tag_column {
+                tag = text.parse().map_err(|_| {
+                    anyhow::anyhow!("{file}:{n}: column {} ('tag'): expected a whole number >= 0, found '{text}'", col + 1)
+                })?;
+                continue;
+            }
+            let k = quantity_of_column[col];
             let x: f64 = text.parse().map_err(|_| {
                 anyhow::anyhow!(
                     "{file}:{n}: column {} ('{}'): expected a number, found '{text}'",
@@ -171,6 +187,7 @@ pub fn read_particles(input: impl Read, file: &str) -> Result<Particles> {
                 q / norm
             },
             w: DVec3::new(v[11], v[12], v[13]),
+            tag,
         });
     }
     Ok(particles)
@@ -195,11 +212,12 @@ mod tests {
             v: DVec3::new(1e-7, 2.5, -0.0),
             q: DQuat::from_rotation_x(0.3),
             w: DVec3::new(1.0, 2.0, 3.0),
+            tag: 42,
         }]
         .into_iter()
         .collect();
         let mut text = Vec::new();
-        write_particles(&mut text, &p).unwrap();
+        write_particles(&mut text, &p, true).unwrap();
         let back = read_particles(&text[..], "t").unwrap();
         assert_eq!(back, p);
     }

@@ -59,6 +59,9 @@ enum Command {
         /// Report the mean height of the particles with at least this radius.
         #[arg(long)]
         large: Option<f64>,
+        /// Report the number and mean height of the particles with this tag.
+        #[arg(long)]
+        tag: Option<u32>,
         /// Also write the table as CSV to this file.
         #[arg(long)]
         csv: Option<PathBuf>,
@@ -236,8 +239,9 @@ fn execute(command: Option<Command>, resume_default: Option<PathBuf>) -> Result<
             scenario,
             repose,
             large,
+            tag,
             csv,
-        }) => analyze_command(&dir, scenario, repose, large, csv)?,
+        }) => analyze_command(&dir, scenario, repose, large, tag, csv)?,
         Some(Command::Check { scenario }) => {
             let s = Scenario::load(&scenario)?;
             print!("{}", describe(&s)?);
@@ -397,6 +401,7 @@ fn analyze_command(
     scenario: Option<PathBuf>,
     repose: bool,
     large: Option<f64>,
+    tag: Option<u32>,
     csv: Option<PathBuf>,
 ) -> Result<()> {
     use tinydem::analyze::*;
@@ -439,6 +444,9 @@ fn analyze_command(
     if large.is_some() {
         header.push("large_mean_height");
     }
+    if tag.is_some() {
+        header.extend(["tagged", "tagged_mean_height"]);
+    }
     let mut rows = Vec::new();
     println!(
         "{}",
@@ -465,6 +473,18 @@ fn analyze_command(
         }
         if let Some(r) = large {
             row.push(mean_height_of_large(&p, r).map_or("nan".into(), |z| format!("{z:.6e}")));
+        }
+        if let Some(t) = tag {
+            let z: Vec<f64> = (0..p.len())
+                .filter(|&k| p.tag[k] == t)
+                .map(|k| p.x[k].z)
+                .collect();
+            row.push(z.len().to_string());
+            row.push(if z.is_empty() {
+                "nan".into()
+            } else {
+                format!("{:.6e}", z.iter().sum::<f64>() / z.len() as f64)
+            });
         }
         println!(
             "{}",

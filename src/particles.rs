@@ -16,6 +16,9 @@ pub struct Particles {
     pub q: Vec<DQuat>,
     /// ω [1/T], world frame.
     pub w: Vec<DVec3>,
+    /// A label per particle (0 by default), set by `[[tags]]` regions, e.g. to dye grains by
+    /// the path they took.
+    pub tag: Vec<u32>,
 }
 
 /// One particle's state, as read from and written to CSV.
@@ -26,6 +29,7 @@ pub struct Particle {
     pub v: DVec3,
     pub q: DQuat,
     pub w: DVec3,
+    pub tag: u32,
 }
 
 impl Particles {
@@ -43,6 +47,7 @@ impl Particles {
         self.v.push(p.v);
         self.q.push(p.q);
         self.w.push(p.w);
+        self.tag.push(p.tag);
     }
 
     pub fn get(&self, i: usize) -> Particle {
@@ -52,11 +57,17 @@ impl Particles {
             v: self.v[i],
             q: self.q[i],
             w: self.w[i],
+            tag: self.tag[i],
         }
     }
 
     pub fn iter(&self) -> impl Iterator<Item = Particle> + '_ {
         (0..self.len()).map(|i| self.get(i))
+    }
+
+    /// Whether any particle carries a tag.
+    pub fn tagged(&self) -> bool {
+        self.tag.iter().any(|&t| t != 0)
     }
 
     /// Largest radius present, or 0.

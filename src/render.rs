@@ -14,6 +14,7 @@ pub enum ColorBy {
     Speed,
     Height,
     Radius,
+    Tag,
 }
 
 /// Where the camera looks from.
@@ -134,9 +135,11 @@ pub fn render(p: &Particles, mesh: &Mesh, style: &Style) -> Result<RgbImage> {
         ColorBy::Speed => p.v.iter().map(|v| v.length()).collect(),
         ColorBy::Height => p.x.iter().map(|x| x.z).collect(),
         ColorBy::Radius => p.radius.clone(),
+        ColorBy::Tag => p.tag.iter().map(|&t| t as f64).collect(),
     };
     // Colour range from the 1 % to the 99 % quantile, so that outliers do not wash it out
-    // (radii: the full range, as a few large particles are the point of such a picture).
+    // (radii and tags: the full range, as a few special particles are the point of such a
+    // picture).
     let (vmin, vmax) = {
         let mut sorted = values.clone();
         sorted.sort_by(f64::total_cmp);
@@ -246,6 +249,7 @@ mod tests {
             v: DVec3::ZERO,
             q: DQuat::IDENTITY,
             w: DVec3::ZERO,
+            tag: 0,
         }]
         .into_iter()
         .collect();

@@ -78,6 +78,8 @@ impl std::error::Error for Interrupted {}
 struct Frames<'a> {
     dir: &'a Path,
     formats: Formats,
+    /// Whether the CSV frames have a tag column.
+    tags: bool,
     /// Simulated time between frames.
     frame_time: f64,
 }
@@ -93,7 +95,7 @@ impl Frames<'_> {
 
     fn write(&self, k: u64, sim: &Simulation) -> Result<()> {
         if self.formats.csv {
-            write_frame(self.dir, k, &sim.particles)?;
+            write_frame(self.dir, k, &sim.particles, self.tags)?;
         }
         if self.formats.vtk {
             let name = format!("particles{k:06}.vtu");
@@ -156,6 +158,7 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
     let out = Frames {
         dir: output_dir,
         formats: sim.scenario.formats,
+        tags: sim.has_tags(),
         frame_time: steps_per_frame as f64 * sim.scenario.simulation.timestep,
     };
     out.start(&sim)?;
@@ -198,7 +201,8 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
     while sim.steps < total_steps {
         if let Err(unstable) = sim.step() {
             let last = sim.steps.saturating_sub(1) / steps_per_frame.max(1);
-            let written = crate::csv::write_frame_as(output_dir, UNSTABLE, &sim.particles).is_ok();
+            let written =
+                crate::csv::write_frame_as(output_dir, UNSTABLE, &sim.particles, out.tags).is_ok();
             anyhow::bail!(
                 "{unstable}.\nThe last complete frame is {}{}.",
                 output_dir.join(frame_name(last)).display(),
@@ -231,7 +235,7 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
         if options.stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
             let path = output_dir.join(CHECKPOINT);
             checkpoint::save(&path, &sim.snapshot(), fingerprint(&sim))?;
-            crate::csv::write_frame_as(output_dir, INTERRUPTED, &sim.particles)?;
+            crate::csv::write_frame_as(output_dir, INTERRUPTED, &sim.particles, out.tags)?;
             if let Some(bar) = &bar {
                 bar.abandon();
             }

@@ -10,6 +10,7 @@
 //! [[meshes]]   file, radii, motion = { type = "harmonic", amplitude, frequency, direction,
 //!              phase } | { type = "velocity", velocity } | { type = "rotation", center, axis,
 //!              angular_velocity }   (any number of these)
+//! [[tags]]     min, max, tag   (a box that labels particles entering it; any number)
 //! [input]      particles
 //! [output]     dir, checkpoint_every, formats
 //! ```
@@ -107,6 +108,14 @@ pub struct MeshSpec {
     pub motion: Option<Motion>,
 }
 
+/// A box that labels the particles whose centre enters it (`[[tags]]`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TagRegion {
+    pub min: DVec3,
+    pub max: DVec3,
+    pub tag: u32,
+}
+
 /// A complete, validated scenario.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scenario {
@@ -116,6 +125,8 @@ pub struct Scenario {
     pub simulation: Simulation,
     /// Further meshes, each with its own radii and motion (`[[meshes]]`).
     pub meshes: Vec<MeshSpec>,
+    /// Regions that tag particles passing through them (`[[tags]]`), later ones winning.
+    pub tags: Vec<TagRegion>,
     /// Initial particles (CSV), if any.
     pub particles: Option<PathBuf>,
     /// Output directory.
@@ -198,11 +209,21 @@ enum RawMotion {
     },
 }
 
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawTag {
+    min: [f64; 3],
+    max: [f64; 3],
+    tag: u32,
+}
+
 #[derive(Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 struct RawScenario {
     #[serde(default)]
     meshes: Vec<RawMesh>,
+    #[serde(default)]
+    tags: Vec<RawTag>,
     #[serde(default)]
     geometry: RawGeometry,
     #[serde(default)]
@@ -550,12 +571,37 @@ impl Scenario {
             .map(|(k, m)| mesh_spec(k, m, base))
             .collect::<Result<Vec<_>>>()?;
 
+        let tags = raw
+            .tags
+            .into_iter()
+            .enumerate()
+            .map(|(k, t)| {
+                let key = |name: &str| format!("[[tags]] #{} {name}", k + 1);
+                let (min, max) = (
+                    check_vec(&key("min"), t.min)?,
+                    check_vec(&key("max"), t.max)?,
+                );
+                if max.cmplt(min).any() {
+                    bail!(
+                        "{} = {max} must be >= min = {min} in every component",
+                        key("max")
+                    );
+                }
+                Ok(TagRegion {
+                    min,
+                    max,
+                    tag: t.tag,
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+
         Ok(Scenario {
             geometry,
             material,
             kinetics,
             simulation,
             meshes,
+            tags,
             particles: raw.input.particles.map(|p| base.join(p)),
             output_dir: raw
                 .output

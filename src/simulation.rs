@@ -266,9 +266,35 @@ impl Simulation {
         let mut deep = self.particle_contacts();
         deep.extend(self.mesh_contacts());
         self.integrate();
+        self.tag();
         self.steps += 1;
         self.time = self.steps as f64 * self.scenario.simulation.timestep;
         self.check_stability(deep)
+    }
+
+    /// Stage 5b: particles whose centre is inside a `[[tags]]` box take its tag.
+    fn tag(&mut self) {
+        let regions = &self.scenario.tags;
+        if regions.is_empty() {
+            return;
+        }
+        let p = &mut self.particles;
+        p.tag
+            .par_iter_mut()
+            .zip(p.x.par_iter())
+            .with_min_len(4 * MIN_PARALLEL_LEN)
+            .for_each(|(tag, x)| {
+                for r in regions {
+                    if x.cmpge(r.min).all() && x.cmple(r.max).all() {
+                        *tag = r.tag;
+                    }
+                }
+            });
+    }
+
+    /// Whether frames carry a tag column: the scenario tags particles, or they came tagged.
+    pub fn has_tags(&self) -> bool {
+        !self.scenario.tags.is_empty() || self.particles.tagged()
     }
 
     /// Stage 6: stop loudly rather than continue a run that has blown up. `deep` lists the

@@ -138,6 +138,7 @@ impl Spawner {
                 v: s.kinetics.initial_velocity,
                 q: DQuat::IDENTITY,
                 w: s.kinetics.initial_angular_velocity,
+                tag: 0,
             });
         }
         particles.len() - before

@@ -2,7 +2,7 @@
 //! data, and a `.pvd` collection that lists the frames with their times.
 //!
 //! Particles are points with one vertex cell each and the point arrays `radius`,
-//! `velocity`, `angular_velocity` and `orientation` (the quaternion q0, q1, q2, q3); the mesh
+//! `velocity`, `angular_velocity`, `orientation` (the quaternion q0, q1, q2, q3) and `tag`; the mesh
 //! is its faces (vertex, line, triangle and quad cells) with the cell array `radius`.
 
 use std::io::Write;
@@ -46,6 +46,13 @@ impl VtkType for f64 {
 
 impl VtkType for i64 {
     const NAME: &'static str = "Int64";
+    fn put(self, out: &mut Vec<u8>) {
+        out.extend_from_slice(&self.to_le_bytes());
+    }
+}
+
+impl VtkType for u32 {
+    const NAME: &'static str = "UInt32";
     fn put(self, out: &mut Vec<u8>) {
         out.extend_from_slice(&self.to_le_bytes());
     }

@@ -356,3 +356,34 @@ fn render_draws_frames_and_directories() {
         &["picture size 0x600"],
     );
 }
+
+#[test]
+fn tag_regions_label_particles_and_add_a_tag_column() {
+    let t = tempfile::tempdir().unwrap();
+    write(
+        t.path(),
+        "s.toml",
+        "[geometry]\nspawn_min = [-0.05, -0.05, 0.3]\nspawn_max = [0.05, 0.05, 0.4]\n\
+         [simulation]\nmax_particles = 100\nframes = 2\nsteps_per_frame = 2000\n\
+         [[tags]]\nmin = [-1.0, -1.0, -10.0]\nmax = [0.0, 1.0, 0.25]\ntag = 3\n\
+         [[tags]]\nmin = [0.0, -1.0, -10.0]\nmax = [1.0, 1.0, 0.25]\ntag = 4\n",
+    );
+    let o = tinydem(&["run", "s.toml", "-q"], t.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(t.path().join("output/particles000002.csv")).unwrap();
+    assert!(text.starts_with("x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz,tag\n"));
+    let rows: Vec<Vec<f64>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 100);
+    // Every particle fell below z = 0.25 and took the tag of the side it fell on.
+    for r in &rows {
+        assert!(r[2] < 0.25);
+        assert_eq!(r[14], if r[0] <= 0.0 { 3.0 } else { 4.0 }, "{r:?}");
+    }
+    // The tagged frame reads back, tags included.
+    let p = tinydem::csv::load_particles(&t.path().join("output/particles000002.csv")).unwrap();
+    assert!(p.tag.iter().all(|&t| t == 3 || t == 4));
+}

@@ -27,6 +27,7 @@ fn pair(speed: f64) -> Simulation {
         v: v * diagonal,
         q: DQuat::IDENTITY,
         w: DVec3::ZERO,
+        tag: 0,
     };
     let particles: Particles = [p(-0.006, -speed), p(0.006, speed)].into_iter().collect();
     Simulation::from_parts(s, Mesh::default(), particles).unwrap()

@@ -23,6 +23,7 @@ fn particle(x: DVec3, v: DVec3, w: DVec3) -> Particle {
         v,
         q: DQuat::IDENTITY,
         w,
+        tag: 0,
     }
 }
 

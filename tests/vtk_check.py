@@ -15,6 +15,8 @@ checks = {
     "angular_velocity": (m.point_data["angular_velocity"], col("wx", "wy", "wz")),
     "orientation": (m.point_data["orientation"], col("q0", "q1", "q2", "q3")),
 }
+tags = col("tag").reshape(-1) if "tag" in rows[0] else np.zeros(len(rows))
+checks["tag"] = (m.point_data["tag"].reshape(-1).astype(float), tags)
 assert len(rows) > 0, "empty frame"
 for name, (vtk, ref) in checks.items():
     assert vtk.shape == ref.shape, (name, vtk.shape, ref.shape)
