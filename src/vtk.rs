@@ -181,6 +181,7 @@ pub fn write_particles(path: &Path, p: &Particles) -> Result<()> {
         4 * n,
         p.q.iter().flat_map(|q| [q.w, q.x, q.y, q.z]),
     );
+    v.array(PointData, "tag", 1, n, p.tag.iter().copied());
     v.array(
         Points,
         "points",
