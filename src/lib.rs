@@ -14,6 +14,7 @@ pub mod mesh;
 pub mod motion;
 pub mod neighbours;
 pub mod particles;
+pub mod plot;
 pub mod render;
 pub mod run;
 pub mod scenario;

@@ -65,6 +65,12 @@ enum Command {
         /// Also write the table as CSV to this file.
         #[arg(long)]
         csv: Option<PathBuf>,
+        /// Also plot one column against time as a PNG (see --column).
+        #[arg(long)]
+        plot: Option<PathBuf>,
+        /// The column to plot (a name from the table's header).
+        #[arg(long, default_value = "kinetic_energy")]
+        column: String,
     },
     /// Draw a frame (CSV) as a PNG picture, or every frame of an output directory.
     Render {
@@ -241,7 +247,17 @@ fn execute(command: Option<Command>, resume_default: Option<PathBuf>) -> Result<
             large,
             tag,
             csv,
-        }) => analyze_command(&dir, scenario, repose, large, tag, csv)?,
+            plot,
+            column,
+        }) => analyze_command(
+            &dir,
+            scenario,
+            repose,
+            large,
+            tag,
+            csv,
+            plot.map(|p| (p, column)),
+        )?,
         Some(Command::Check { scenario }) => {
             let s = Scenario::load(&scenario)?;
             print!("{}", describe(&s)?);
@@ -403,6 +419,7 @@ fn analyze_command(
     large: Option<f64>,
     tag: Option<u32>,
     csv: Option<PathBuf>,
+    plot: Option<(PathBuf, String)>,
 ) -> Result<()> {
     use tinydem::analyze::*;
     let s = match scenario {
@@ -498,6 +515,28 @@ fn analyze_command(
             format!("{}\n{}\n", header.join(","), rows.join("\n")),
         )
         .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    if let Some((path, column)) = plot {
+        let Some(c) = header.iter().position(|h| *h == column) else {
+            anyhow::bail!(
+                "--column {column}: not a column of this table ({})",
+                header.join(", ")
+            );
+        };
+        let points: Vec<(f64, f64)> = rows
+            .iter()
+            .map(|r| {
+                let v: Vec<&str> = r.split(',').collect();
+                (
+                    v[1].parse().unwrap_or(f64::NAN),
+                    v[c].parse().unwrap_or(f64::NAN),
+                )
+            })
+            .collect();
+        tinydem::plot::line_plot(&points, 640, 400)?
+            .save(&path)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        eprintln!("plot of {column} against time in {}", path.display());
     }
     Ok(())
 }

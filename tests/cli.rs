@@ -387,3 +387,55 @@ fn tag_regions_label_particles_and_add_a_tag_column() {
     let p = tinydem::csv::load_particles(&t.path().join("output/particles000002.csv")).unwrap();
     assert!(p.tag.iter().all(|&t| t == 3 || t == 4));
 }
+
+#[test]
+fn analyze_prints_a_table_and_writes_csv_and_plot() {
+    let t = tempfile::tempdir().unwrap();
+    hourglass_frames("2", t.path());
+    let o = tinydem(
+        &[
+            "analyze",
+            "out",
+            "--scenario",
+            "s.toml",
+            "--large",
+            "0.009",
+            "--csv",
+            "a.csv",
+            "--plot",
+            "a.png",
+            "--column",
+            "coordination",
+        ],
+        t.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let table = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(table.lines().count(), 6, "{table}");
+    let csv = std::fs::read_to_string(t.path().join("a.csv")).unwrap();
+    let last: Vec<f64> = csv
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    assert_eq!(last[0], 4.0);
+    assert!(
+        (last[1] - 4.0 * 600.0 * 6.0332412e-5).abs() < 1e-6,
+        "time {}",
+        last[1]
+    );
+    assert!(
+        last[2] > 1000.0 && last[3] > 0.0 && last[4] > 0.0,
+        "{last:?}"
+    );
+    assert!(image::open(t.path().join("a.png")).is_ok());
+    fails_with(
+        &tinydem(
+            &["analyze", "out", "--plot", "b.png", "--column", "nope"],
+            t.path(),
+        ),
+        &["--column nope"],
+    );
+}
