@@ -191,6 +191,31 @@ impl ContactList {
         &self.partner[self.start[i] as usize..self.start[i + 1] as usize]
     }
 
+    /// Only the slots with non-zero springs (the touching pairs), in a compact list; the rest
+    /// of the memory is freed. Used to carry the contact history across a rebuild.
+    fn touching(self) -> ContactList {
+        let n = self.start.len().saturating_sub(1);
+        let mut start = Vec::with_capacity(n + 1);
+        let mut partner = Vec::new();
+        let mut springs = Vec::new();
+        start.push(0u32);
+        for i in 0..n {
+            for k in self.start[i] as usize..self.start[i + 1] as usize {
+                if self.springs[k] != Springs::default() {
+                    partner.push(self.partner[k]);
+                    springs.push(self.springs[k]);
+                }
+            }
+            start.push(partner.len() as u32);
+        }
+        ContactList {
+            start,
+            owner: Vec::new(),
+            partner,
+            springs,
+        }
+    }
+
     /// A new list from per-owner partner runs (`start`, `partner` in compressed form, each
     /// run sorted), carrying over the springs of pairs that were listed before.
     fn rebuild(&self, start: Vec<u32>, partner: Vec<u32>) -> ContactList {
@@ -286,6 +311,9 @@ impl Neighbours {
     /// index), which searches as many cells as its own reach needs.
     pub fn rebuild(&mut self, x: &[DVec3], radius: &[f64], faces: &[Face], face_grid: &CellGrid) {
         let n = x.len();
+        // Keep only the history of touching pairs while the new lists are built.
+        let old_pairs = std::mem::take(&mut self.pairs).touching();
+        let old_faces = std::mem::take(&mut self.faces).touching();
         let skin = self.skin;
         let max_r = radius.iter().copied().fold(0.0, f64::max);
         let typical_r = if n > 0 {
@@ -384,7 +412,7 @@ impl Neighbours {
             pairs.par_sort_unstable();
         }
         let (start, partner) = compress(n, pairs.iter().map(|&k| ((k >> 32) as u32, k as u32)));
-        self.pairs = self.pairs.rebuild(start, partner);
+        self.pairs = old_pairs.rebuild(start, partner);
 
         // Reverse index by counting sort over partners (keeps slots in ascending order).
         let mut count = vec![0u32; n + 1];
@@ -429,7 +457,7 @@ impl Neighbours {
                 .enumerate()
                 .flat_map(|(i, run)| run.iter().map(move |&f| (i as u32, f))),
         );
-        self.faces = self.faces.rebuild(start, partner);
+        self.faces = old_faces.rebuild(start, partner);
 
         self.x_at_build = x.to_vec();
         self.rebuilds += 1;
