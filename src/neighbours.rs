@@ -484,6 +484,16 @@ pub fn face_grid(faces: &[Face], max_radius: f64, skin: f64) -> CellGrid {
 mod tests {
     use super::*;
 
+    /// The listed particle pairs, as (owner, partner).
+    fn listed(nb: &Neighbours) -> Vec<(u32, u32)> {
+        let p = &nb.pairs;
+        p.owner
+            .iter()
+            .copied()
+            .zip(p.partner.iter().copied())
+            .collect()
+    }
+
     /// Brute-force pairs within reach, as (i, j) with i < j.
     fn brute(x: &[DVec3], radius: &[f64], skin: f64) -> Vec<(u32, u32)> {
         let mut v = Vec::new();
@@ -513,14 +523,7 @@ mod tests {
             .collect();
         let mut nb = Neighbours::new(0.001);
         nb.rebuild(&x, &radius, &[], &CellGrid::default());
-        let listed: Vec<(u32, u32)> = nb
-            .pairs
-            .owner
-            .iter()
-            .copied()
-            .zip(nb.pairs.partner.iter().copied())
-            .collect();
-        assert_eq!(listed, brute(&x, &radius, 0.001));
+        assert_eq!(listed(&nb), brute(&x, &radius, 0.001));
     }
 
     #[test]
@@ -540,22 +543,8 @@ mod tests {
             .collect();
         let mut nb = Neighbours::new(0.002);
         nb.rebuild(&x, &radius, &[], &CellGrid::default());
-        let mut brute = Vec::new();
-        for i in 0..x.len() {
-            for j in i + 1..x.len() {
-                if x[i].distance(x[j]) < radius[i] + radius[j] + 0.002 {
-                    brute.push((i as u32, j as u32));
-                }
-            }
-        }
-        let listed: Vec<(u32, u32)> = nb
-            .pairs
-            .owner
-            .iter()
-            .copied()
-            .zip(nb.pairs.partner.iter().copied())
-            .collect();
-        assert_eq!(listed, brute);
+        let brute = brute(&x, &radius, 0.002);
+        assert_eq!(listed(&nb), brute);
         // The reverse index names every slot once, under its partner.
         for j in 0..x.len() {
             for &slot in
