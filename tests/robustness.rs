@@ -1,20 +1,15 @@
 //! Faults: unstable runs stop loudly, interrupted runs resume bit for bit, killed runs
 //! leave only complete files.
 
+mod common;
+
+use common::tinydem;
 use std::path::Path;
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use tinydem::checkpoint;
 use tinydem::csv::load_particles;
-
-fn tinydem(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tinydem"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("binary runs")
-}
 
 const HEADER: &str = "x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz\n";
 

@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
 
 use tinydem::scenario::Scenario;
 use tinydem::simulation::Simulation;
@@ -24,4 +25,13 @@ pub fn simulate(text: &str, steps: u64) -> Simulation {
         sim.step().unwrap();
     }
     sim
+}
+
+/// Runs the `tinydem` binary with `args` in `dir`.
+pub fn tinydem(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_tinydem"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("binary runs")
 }
