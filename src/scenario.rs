@@ -556,6 +556,23 @@ impl Scenario {
             spawn_attempts: s.spawn_attempts.unwrap_or(100),
             seed: s.seed.unwrap_or(1),
         };
+        if simulation.spawn_attempts > 1_000_000_000 {
+            bail!(
+                "[simulation] spawn_attempts = {} is too large: at most 1000000000 per time step",
+                simulation.spawn_attempts
+            );
+        }
+        if simulation
+            .frames
+            .checked_mul(simulation.steps_per_frame)
+            .is_none_or(|n| n > 1 << 53)
+        {
+            bail!(
+                "[simulation] frames x steps_per_frame = {} x {} is too many time steps (at most 2^53)",
+                simulation.frames,
+                simulation.steps_per_frame
+            );
+        }
         if simulation.max_particles > u32::MAX as u64 / 2 {
             bail!(
                 "[simulation] max_particles = {} is too large: at most {}",
