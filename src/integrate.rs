@@ -19,7 +19,7 @@ pub struct Inertia {
 impl Inertia {
     #[inline]
     pub fn new(radius: f64, density: f64, viscosity: f64) -> Inertia {
-        let m = 4.0 / 3.0 * std::f64::consts::PI * density * radius.powi(3);
+        let m = Inertia::mass(radius, density);
         let c = 9.0 * viscosity / (2.0 * density * radius * radius); // Eq. (3)
         Inertia {
             m,

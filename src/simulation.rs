@@ -181,16 +181,7 @@ impl Simulation {
         sim.time = sim.steps as f64 * sim.scenario.simulation.timestep;
         sim.spawner = Spawner::resume(sim.scenario.simulation.seed, snapshot.spawner);
         sim.move_meshes();
-        let max_radius = sim
-            .scenario
-            .geometry
-            .radius_max
-            .max(sim.particles.max_radius());
-        sim.face_grid = face_grid(&sim.mesh.faces, max_radius, sim.neighbours.skin);
-        let p = &sim.particles;
-        sim.neighbours
-            .rebuild(&p.x, &p.radius, &sim.mesh.faces, &sim.face_grid);
-        sim.mark_mesh_built();
+        sim.rebuild_lists(true);
         sim.neighbours
             .pairs
             .restore(&snapshot.pair_history)
@@ -418,10 +409,15 @@ impl Simulation {
 
     /// Stage 2 (Section 3.3): rebuild the Verlet lists when they may miss a contact.
     fn update_neighbours(&mut self) {
-        if !self.neighbours.stale(&self.particles.x, self.mesh_drift) {
-            return;
+        if self.neighbours.stale(&self.particles.x, self.mesh_drift) {
+            self.rebuild_lists(!self.moving.is_empty());
         }
-        if !self.moving.is_empty() {
+    }
+
+    /// Rebuilds the Verlet lists, re-binning the faces first if `regrid_faces` (they moved,
+    /// or larger particles appeared).
+    fn rebuild_lists(&mut self, regrid_faces: bool) {
+        if regrid_faces {
             let g = &self.scenario.geometry;
             let max_radius = g.radius_max.max(self.particles.max_radius());
             self.face_grid = face_grid(&self.mesh.faces, max_radius, self.neighbours.skin);

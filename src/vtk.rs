@@ -37,26 +37,19 @@ trait VtkType: Copy {
     fn put(self, out: &mut Vec<u8>);
 }
 
-impl VtkType for f64 {
-    const NAME: &'static str = "Float64";
-    fn put(self, out: &mut Vec<u8>) {
-        out.extend_from_slice(&self.to_le_bytes());
-    }
+/// Little-endian numbers of the named VTK type.
+macro_rules! vtk_number {
+    ($($t:ty => $name:literal),*) => {$(
+        impl VtkType for $t {
+            const NAME: &'static str = $name;
+            fn put(self, out: &mut Vec<u8>) {
+                out.extend_from_slice(&self.to_le_bytes());
+            }
+        }
+    )*};
 }
 
-impl VtkType for i64 {
-    const NAME: &'static str = "Int64";
-    fn put(self, out: &mut Vec<u8>) {
-        out.extend_from_slice(&self.to_le_bytes());
-    }
-}
-
-impl VtkType for u32 {
-    const NAME: &'static str = "UInt32";
-    fn put(self, out: &mut Vec<u8>) {
-        out.extend_from_slice(&self.to_le_bytes());
-    }
-}
+vtk_number!(f64 => "Float64", i64 => "Int64", u32 => "UInt32");
 
 impl VtkType for u8 {
     const NAME: &'static str = "UInt8";
