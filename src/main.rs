@@ -11,6 +11,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use tinydem::render::{ColorBy, Style, View};
 use tinydem::run::{Interrupted, Options, Summary, Verbosity, describe, run};
 use tinydem::scenario::Scenario;
+use tinydem::simulation::Stage;
 
 /// A granular DEM simulator (the model of the TinyDEM paper). With no arguments, runs the
 /// paper's default simulation: 1000 particles falling through an hourglass, into ./output.
@@ -277,6 +278,25 @@ fn report(summary: &Summary, out: &std::path::Path) {
         out.display(),
         summary.wall_seconds
     );
+    let times = &summary.stage_times;
+    let mut parts: Vec<(&str, f64)> = Stage::ALL
+        .iter()
+        .map(|&stage| (stage.name(), times.of(stage)))
+        .collect();
+    parts.push(("output", summary.output_seconds));
+    let other = summary.wall_seconds - times.total() - summary.output_seconds;
+    parts.push(("other", other.max(0.0)));
+    let shown: Vec<String> = parts
+        .iter()
+        .filter(|(_, s)| *s >= 0.0005 * summary.wall_seconds)
+        .map(|(name, s)| {
+            format!(
+                "{name} {s:.2} s ({:.0}%)",
+                100.0 * s / summary.wall_seconds.max(1e-9)
+            )
+        })
+        .collect();
+    eprintln!("time: {}", shown.join(", "));
 }
 
 /// Runs every (size, workers) configuration in a child process, so that each reports its

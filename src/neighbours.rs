@@ -21,7 +21,7 @@ use crate::contact::Springs;
 use crate::mesh::Face;
 
 /// Below this many items a parallel loop runs on one thread (spawn overhead dominates).
-pub const MIN_PARALLEL_LEN: usize = 512;
+pub const MIN_PARALLEL_LEN: usize = 64;
 
 const CELL_BIAS: i32 = 1 << 20;
 

@@ -13,7 +13,7 @@ use crate::contact::ContactLaw;
 use crate::csv::{frame_name, write_frame};
 use crate::integrate::Inertia;
 use crate::scenario::{Formats, MeshSource, Scenario};
-use crate::simulation::Simulation;
+use crate::simulation::{Simulation, StageTimes};
 
 /// Name of the checkpoint file in the output directory.
 pub const CHECKPOINT: &str = "checkpoint.bin";
@@ -49,6 +49,9 @@ pub struct Summary {
     /// Neighbour-list rebuilds.
     pub rebuilds: u64,
     pub wall_seconds: f64,
+    /// Wall time per stage of the step, and for writing frames and checkpoints.
+    pub stage_times: StageTimes,
+    pub output_seconds: f64,
 }
 
 /// A run stopped on request, with its checkpoint written.
@@ -163,6 +166,7 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
     };
     out.start(&sim)?;
     let mut frames_written = 0;
+    let mut output_seconds = 0.0;
     if options.resume.is_none() {
         out.write(0, &sim)?;
         frames_written += 1;
@@ -217,6 +221,7 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
             );
         }
         if sim.steps.is_multiple_of(steps_per_frame) {
+            let t = Instant::now();
             let frame = sim.steps / steps_per_frame;
             out.write(frame, &sim)?;
             frames_written += 1;
@@ -228,6 +233,7 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
                     fingerprint(&sim),
                 )?;
             }
+            output_seconds += t.elapsed().as_secs_f64();
         }
         if let Some(bar) = bar.as_ref().filter(|_| sim.steps.is_multiple_of(100)) {
             bar.set_position(sim.steps);
@@ -257,6 +263,8 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
         steps: sim.steps,
         rebuilds: sim.rebuilds(),
         wall_seconds: start.elapsed().as_secs_f64(),
+        stage_times: sim.stage_times.clone(),
+        output_seconds,
     })
 }
 

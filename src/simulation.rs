@@ -6,6 +6,7 @@
 //! ```
 
 use std::sync::Mutex;
+use std::time::Instant;
 
 use anyhow::{Result, bail};
 use glam::DVec3;
@@ -25,6 +26,69 @@ use crate::spawn::{Spawner, SpawnerState};
 fn forget(springs: &mut Springs) {
     if *springs != Springs::default() {
         *springs = Springs::default();
+    }
+}
+
+/// The stages of a step, for the timing breakdown.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stage {
+    MoveMeshes,
+    Spawn,
+    Neighbours,
+    ParticleContacts,
+    MeshContacts,
+    Integrate,
+    Tag,
+    Stability,
+}
+
+impl Stage {
+    pub const ALL: [Stage; 8] = [
+        Stage::MoveMeshes,
+        Stage::Spawn,
+        Stage::Neighbours,
+        Stage::ParticleContacts,
+        Stage::MeshContacts,
+        Stage::Integrate,
+        Stage::Tag,
+        Stage::Stability,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Stage::MoveMeshes => "move meshes",
+            Stage::Spawn => "spawn",
+            Stage::Neighbours => "neighbour lists",
+            Stage::ParticleContacts => "particle contacts",
+            Stage::MeshContacts => "mesh contacts",
+            Stage::Integrate => "integrate",
+            Stage::Tag => "tag",
+            Stage::Stability => "stability check",
+        }
+    }
+}
+
+/// Wall time spent in each stage of the step so far [s].
+#[derive(Clone, Debug, Default)]
+pub struct StageTimes {
+    seconds: [f64; Stage::ALL.len()],
+}
+
+impl StageTimes {
+    fn add(&mut self, stage: Stage, since: Instant) -> Instant {
+        let now = Instant::now();
+        self.seconds[stage as usize] += (now - since).as_secs_f64();
+        now
+    }
+
+    /// Seconds spent in `stage`.
+    pub fn of(&self, stage: Stage) -> f64 {
+        self.seconds[stage as usize]
+    }
+
+    /// Seconds spent in all stages.
+    pub fn total(&self) -> f64 {
+        self.seconds.iter().sum()
     }
 }
 
@@ -123,6 +187,8 @@ pub struct Simulation {
     /// Simulated time [T] and number of steps taken.
     pub time: f64,
     pub steps: u64,
+    /// Wall time per stage.
+    pub stage_times: StageTimes,
 }
 
 impl Simulation {
@@ -223,6 +289,7 @@ impl Simulation {
             mesh_drift: 0.0,
             time: 0.0,
             steps: 0,
+            stage_times: StageTimes::default(),
             scenario,
             particles,
             mesh,
@@ -251,16 +318,26 @@ impl Simulation {
     /// Fails, leaving the state as computed, when the run has become unstable: an overlap
     /// deeper than the smaller radius, or a non-finite position or velocity.
     pub fn step(&mut self) -> Result<(), Unstable> {
+        let t = Instant::now();
         self.move_meshes();
+        let t = self.stage_times.add(Stage::MoveMeshes, t);
         self.spawn();
+        let t = self.stage_times.add(Stage::Spawn, t);
         self.update_neighbours();
+        let t = self.stage_times.add(Stage::Neighbours, t);
         let mut deep = self.particle_contacts();
+        let t = self.stage_times.add(Stage::ParticleContacts, t);
         deep.extend(self.mesh_contacts());
+        let t = self.stage_times.add(Stage::MeshContacts, t);
         self.integrate();
+        let t = self.stage_times.add(Stage::Integrate, t);
         self.tag();
+        let t = self.stage_times.add(Stage::Tag, t);
         self.steps += 1;
         self.time = self.steps as f64 * self.scenario.simulation.timestep;
-        self.check_stability(deep)
+        let result = self.check_stability(deep);
+        self.stage_times.add(Stage::Stability, t);
+        result
     }
 
     /// Stage 5b: particles whose centre is inside a `[[tags]]` box take its tag.

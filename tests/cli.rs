@@ -434,3 +434,28 @@ fn analyze_prints_a_table_and_writes_csv_and_plot() {
         &["--column nope"],
     );
 }
+
+#[test]
+fn a_run_reports_where_its_time_went() {
+    let dir = tempfile::tempdir().unwrap();
+    write(
+        dir.path(),
+        "s.toml",
+        "[geometry]\nspawn_min = [0, 0, 0]\nspawn_max = [0.1, 0.1, 0.1]\n\
+         [simulation]\nmax_particles = 50\nframes = 2\nsteps_per_frame = 100\n",
+    );
+    let o = tinydem(&["run", "s.toml", "--output", "out"], dir.path());
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    let line = err
+        .lines()
+        .find(|l| l.starts_with("time: "))
+        .unwrap_or_else(|| panic!("no time line in\n{err}"));
+    for stage in ["particle contacts", "integrate", "output"] {
+        assert!(line.contains(stage), "{stage} missing from {line}");
+    }
+    // Quiet runs stay quiet.
+    let o = tinydem(&["run", "s.toml", "-q", "--output", "out2"], dir.path());
+    assert!(o.status.success());
+    assert!(stderr(&o).is_empty(), "{}", stderr(&o));
+}
