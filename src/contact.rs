@@ -91,7 +91,11 @@ pub struct Kinematics {
 /// normal instead of NaN.
 #[inline]
 fn unit(d: DVec3, dist: f64) -> DVec3 {
-    if dist > 0.0 { d / dist } else { DVec3::Z }
+    if dist > 0.0 {
+        d * dist.recip()
+    } else {
+        DVec3::Z
+    }
 }
 
 impl Kinematics {
@@ -218,19 +222,29 @@ impl ContactLaw {
             v,
             omega,
         } = *kin;
-        // Effective quantities; for a wall R_j = m_j = r_j = ∞.
-        let (r_star, m_star, e_star, g_star, r_roll) = match other {
+        // Effective quantities; for a wall R_j = m_j = r_j = ∞. The four quotients of a
+        // particle pair share one division (it costs as much as a dozen multiplications):
+        // with A = (R_i + R_j)(m_i + m_j) and B = r_i (r_i + r_j), 1/A = B/(AB), 1/B = A/(AB).
+        let (r_star, m_star, e_star, g_star, r_roll, r_j_per_r_i) = match other {
             Other::Particle {
                 r: radius_j,
                 m: m_j,
-            } => (
-                radius_i * radius_j / (radius_i + radius_j), // Eq. (17)
-                m_i * m_j / (m_i + m_j),                     // Eq. (20)
-                self.e_star_pp,
-                self.g_star_pp,
-                r_i * r_j / (r_i + r_j), // (1/r_i + 1/r_j)^-1 of Eq. (36)
-            ),
-            Other::Wall => (radius_i, m_i, self.e_star_pw, self.g_star_pw, r_i),
+            } => {
+                let (sum_r, sum_m, sum_contact) = (radius_i + radius_j, m_i + m_j, r_i + r_j);
+                let a = sum_r * sum_m;
+                let b = r_i * sum_contact;
+                let inv_ab = (a * b).recip();
+                let (inv_a, inv_b) = (b * inv_ab, a * inv_ab);
+                (
+                    radius_i * radius_j * sum_m * inv_a, // Eq. (17)
+                    m_i * m_j * sum_r * inv_a,           // Eq. (20)
+                    self.e_star_pp,
+                    self.g_star_pp,
+                    r_i * r_i * r_j * inv_b, // (1/r_i + 1/r_j)^-1 of Eq. (36)
+                    r_j * sum_contact * inv_b,
+                )
+            }
+            Other::Wall => (radius_i, m_i, self.e_star_pw, self.g_star_pw, r_i, 0.0),
         };
 
         let a = (r_star * delta).sqrt(); // Eq. (14)
@@ -289,7 +303,7 @@ impl ContactLaw {
             tau_i: tau_s + tau_r + tau_t,
             // A wall takes no reaction torque; avoid ∞ · 0 there.
             tau_j: match other {
-                Other::Particle { .. } => r_j / r_i * tau_s - tau_r - tau_t, // Eqs. (58)-(60)
+                Other::Particle { .. } => r_j_per_r_i * tau_s - tau_r - tau_t, // Eqs. (58)-(60)
                 Other::Wall => DVec3::ZERO,
             },
         }
