@@ -277,6 +277,9 @@ pub struct Neighbours {
     pub faces: ContactList,
     /// Positions at the last rebuild.
     x_at_build: Vec<DVec3>,
+    /// Particles with nothing within reach at the last rebuild, each with how far it may
+    /// move before the lists can miss a contact (half its clearance, at least skin / 2).
+    lonely: Vec<(u32, f64)>,
     /// Number of rebuilds so far.
     pub rebuilds: u64,
 }
@@ -297,10 +300,65 @@ impl Neighbours {
             return true;
         }
         let limit = (0.5 * self.skin - mesh_drift).powi(2);
-        x.par_iter()
+        let moved = |(a, b): (&DVec3, &DVec3)| (*a - *b).length_squared();
+        let any_far = x
+            .par_iter()
             .zip(self.x_at_build.par_iter())
             .with_min_len(4 * MIN_PARALLEL_LEN)
-            .any(|(a, b)| (*a - *b).length_squared() > limit || !a.is_finite())
+            .any(|pair| moved(pair) > limit || !pair.0.is_finite());
+        if !any_far {
+            return false;
+        }
+        if self.lonely.is_empty() {
+            return true;
+        }
+        // Some particle moved more than skin / 2: stale unless every such particle is a
+        // lonely one still within its own allowance.
+        let mut lonely = self.lonely.iter().peekable();
+        (0..x.len()).any(|i| {
+            let d2 = moved((&x[i], &self.x_at_build[i]));
+            while lonely.next_if(|&&(k, _)| (k as usize) < i).is_some() {}
+            match lonely.peek() {
+                Some(&&(k, allowance)) if k as usize == i => {
+                    d2 > (allowance - mesh_drift).powi(2) || !x[i].is_finite()
+                }
+                _ => d2 > limit || !x[i].is_finite(),
+            }
+        })
+    }
+
+    /// The lonely particles of the new lists and their allowances: a particle with no
+    /// listed partner is at least `skin` from every other body (its clearance c). Allowing
+    /// it to move c / 2 keeps every unlisted pair apart: two lonely particles move at most
+    /// (c_i + c_j) / 2 <= max(c_i, c_j), a lonely and an ordinary one c_i / 2 + skin / 2
+    /// <= c_i. Clearances are found by brute force, so only while that stays cheap.
+    fn find_lonely(&mut self, x: &[DVec3], radius: &[f64], faces: &[Face]) {
+        let n = x.len();
+        let listed = |i: usize| {
+            self.pairs.start[i] != self.pairs.start[i + 1]
+                || self.reverse_start[i] != self.reverse_start[i + 1]
+                || self.faces.start[i] != self.faces.start[i + 1]
+        };
+        let candidates: Vec<usize> = (0..n).filter(|&i| !listed(i)).collect();
+        const BUDGET: usize = 4_000_000;
+        if candidates.is_empty() || candidates.len() * (n + faces.len()) > BUDGET {
+            self.lonely = Vec::new();
+            return;
+        }
+        self.lonely = candidates
+            .par_iter()
+            .map(|&i| {
+                let (xi, ri) = (x[i], radius[i]);
+                let mut clearance = f64::INFINITY;
+                for j in (0..n).filter(|&j| j != i) {
+                    clearance = clearance.min(xi.distance(x[j]) - ri - radius[j]);
+                }
+                for face in faces {
+                    clearance = clearance.min(face.separation(xi).length() - ri - face.radius);
+                }
+                (i as u32, (0.5 * clearance).max(0.5 * self.skin))
+            })
+            .collect();
     }
 
     /// Rebuilds both lists for particles at `x` with radii `radius`.
@@ -459,6 +517,7 @@ impl Neighbours {
         );
         self.faces = old_faces.rebuild(start, partner);
 
+        self.find_lonely(x, radius, faces);
         self.x_at_build = x.to_vec();
         self.rebuilds += 1;
     }
@@ -554,5 +613,45 @@ mod tests {
             }
         }
         assert_eq!(nb.reverse_slot.len(), brute.len());
+    }
+
+    #[test]
+    fn a_lonely_particle_may_move_half_its_clearance() {
+        // A particle 0.5 m from a small cluster falls towards it in 1 mm steps.
+        let radius = vec![0.01; 4];
+        let mut x = vec![
+            DVec3::new(0.0, 0.0, 0.5),
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(0.02, 0.0, 0.0),
+            DVec3::new(-0.02, 0.0, 0.0),
+        ];
+        let skin = 0.005;
+        let mut nb = Neighbours::new(skin);
+        nb.rebuild(&x, &radius, &[], &CellGrid::default());
+        assert_eq!(nb.lonely.len(), 1, "{:?}", nb.lonely);
+        let mut rebuilds = 0;
+        while x[0].z > 0.015 {
+            x[0].z -= 0.001;
+            if nb.stale(&x, 0.0) {
+                nb.rebuild(&x, &radius, &[], &CellGrid::default());
+                rebuilds += 1;
+            }
+            // Whatever touches is listed.
+            if x[0].distance(x[1]) < 0.02 {
+                assert_eq!(
+                    &nb.pairs.partner[..1],
+                    &[1],
+                    "contact missed at z = {}",
+                    x[0].z
+                );
+            }
+        }
+        // Skin / 2 alone would rebuild every 3 steps (160 times).
+        assert!(rebuilds < 20, "{rebuilds} rebuilds");
+        // An ordinary particle still triggers a rebuild after skin / 2.
+        let mut nb = Neighbours::new(skin);
+        nb.rebuild(&x, &radius, &[], &CellGrid::default());
+        x[2].x += 0.6 * skin;
+        assert!(nb.stale(&x, 0.0));
     }
 }
