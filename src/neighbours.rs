@@ -295,17 +295,21 @@ impl Neighbours {
     /// Whether the lists must be rebuilt: the particle count changed, or some particle moved
     /// more than half the skin, less `mesh_drift` (how far a moving face has moved), since
     /// the last rebuild.
-    pub fn stale(&self, x: &[DVec3], mesh_drift: f64) -> bool {
+    ///
+    /// A lonely particle past its allowance that is still lonely is re-anchored where it
+    /// is instead (see [`Neighbours::reanchor`]), which costs one pass over the particles
+    /// rather than a rebuild.
+    pub fn stale(&mut self, x: &[DVec3], radius: &[f64], faces: &[Face], mesh_drift: f64) -> bool {
         if x.len() != self.x_at_build.len() || mesh_drift >= 0.5 * self.skin {
             return true;
         }
         let limit = (0.5 * self.skin - mesh_drift).powi(2);
-        let moved = |(a, b): (&DVec3, &DVec3)| (*a - *b).length_squared();
+        let moved = |a: DVec3, b: DVec3| (a - b).length_squared();
         let any_far = x
             .par_iter()
             .zip(self.x_at_build.par_iter())
             .with_min_len(4 * MIN_PARALLEL_LEN)
-            .any(|pair| moved(pair) > limit || !pair.0.is_finite());
+            .any(|(a, b)| moved(*a, *b) > limit || !a.is_finite());
         if !any_far {
             return false;
         }
@@ -313,18 +317,74 @@ impl Neighbours {
             return true;
         }
         // Some particle moved more than skin / 2: stale unless every such particle is a
-        // lonely one still within its own allowance.
-        let mut lonely = self.lonely.iter().peekable();
-        (0..x.len()).any(|i| {
-            let d2 = moved((&x[i], &self.x_at_build[i]));
-            while lonely.next_if(|&&(k, _)| (k as usize) < i).is_some() {}
-            match lonely.peek() {
-                Some(&&(k, allowance)) if k as usize == i => {
-                    d2 > (allowance - mesh_drift).powi(2) || !x[i].is_finite()
-                }
-                _ => d2 > limit || !x[i].is_finite(),
+        // lonely one within its own allowance, or one that can be re-anchored.
+        let mut k = 0;
+        for i in 0..x.len() {
+            while k < self.lonely.len() && (self.lonely[k].0 as usize) < i {
+                k += 1;
             }
-        })
+            let d2 = moved(x[i], self.x_at_build[i]);
+            if !x[i].is_finite() {
+                return true;
+            }
+            match self.lonely.get(k).copied() {
+                Some((j, allowance))
+                    if j as usize == i
+                        && d2 > (allowance - mesh_drift).powi(2)
+                        && !self.reanchor(k, x, radius, faces, mesh_drift) =>
+                {
+                    return true;
+                }
+                Some((j, _)) if j as usize == i => {}
+                _ if d2 > limit => return true,
+                _ => {}
+            }
+        }
+        false
+    }
+
+    /// Re-anchors lonely particle `self.lonely[k]` at its current position if it is still
+    /// at least a skin from where any other body can be before the next rebuild: particle
+    /// j anywhere within its allowance a_j of its anchor, faces anywhere within skin / 2 of
+    /// where they are. With c the smallest such gap, the particle may then move c / 2; no
+    /// other particle's allowance relied on where it was. Returns false (a rebuild is
+    /// needed) if it is not, or if the brute-force search would be too costly.
+    fn reanchor(
+        &mut self,
+        k: usize,
+        x: &[DVec3],
+        radius: &[f64],
+        faces: &[Face],
+        mesh_drift: f64,
+    ) -> bool {
+        const BUDGET: usize = 200_000;
+        if x.len() + faces.len() > BUDGET {
+            return false;
+        }
+        let i = self.lonely[k].0 as usize;
+        let (xi, ri) = (x[i], radius[i]);
+        let half_skin = 0.5 * self.skin;
+        let mut lonely = self.lonely.iter().peekable();
+        let mut clearance = f64::INFINITY;
+        for (j, (&anchor, &rj)) in self.x_at_build.iter().zip(radius).enumerate() {
+            let allowance = match lonely.next_if(|&&(l, _)| l as usize == j) {
+                Some(&(_, a)) => a,
+                None => half_skin,
+            };
+            if j != i {
+                clearance = clearance.min(xi.distance(anchor) - ri - rj - allowance);
+            }
+        }
+        for face in faces {
+            let gap = face.separation(xi).length() - ri - face.radius - half_skin;
+            clearance = clearance.min(gap);
+        }
+        if clearance < self.skin || mesh_drift > 0.0 {
+            return false;
+        }
+        self.x_at_build[i] = xi;
+        self.lonely[k].1 = 0.5 * clearance;
+        true
     }
 
     /// The lonely particles of the new lists and their allowances: a particle with no
@@ -442,7 +502,7 @@ impl Neighbours {
                     let m = cells_needed(i);
                     if m == 1 {
                         for &j in near.iter().flat_map(|r| r.iter()) {
-                            if finds(i, j) && close(i, j) {
+                            if finds(i, j) & close(i, j) {
                                 pairs.push(key(i, j));
                             }
                         }
@@ -451,7 +511,7 @@ impl Neighbours {
                             for dy in -m..=m {
                                 for dx in -m..=m {
                                     for &j in grid.in_cell(c + IVec3::new(dx, dy, dz)) {
-                                        if finds(i, j) && close(i, j) {
+                                        if finds(i, j) & close(i, j) {
                                             pairs.push(key(i, j));
                                         }
                                     }
@@ -632,7 +692,7 @@ mod tests {
         let mut rebuilds = 0;
         while x[0].z > 0.015 {
             x[0].z -= 0.001;
-            if nb.stale(&x, 0.0) {
+            if nb.stale(&x, &radius, &[], 0.0) {
                 nb.rebuild(&x, &radius, &[], &CellGrid::default());
                 rebuilds += 1;
             }
@@ -652,6 +712,29 @@ mod tests {
         let mut nb = Neighbours::new(skin);
         nb.rebuild(&x, &radius, &[], &CellGrid::default());
         x[2].x += 0.6 * skin;
-        assert!(nb.stale(&x, 0.0));
+        assert!(nb.stale(&x, &radius, &[], 0.0));
+    }
+
+    #[test]
+    fn two_lonely_particles_meeting_head_on_are_listed_before_they_touch() {
+        let radius = vec![0.01; 2];
+        let mut x = vec![DVec3::new(-0.5, 0.0, 0.0), DVec3::new(0.5, 0.0, 0.0)];
+        let mut nb = Neighbours::new(0.005);
+        nb.rebuild(&x, &radius, &[], &CellGrid::default());
+        assert_eq!(nb.lonely.len(), 2);
+        let mut rebuilds = 0;
+        for _ in 0..600 {
+            x[0].x += 0.001;
+            x[1].x -= 0.0013;
+            if nb.stale(&x, &radius, &[], 0.0) {
+                nb.rebuild(&x, &radius, &[], &CellGrid::default());
+                rebuilds += 1;
+            }
+            if x[0].distance(x[1]) < 0.02 {
+                assert_eq!(nb.pairs.partner, vec![1], "contact missed at {:?}", x);
+            }
+        }
+        assert!(x[0].x > x[1].x, "they passed through each other's place");
+        assert!(rebuilds < 150, "{rebuilds} rebuilds");
     }
 }

@@ -486,7 +486,11 @@ impl Simulation {
 
     /// Stage 2 (Section 3.3): rebuild the Verlet lists when they may miss a contact.
     fn update_neighbours(&mut self) {
-        if self.neighbours.stale(&self.particles.x, self.mesh_drift) {
+        let p = &self.particles;
+        if self
+            .neighbours
+            .stale(&p.x, &p.radius, &self.mesh.faces, self.mesh_drift)
+        {
             self.rebuild_lists(!self.moving.is_empty());
         }
     }
