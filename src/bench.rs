@@ -15,7 +15,7 @@ use glam::DVec3;
 use crate::mesh::Mesh;
 use crate::particles::Particles;
 use crate::scenario::Scenario;
-use crate::simulation::Simulation;
+use crate::simulation::{Simulation, Stage};
 
 /// The material and time step of the benchmark (`shared/bench/README.md`).
 pub const SCENARIO: &str = "\
@@ -105,6 +105,10 @@ pub struct Measurement {
     pub contacts_per_particle: f64,
     /// Verlet-list entries (pairs and particle-face pairs) per particle.
     pub slots_per_particle: f64,
+    /// Shares of the timed wall time spent on the neighbour lists (checks and rebuilds)
+    /// and on particle-particle contacts.
+    pub lists_share: f64,
+    pub pairs_share: f64,
 }
 
 /// Reads a field of `/proc/self/status` in bytes (Linux); 0 elsewhere.
@@ -134,6 +138,8 @@ pub fn measure(n: usize, steps: u64, repeats: usize) -> Result<Measurement> {
         sim.step()?; // warm-up: first neighbour lists, caches
     }
     let rebuilds_before = sim.rebuilds();
+    let stages_before = sim.stage_times.clone();
+    let timed = Instant::now();
     let mut times = Vec::with_capacity(repeats);
     for _ in 0..repeats {
         let t = Instant::now();
@@ -142,6 +148,11 @@ pub fn measure(n: usize, steps: u64, repeats: usize) -> Result<Measurement> {
         }
         times.push(t.elapsed().as_secs_f64() / steps as f64);
     }
+    let timed = timed.elapsed().as_secs_f64();
+    let share = |stage: Stage| {
+        (sim.stage_times.of(stage) - stages_before.of(stage)) / timed.max(f64::MIN_POSITIVE)
+    };
+    let (lists_share, pairs_share) = (share(Stage::Neighbours), share(Stage::ParticleContacts));
     times.sort_by(f64::total_cmp);
     let per_step = times[times.len() / 2];
     let peak = proc_status_bytes("VmHWM:");
@@ -159,15 +170,17 @@ pub fn measure(n: usize, steps: u64, repeats: usize) -> Result<Measurement> {
             let (p, f) = sim.list_slots();
             (p + f) as f64 / n as f64
         },
+        lists_share,
+        pairs_share,
     })
 }
 
 impl Measurement {
-    pub const HEADER: &'static str = "       N  threads   ms/step    Cundall   peak MB  B/particle  rebuilds/100  contacts/particle  list/particle";
+    pub const HEADER: &'static str = "       N  threads   ms/step    Cundall   peak MB  B/particle  rebuilds/100  contacts/particle  list/particle  lists %  pairs %";
 
     pub fn row(&self) -> String {
         format!(
-            "{:>8}  {:>7}  {:>8.3}  {:>9.3e}  {:>8.1}  {:>10.0}  {:>12.2}  {:>17.2}  {:>13.2}",
+            "{:>8}  {:>7}  {:>8.3}  {:>9.3e}  {:>8.1}  {:>10.0}  {:>12.2}  {:>17.2}  {:>13.2}  {:>7.0}  {:>7.0}",
             self.n,
             self.threads,
             self.ms_per_step,
@@ -176,7 +189,9 @@ impl Measurement {
             self.bytes_per_particle,
             self.rebuilds_per_100_steps,
             self.contacts_per_particle,
-            self.slots_per_particle
+            self.slots_per_particle,
+            100.0 * self.lists_share,
+            100.0 * self.pairs_share
         )
     }
 }

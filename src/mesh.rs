@@ -49,6 +49,18 @@ impl Face {
         }
     }
 
+    /// Whether `x` is certainly farther than `reach` from the primitive: for a triangle or
+    /// a rectangle, from the distance to its plane alone (a cheap first test).
+    #[inline]
+    pub fn certainly_beyond(&self, x: DVec3, reach: f64) -> bool {
+        match self.shape {
+            Primitive::Triangle { a: p, n, .. } | Primitive::Rectangle { o: p, n, .. } => {
+                (x - p).dot(n).abs() >= reach
+            }
+            Primitive::Point(_) | Primitive::Segment(..) => false,
+        }
+    }
+
     /// Closest point of the (undilated) primitive to `x`.
     pub fn closest_point(&self, x: DVec3) -> DVec3 {
         x - self.separation(x)
@@ -445,6 +457,35 @@ mod tests {
         assert!(matches!(m.faces[17].shape, Primitive::Point(_)));
         assert!(matches!(m.faces[18].shape, Primitive::Segment(..)));
         assert!(matches!(m.faces[0].shape, Primitive::Rectangle { .. }));
+    }
+
+    #[test]
+    fn the_plane_test_never_rejects_a_face_within_reach() {
+        let m = Mesh::parse_off(
+            crate::scenario::HOURGLASS_OFF,
+            "hourglass",
+            &[0.002, 0.02, 0.01],
+        )
+        .unwrap();
+        let mut s = 3u64;
+        let mut rnd = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut rejected = 0;
+        for _ in 0..20_000 {
+            let x = DVec3::new(rnd() * 0.3 - 0.15, rnd() * 0.3 - 0.15, rnd() * 0.35 - 0.02);
+            let reach = 0.05 * rnd();
+            for face in &m.faces {
+                if face.certainly_beyond(x, reach) {
+                    rejected += 1;
+                    assert!(face.separation(x).length() >= reach, "{x} {face:?}");
+                }
+            }
+        }
+        assert!(rejected > 10_000, "the test rejects something: {rejected}");
     }
 
     fn err(text: &str) -> String {

@@ -585,6 +585,11 @@ impl Simulation {
                     v: p.v[i],
                     w: p.w[i],
                 };
+                if face.certainly_beyond(body.x, body.radius + face.radius) {
+                    forget(springs);
+                    *force = ContactForce::default();
+                    return;
+                }
                 let d = face.separation(body.x);
                 let wall = match face_part[f as usize] {
                     STATIC => RigidVelocity::default(),
