@@ -112,7 +112,7 @@ enum Command {
         /// Thread counts to run each size with (default: 1 and all cores).
         #[arg(long = "workers", value_delimiter = ',')]
         workers: Vec<usize>,
-        /// Steps per timed segment (default: about 10^7 particle-steps, at least 10).
+        /// Steps per timed segment (default: about 10^7 particle-steps, at least 100).
         #[arg(long)]
         steps: Option<u64>,
         /// Timed segments per configuration; the median is reported.
