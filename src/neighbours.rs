@@ -25,6 +25,30 @@ pub const MIN_PARALLEL_LEN: usize = 64;
 
 const CELL_BIAS: i32 = 1 << 20;
 
+/// The 13 neighbours of a cell that come after it (z, then y, then x): with the cell itself,
+/// every pair of neighbouring cells once.
+const FORWARD: [IVec3; 13] = {
+    let mut d = [IVec3::ZERO; 13];
+    let mut k = 0;
+    let mut dz = -1;
+    while dz <= 1 {
+        let mut dy = -1;
+        while dy <= 1 {
+            let mut dx = -1;
+            while dx <= 1 {
+                if dz > 0 || (dz == 0 && (dy > 0 || (dy == 0 && dx > 0))) {
+                    d[k] = IVec3::new(dx, dy, dz);
+                    k += 1;
+                }
+                dx += 1;
+            }
+            dy += 1;
+        }
+        dz += 1;
+    }
+    d
+};
+
 /// Integer cell of a position; clamped so that far-flung particles share the outermost
 /// cells (still correct, as pairs are always tested by distance).
 #[inline]
@@ -481,54 +505,83 @@ impl Neighbours {
         // Per occupied cell: the 27 neighbour ranges are looked up once for the cell's
         // particles of ordinary size; larger particles search their own wider block. Each
         // finder's pairs are sorted.
-        let per_cell: Vec<Vec<u64>> = grid
-            .occupied
-            .par_iter()
-            .with_min_len(MIN_PARALLEL_LEN / 16)
-            .map(|&(c, a, b)| {
-                let mut near: [&[u32]; 27] = [&[]; 27];
-                let mut k = 0;
-                for dz in -1..=1 {
-                    for dy in -1..=1 {
-                        for dx in -1..=1 {
-                            near[k] = grid.in_cell(c + IVec3::new(dx, dy, dz));
-                            k += 1;
-                        }
-                    }
-                }
-                let mut pairs = Vec::new();
-                for &i in &grid.items[a as usize..b as usize] {
-                    let first = pairs.len();
-                    let m = cells_needed(i);
-                    if m == 1 {
-                        for &j in near.iter().flat_map(|r| r.iter()) {
-                            if finds(i, j) & close(i, j) {
+        let per_cell: Vec<Vec<u64>> = if uniform {
+            // Cells sized for every pair: each pair of cells is visited once (a cell and
+            // the 13 of its neighbours that come after it), so each pair of particles is
+            // tested once; the pairs are sorted afterwards.
+            grid.occupied
+                .par_iter()
+                .with_min_len(MIN_PARALLEL_LEN / 16)
+                .map(|&(c, a, b)| {
+                    let own = &grid.items[a as usize..b as usize];
+                    let mut pairs = Vec::new();
+                    for (k, &i) in own.iter().enumerate() {
+                        for &j in &own[k + 1..] {
+                            if close(i, j) {
                                 pairs.push(key(i, j));
                             }
                         }
-                    } else {
-                        for dz in -m..=m {
-                            for dy in -m..=m {
-                                for dx in -m..=m {
-                                    for &j in grid.in_cell(c + IVec3::new(dx, dy, dz)) {
-                                        if finds(i, j) & close(i, j) {
-                                            pairs.push(key(i, j));
+                    }
+                    for d in FORWARD {
+                        let other = grid.in_cell(c + d);
+                        for &i in own {
+                            for &j in other {
+                                if close(i, j) {
+                                    pairs.push(key(i, j));
+                                }
+                            }
+                        }
+                    }
+                    pairs
+                })
+                .collect()
+        } else {
+            grid.occupied
+                .par_iter()
+                .with_min_len(MIN_PARALLEL_LEN / 16)
+                .map(|&(c, a, b)| {
+                    let mut near: [&[u32]; 27] = [&[]; 27];
+                    let mut k = 0;
+                    for dz in -1..=1 {
+                        for dy in -1..=1 {
+                            for dx in -1..=1 {
+                                near[k] = grid.in_cell(c + IVec3::new(dx, dy, dz));
+                                k += 1;
+                            }
+                        }
+                    }
+                    let mut pairs = Vec::new();
+                    for &i in &grid.items[a as usize..b as usize] {
+                        let first = pairs.len();
+                        let m = cells_needed(i);
+                        if m == 1 {
+                            for &j in near.iter().flat_map(|r| r.iter()) {
+                                if finds(i, j) & close(i, j) {
+                                    pairs.push(key(i, j));
+                                }
+                            }
+                        } else {
+                            for dz in -m..=m {
+                                for dy in -m..=m {
+                                    for dx in -m..=m {
+                                        for &j in grid.in_cell(c + IVec3::new(dx, dy, dz)) {
+                                            if finds(i, j) & close(i, j) {
+                                                pairs.push(key(i, j));
+                                            }
                                         }
                                     }
                                 }
                             }
                         }
+                        pairs[first..].sort_unstable();
                     }
-                    pairs[first..].sort_unstable();
-                }
-                pairs
-            })
-            .collect();
+                    pairs
+                })
+                .collect()
+        };
         let mut pairs: Vec<u64> = per_cell.into_iter().flatten().collect();
-        if !uniform {
-            // Pairs of one owner came from several finders: bring them together in order.
-            pairs.par_sort_unstable();
-        }
+        // Pairs of one owner came from several cells: bring them together in order.
+        pairs.par_sort_unstable();
         let (start, partner) = compress(n, pairs.iter().map(|&k| ((k >> 32) as u32, k as u32)));
         self.pairs = old_pairs.rebuild(start, partner);
 
