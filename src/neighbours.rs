@@ -502,9 +502,7 @@ impl Neighbours {
         };
         let key = |i: u32, j: u32| ((i.min(j) as u64) << 32) | i.max(j) as u64;
 
-        // Per occupied cell: the 27 neighbour ranges are looked up once for the cell's
-        // particles of ordinary size; larger particles search their own wider block. Each
-        // finder's pairs are sorted.
+        // The pairs found from each occupied cell.
         let per_cell: Vec<Vec<u64>> = if uniform {
             // Cells sized for every pair: each pair of cells is visited once (a cell and
             // the 13 of its neighbours that come after it), so each pair of particles is
@@ -536,6 +534,9 @@ impl Neighbours {
                 })
                 .collect()
         } else {
+            // Cells for ordinary sizes: the 27 neighbour ranges are looked up once for the
+            // cell's particles of ordinary size; larger particles search their own wider
+            // block, and find only partners no larger than themselves.
             grid.occupied
                 .par_iter()
                 .with_min_len(MIN_PARALLEL_LEN / 16)
