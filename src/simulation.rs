@@ -329,13 +329,13 @@ impl Simulation {
         let t = self.stage_times.add(Stage::ParticleContacts, t);
         deep.extend(self.mesh_contacts());
         let t = self.stage_times.add(Stage::MeshContacts, t);
-        self.integrate();
+        let non_finite = self.integrate();
         let t = self.stage_times.add(Stage::Integrate, t);
         self.tag();
         let t = self.stage_times.add(Stage::Tag, t);
         self.steps += 1;
         self.time = self.steps as f64 * self.scenario.simulation.timestep;
-        let result = self.check_stability(deep);
+        let result = self.check_stability(deep, non_finite);
         self.stage_times.add(Stage::Stability, t);
         result
     }
@@ -366,15 +366,12 @@ impl Simulation {
     }
 
     /// Stage 6: stop loudly rather than continue a run that has blown up. `deep` lists the
-    /// overlaps deeper than the smaller radius found in this step's contact stages.
-    fn check_stability(&self, mut deep: Vec<Deep>) -> Result<(), Unstable> {
+    /// overlaps deeper than the smaller radius found in this step's contact stages, `bad`
+    /// whether the integration produced a non-finite state.
+    fn check_stability(&self, mut deep: Vec<Deep>, bad: bool) -> Result<(), Unstable> {
         let p = &self.particles;
         let non_finite =
             |k: usize| !(p.x[k].is_finite() && p.v[k].is_finite() && p.w[k].is_finite());
-        let bad = (0..p.len())
-            .into_par_iter()
-            .with_min_len(4 * MIN_PARALLEL_LEN)
-            .any(non_finite);
         if !bad && deep.is_empty() {
             return Ok(());
         }
@@ -619,7 +616,9 @@ impl Simulation {
 
     /// Stage 5 (Section 2.3): sum each particle's contact forces and torques (Eqs. 1-2,
     /// with the reactions of Eqs. 56-60) and advance it by Δt.
-    fn integrate(&mut self) {
+    /// Returns whether some particle's new state is not finite (for stage 6, so that it
+    /// needs no pass of its own).
+    fn integrate(&mut self) -> bool {
         let s = &self.scenario;
         let (dt, g) = (s.simulation.timestep, s.kinetics.gravity);
         let (density, viscosity) = (s.material.density, s.material.viscosity);
@@ -636,7 +635,7 @@ impl Simulation {
             .into_par_iter()
             .with_min_len(MIN_PARALLEL_LEN)
             .enumerate()
-            .for_each(|(i, (x, v, q, w, &radius))| {
+            .map(|(i, (x, v, q, w, &radius))| {
                 let mut f = DVec3::ZERO;
                 let mut tau = DVec3::ZERO;
                 let own = nb.pairs.start[i] as usize..nb.pairs.start[i + 1] as usize;
@@ -657,6 +656,8 @@ impl Simulation {
                 }
                 let body = Inertia::new(radius, density, viscosity);
                 advance(State { x, v, q, w }, &body, f, tau, g, dt);
-            });
+                !(x.is_finite() && v.is_finite() && w.is_finite())
+            })
+            .reduce(|| false, |a, b| a || b)
     }
 }
