@@ -399,10 +399,7 @@ impl Neighbours {
                 clearance = clearance.min(xi.distance(anchor) - ri - rj - allowance);
             }
         }
-        for face in faces {
-            let gap = face.separation(xi).length() - ri - face.radius - half_skin;
-            clearance = clearance.min(gap);
-        }
+        let clearance = clearance.min(clearance_to_faces(xi, ri, faces) - half_skin);
         if clearance < self.skin || mesh_drift > 0.0 {
             return false;
         }
@@ -437,9 +434,7 @@ impl Neighbours {
                 for j in (0..n).filter(|&j| j != i) {
                     clearance = clearance.min(xi.distance(x[j]) - ri - radius[j]);
                 }
-                for face in faces {
-                    clearance = clearance.min(face.separation(xi).length() - ri - face.radius);
-                }
+                let clearance = clearance.min(clearance_to_faces(xi, ri, faces));
                 (i as u32, (0.5 * clearance).max(0.5 * self.skin))
             })
             .collect();
@@ -476,26 +471,14 @@ impl Neighbours {
         let h = if h > 0.0 { h } else { 1.0 };
         let grid = CellGrid::of_points(x, h);
         let uniform = cell_r == max_r;
-        // Whether i lists its pair with j. With cells for the largest particle: the lower
-        // index, so that each owner's pairs come out together and in order. Otherwise the
-        // larger radius (ties: the lower index), searching its own reach.
+        // With cells for ordinary sizes (not `uniform`): whether i finds its pair with j (the
+        // larger radius, ties: the lower index), and how many cells around its own it must
+        // search (its partners are no larger, so within 2 R_i + skin).
         let finds = |i: u32, j: u32| {
             let (ri, rj) = (radius[i as usize], radius[j as usize]);
-            if uniform {
-                j > i
-            } else {
-                rj < ri || (rj == ri && j > i)
-            }
+            rj < ri || (rj == ri && j > i)
         };
-        // How many cells around its own a particle must search: its partners are no larger,
-        // so they are within 2 R_i + skin.
-        let cells_needed = |i: u32| {
-            if uniform {
-                1
-            } else {
-                ((2.0 * radius[i as usize] + skin) / h).ceil().max(1.0) as i32
-            }
-        };
+        let cells_needed = |i: u32| ((2.0 * radius[i as usize] + skin) / h).ceil().max(1.0) as i32;
         let close = |i: u32, j: u32| {
             let reach = radius[i as usize] + radius[j as usize] + skin;
             (x[i as usize] - x[j as usize]).length_squared() < reach * reach
@@ -553,7 +536,6 @@ impl Neighbours {
                     }
                     let mut pairs = Vec::new();
                     for &i in &grid.items[a as usize..b as usize] {
-                        let first = pairs.len();
                         let m = cells_needed(i);
                         if m == 1 {
                             for &j in near.iter().flat_map(|r| r.iter()) {
@@ -574,7 +556,6 @@ impl Neighbours {
                                 }
                             }
                         }
-                        pairs[first..].sort_unstable();
                     }
                     pairs
                 })
@@ -635,6 +616,14 @@ impl Neighbours {
         self.x_at_build = x.to_vec();
         self.rebuilds += 1;
     }
+}
+
+/// The smallest gap between a particle at `x` of radius `r` and the faces (brute force).
+fn clearance_to_faces(x: DVec3, r: f64, faces: &[Face]) -> f64 {
+    faces
+        .iter()
+        .map(|face| face.separation(x).length() - r - face.radius)
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// The grid of mesh faces for particles up to radius `max_radius`: each face is binned into
