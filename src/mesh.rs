@@ -444,14 +444,18 @@ fn rectangle(v: [DVec3; 4], file: &str, n: usize) -> Result<Primitive> {
 mod tests {
     use super::*;
 
-    #[test]
-    fn hourglass_parses() {
-        let m = Mesh::parse_off(
+    fn hourglass() -> Mesh {
+        Mesh::parse_off(
             crate::scenario::HOURGLASS_OFF,
             "hourglass",
             &[0.002, 0.02, 0.01],
         )
-        .unwrap();
+        .unwrap()
+    }
+
+    #[test]
+    fn hourglass_parses() {
+        let m = hourglass();
         assert_eq!(m.faces.len(), 19);
         assert_eq!(m.faces[17].radius, 0.02);
         assert!(matches!(m.faces[17].shape, Primitive::Point(_)));
@@ -461,12 +465,7 @@ mod tests {
 
     #[test]
     fn the_plane_test_never_rejects_a_face_within_reach() {
-        let m = Mesh::parse_off(
-            crate::scenario::HOURGLASS_OFF,
-            "hourglass",
-            &[0.002, 0.02, 0.01],
-        )
-        .unwrap();
+        let m = hourglass();
         let mut s = 3u64;
         let mut rnd = || {
             s = s

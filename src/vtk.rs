@@ -128,6 +128,18 @@ impl Vtu {
         let tail = "\n  </AppendedData>\n</VTKFile>\n";
         atomic_write(path, &[text.as_bytes(), &self.appended, tail.as_bytes()])
     }
+
+    /// A named array of 3-vectors.
+    fn vectors(&mut self, section: Section, name: &str, values: &[glam::DVec3]) {
+        let count = 3 * values.len();
+        self.array(
+            section,
+            name,
+            3,
+            count,
+            values.iter().flat_map(|a| a.to_array()),
+        );
+    }
 }
 
 /// Writes `parts` to a temporary file and renames it to `path`.
@@ -153,20 +165,8 @@ pub fn write_particles(path: &Path, p: &Particles) -> Result<()> {
     let n = p.len();
     let mut v = Vtu::new();
     v.array(PointData, "radius", 1, n, p.radius.iter().copied());
-    v.array(
-        PointData,
-        "velocity",
-        3,
-        3 * n,
-        p.v.iter().flat_map(|a| a.to_array()),
-    );
-    v.array(
-        PointData,
-        "angular_velocity",
-        3,
-        3 * n,
-        p.w.iter().flat_map(|a| a.to_array()),
-    );
+    v.vectors(PointData, "velocity", &p.v);
+    v.vectors(PointData, "angular_velocity", &p.w);
     v.array(
         PointData,
         "orientation",
@@ -175,13 +175,7 @@ pub fn write_particles(path: &Path, p: &Particles) -> Result<()> {
         p.q.iter().flat_map(|q| [q.w, q.x, q.y, q.z]),
     );
     v.array(PointData, "tag", 1, n, p.tag.iter().copied());
-    v.array(
-        Points,
-        "points",
-        3,
-        3 * n,
-        p.x.iter().flat_map(|a| a.to_array()),
-    );
+    v.vectors(Points, "points", &p.x);
     v.array(Cells, "connectivity", 1, n, 0..n as i64);
     v.array(Cells, "offsets", 1, n, 1..=n as i64);
     v.array(Cells, "types", 1, n, std::iter::repeat_n(1u8, n)); // VTK_VERTEX
@@ -218,13 +212,7 @@ pub fn write_mesh(path: &Path, mesh: &Mesh) -> Result<()> {
         nc,
         mesh.faces.iter().map(|f| f.radius),
     );
-    v.array(
-        Points,
-        "points",
-        3,
-        3 * np,
-        points.iter().flat_map(|a| a.to_array()),
-    );
+    v.vectors(Points, "points", &points);
     v.array(
         Cells,
         "connectivity",
