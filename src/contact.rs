@@ -21,16 +21,17 @@
 
 use glam::DVec3;
 
+use crate::lanes::{Displacement, Lanes};
 use crate::motion::RigidVelocity;
 use crate::scenario::Material;
 
 /// Displacements of the three static friction springs of one contact (Table 3):
 /// sliding `u_s`, rolling `u_r` and twisting `u_t`. Zero at first touch.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Springs {
-    pub u_s: DVec3,
-    pub u_r: DVec3,
-    pub u_t: f64,
+pub struct Springs<T: Lanes = f64> {
+    pub u_s: T::Vec,
+    pub u_r: T::Vec,
+    pub u_t: T,
 }
 
 /// Constants of the contact law derived once from the (single) material.
@@ -55,46 +56,70 @@ pub struct ContactLaw {
 
 /// What body `j` of a contact is, as far as the law is concerned.
 #[derive(Clone, Copy, Debug)]
-pub enum Other {
+pub enum Other<T: Lanes = f64> {
     /// Another particle, with radius R_j and mass m_j.
-    Particle { r: f64, m: f64 },
+    Particle { r: T, m: T },
     /// A mesh element: infinitely flat, stiff and heavy (R_j = E_j = m_j = ∞).
     Wall,
 }
 
 /// Position, radius and velocities of a particle entering a contact.
 #[derive(Clone, Copy, Debug)]
-pub struct Body {
-    pub x: DVec3,
-    pub radius: f64,
-    pub v: DVec3,
-    pub w: DVec3,
+pub struct Body<T: Lanes = f64> {
+    pub x: T::Vec,
+    pub radius: T,
+    pub v: T::Vec,
+    pub w: T::Vec,
 }
 
 /// Geometry and relative motion of one contact, computed once and shared by all modes.
 #[derive(Clone, Copy, Debug)]
-pub struct Kinematics {
+pub struct Kinematics<T: Lanes = f64> {
     /// Unit normal n̂ pointing from j to i, Eq. (9).
-    pub n: DVec3,
+    pub n: T::Vec,
     /// Overlap δ > 0, Eq. (7).
-    pub delta: f64,
+    pub delta: T,
     /// Distances of the contact point from the centres, Eqs. (29), (30); r_j = ∞ for a wall.
-    pub r_i: f64,
-    pub r_j: f64,
+    pub r_i: T,
+    pub r_j: T,
     /// Total relative velocity of the material points at the contact, Eq. (26).
-    pub v: DVec3,
+    pub v: T::Vec,
     /// Relative angular velocity ω = ω_i - ω_j, Eq. (38).
-    pub omega: DVec3,
+    pub omega: T::Vec,
 }
 
 /// Unit vector of `d` with length `dist`; two coincident centres get an arbitrary but fixed
 /// normal instead of NaN.
-#[inline]
-fn unit(d: DVec3, dist: f64) -> DVec3 {
-    if dist > 0.0 {
-        d * dist.recip()
-    } else {
-        DVec3::Z
+#[inline(always)]
+fn unit<T: Lanes>(d: T::Vec, dist: T) -> T::Vec {
+    T::pick_vec(
+        dist.positive(),
+        || d * (T::splat(1.0) / dist),
+        || T::splat_vec(DVec3::Z),
+    )
+}
+
+impl<T: Lanes> Kinematics<T> {
+    /// The contact of particles `i` and `j`, known to overlap: |x_i - x_j|² = `dist2` <
+    /// (R_i + R_j)².
+    #[inline(always)]
+    pub fn of_touching_particles(i: &Body<T>, j: &Body<T>, d: T::Vec, dist2: T) -> Self {
+        let reach = i.radius + j.radius;
+        let dist = dist2.sqrt();
+        let delta = reach - dist; // Eq. (7)
+        let n = unit(d, dist); // Eq. (9)
+        let half = T::splat(0.5);
+        let r_i = i.radius - delta * half; // Eq. (29)
+        let r_j = j.radius - delta * half; // Eq. (30)
+        Kinematics {
+            n,
+            delta,
+            r_i,
+            r_j,
+            // Eq. (26), sign as in the README
+            v: i.v - j.v + T::cross(n, i.w * r_i + j.w * r_j),
+            omega: i.w - j.w, // Eq. (38)
+        }
     }
 }
 
@@ -108,19 +133,7 @@ impl Kinematics {
         if dist2 >= reach * reach {
             return None;
         }
-        let dist = dist2.sqrt();
-        let delta = reach - dist; // Eq. (7)
-        let n = unit(d, dist); // Eq. (9)
-        let r_i = i.radius - delta / 2.0; // Eq. (29)
-        let r_j = j.radius - delta / 2.0; // Eq. (30)
-        Some(Kinematics {
-            n,
-            delta,
-            r_i,
-            r_j,
-            v: i.v - j.v + n.cross(r_i * i.w + r_j * j.w), // Eq. (26), sign as in the README
-            omega: i.w - j.w,                              // Eq. (38)
-        })
+        Some(Kinematics::of_touching_particles(i, j, d, dist2))
     }
 
     /// The contact of particle `i` with a mesh face of radius `face_radius`, whose closest
@@ -140,7 +153,7 @@ impl Kinematics {
         }
         let dist = dist2.sqrt();
         let delta = reach - dist; // Eq. (7)
-        let n = unit(d, dist); // Eq. (9)
+        let n = unit::<f64>(d, dist); // Eq. (9)
         let r_i = i.radius - delta / 2.0; // Eq. (29)
         let contact_point = i.x - r_i * n;
         Some(Kinematics {
@@ -157,13 +170,13 @@ impl Kinematics {
 
 /// Force and torques of one contact.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct ContactForce {
+pub struct ContactForce<T: Lanes = f64> {
     /// f_n + f_s on body i; body j receives the opposite, Eqs. (56), (57).
-    pub f: DVec3,
+    pub f: T::Vec,
     /// τ_s + τ_r + τ_t on body i.
-    pub tau_i: DVec3,
+    pub tau_i: T::Vec,
     /// Torque on body j: (r_j / r_i) τ_s - τ_r - τ_t, Eqs. (58)-(60).
-    pub tau_j: DVec3,
+    pub tau_j: T::Vec,
 }
 
 /// Damping factor β of Eq. (21), with its limits e_n → 0 (β = 1) and e_n = 1 (β = 0).
@@ -204,16 +217,21 @@ impl ContactLaw {
     }
 
     /// Evaluates the contact of particle `i` (radius `radius_i`, mass `m_i`) with body
-    /// `other`, updating the friction springs for the next time step.
+    /// `other`, updating the friction springs for the next time step. One contact, or four
+    /// particle pairs in lanes.
     #[inline(always)]
-    pub fn evaluate(
+    pub fn evaluate<T>(
         &self,
-        radius_i: f64,
-        m_i: f64,
-        other: Other,
-        kin: &Kinematics,
-        springs: &mut Springs,
-    ) -> ContactForce {
+        radius_i: T,
+        m_i: T,
+        other: Other<T>,
+        kin: &Kinematics<T>,
+        springs: &mut Springs<T>,
+    ) -> ContactForce<T>
+    where
+        T: Lanes + Displacement<T>,
+        T::Vec: Displacement<T>,
+    {
         let Kinematics {
             n,
             delta,
@@ -222,6 +240,7 @@ impl ContactLaw {
             v,
             omega,
         } = *kin;
+        let c = T::splat;
         // Effective quantities; for a wall R_j = m_j = r_j = ∞. The four quotients of a
         // particle pair share one division (it costs as much as a dozen multiplications):
         // with A = (R_i + R_j)(m_i + m_j) and B = r_i (r_i + r_j), 1/A = B/(AB), 1/B = A/(AB).
@@ -233,78 +252,65 @@ impl ContactLaw {
                 let (sum_r, sum_m, sum_contact) = (radius_i + radius_j, m_i + m_j, r_i + r_j);
                 let a = sum_r * sum_m;
                 let b = r_i * sum_contact;
-                let inv_ab = (a * b).recip();
+                let inv_ab = c(1.0) / (a * b);
                 let (inv_a, inv_b) = (b * inv_ab, a * inv_ab);
                 (
                     radius_i * radius_j * sum_m * inv_a, // Eq. (17)
                     m_i * m_j * sum_r * inv_a,           // Eq. (20)
-                    self.e_star_pp,
-                    self.g_star_pp,
+                    c(self.e_star_pp),
+                    c(self.g_star_pp),
                     r_i * r_i * r_j * inv_b, // (1/r_i + 1/r_j)^-1 of Eq. (36)
                     r_j * sum_contact * inv_b,
                 )
             }
-            Other::Wall => (radius_i, m_i, self.e_star_pw, self.g_star_pw, r_i, 0.0),
+            Other::Wall => (
+                radius_i,
+                m_i,
+                c(self.e_star_pw),
+                c(self.g_star_pw),
+                r_i,
+                c(0.0),
+            ),
         };
 
         let a = (r_star * delta).sqrt(); // Eq. (14)
-        let k_n = 4.0 / 3.0 * e_star * a; // Eq. (12)
-        let k_s = 8.0 * g_star * a; // Eq. (13)
-        let c_n = (5.0 * m_star * k_n).sqrt() * self.beta; // Eq. (18)
-        let c_s = c_n * self.c_s_per_c_n; // Eq. (19), as Eq. (25)
+        let k_n = c(4.0 / 3.0) * e_star * a; // Eq. (12)
+        let k_s = c(8.0) * g_star * a; // Eq. (13)
+        let c_n = (c(5.0) * m_star * k_n).sqrt() * c(self.beta); // Eq. (18)
+        let c_s = c_n * c(self.c_s_per_c_n); // Eq. (19), as Eq. (25)
 
         // Normal force, along n̂: f_n = -k_n u_n - c_n v_n with u_n = -δ n̂ (Eqs. 5, 10).
-        let v_dot_n = v.dot(n);
-        let v_n = v_dot_n * n; // Eq. (27)
+        let v_dot_n = T::dot(v, n);
+        let v_n = n * v_dot_n; // Eq. (27)
         let v_s = v - v_n; // Eq. (28)
         let f_n_scalar = k_n * delta - c_n * v_dot_n;
-        let f_n = f_n_scalar * n; // Eq. (5)
+        let f_n = n * f_n_scalar; // Eq. (5)
         let f_n_norm = f_n_scalar.abs();
+        let dt = c(self.dt);
 
         // Sliding friction.
-        springs.u_s = project_onto_tangent_plane(springs.u_s, n); // Eq. (52)
-        let f_s = coulomb_spring(
-            &mut springs.u_s,
-            v_s,
-            k_s,
-            c_s,
-            self.mu_s * f_n_norm,
-            self.dt,
-        ); // Eqs. (6), (11), (53)-(55)
-        let tau_s = r_i * f_s.cross(n); // Eq. (31)
+        springs.u_s = project_onto_tangent_plane::<T>(springs.u_s, n); // Eq. (52)
+        let f_s = coulomb_spring(&mut springs.u_s, v_s, k_s, c_s, c(self.mu_s) * f_n_norm, dt); // Eqs. (6), (11), (53)-(55)
+        let tau_s = T::cross(f_s, n) * r_i; // Eq. (31)
 
         // Rolling friction, k_r = k_n and c_r = c_n.
-        let v_r = r_roll * omega.cross(n); // Eq. (36)
-        springs.u_r = project_onto_tangent_plane(springs.u_r, n); // Eq. (52)
-        let f_r = coulomb_spring(
-            &mut springs.u_r,
-            v_r,
-            k_n,
-            c_n,
-            self.mu_r * f_n_norm,
-            self.dt,
-        ); // Eqs. (34), (39), (53)-(55)
-        let tau_r = r_star * n.cross(f_r); // Eq. (32)
+        let v_r = T::cross(omega, n) * r_roll; // Eq. (36)
+        springs.u_r = project_onto_tangent_plane::<T>(springs.u_r, n); // Eq. (52)
+        let f_r = coulomb_spring(&mut springs.u_r, v_r, k_n, c_n, c(self.mu_r) * f_n_norm, dt); // Eqs. (34), (39), (53)-(55)
+        let tau_r = T::cross(n, f_r) * r_star; // Eq. (32)
 
         // Twisting friction, k_t = k_s and c_t = c_s.
-        let v_t = r_star * omega.dot(n); // Eq. (37)
-        let f_t = coulomb_spring(
-            &mut springs.u_t,
-            v_t,
-            k_s,
-            c_s,
-            self.mu_t * f_n_norm,
-            self.dt,
-        ); // Eqs. (35), (40), (53)-(55)
-        let tau_t = f_t * r_star * n; // Eq. (33)
+        let v_t = r_star * T::dot(omega, n); // Eq. (37)
+        let f_t = coulomb_spring(&mut springs.u_t, v_t, k_s, c_s, c(self.mu_t) * f_n_norm, dt); // Eqs. (35), (40), (53)-(55)
+        let tau_t = n * (f_t * r_star); // Eq. (33)
 
         ContactForce {
             f: f_n + f_s,
             tau_i: tau_s + tau_r + tau_t,
             // A wall takes no reaction torque; avoid ∞ · 0 there.
             tau_j: match other {
-                Other::Particle { .. } => r_j_per_r_i * tau_s - tau_r - tau_t, // Eqs. (58)-(60)
-                Other::Wall => DVec3::ZERO,
+                Other::Particle { .. } => tau_s * r_j_per_r_i - tau_r - tau_t, // Eqs. (58)-(60)
+                Other::Wall => T::Vec::default(),
             },
         }
     }
@@ -313,57 +319,29 @@ impl ContactLaw {
 /// Eq. (52): rotate a spring back into the tangent plane of the current normal, keeping its
 /// length (unless it is zero or parallel to the normal).
 #[inline(always)]
-fn project_onto_tangent_plane(u: DVec3, n: DVec3) -> DVec3 {
-    let length2 = u.length_squared();
-    if length2 == 0.0 {
-        return u;
-    }
-    let tangential = u - u.dot(n) * n;
-    let t2 = tangential.length_squared();
-    if t2 == 0.0 {
-        DVec3::ZERO
-    } else {
-        tangential * (length2 / t2).sqrt()
-    }
-}
-
-/// A spring displacement: a vector (sliding, rolling) or a scalar (twisting).
-trait Displacement:
-    Copy
-    + std::ops::Add<Output = Self>
-    + std::ops::Neg<Output = Self>
-    + std::ops::Mul<f64, Output = Self>
-{
-    fn norm_squared(self) -> f64;
-}
-
-impl Displacement for DVec3 {
-    fn norm_squared(self) -> f64 {
-        self.length_squared()
-    }
-}
-
-impl Displacement for f64 {
-    fn norm_squared(self) -> f64 {
-        self * self
-    }
+fn project_onto_tangent_plane<T: Lanes>(u: T::Vec, n: T::Vec) -> T::Vec {
+    let length2 = T::dot(u, u);
+    let tangential = u - n * T::dot(u, n);
+    let t2 = T::dot(tangential, tangential);
+    let stretch = T::pick(t2.is_zero(), || T::splat(0.0), || (length2 / t2).sqrt());
+    tangential * stretch
 }
 
 /// One friction mode m ∈ {s, r, t}: the Kelvin-Voigt force -k u - c v, clipped by Coulomb's
 /// law to `f_max` = μ_m |f_n|. Static: the spring grows by Δt v (Eq. 53). Kinetic: the force
 /// is scaled to the Coulomb limit (Eq. 54) and the spring set to match it (Eq. 55).
 #[inline(always)]
-fn coulomb_spring<V: Displacement>(u: &mut V, v: V, k: f64, c: f64, f_max: f64, dt: f64) -> V {
+fn coulomb_spring<T: Lanes, V: Displacement<T>>(u: &mut V, v: V, k: T, c: T, f_max: T, dt: T) -> V {
     let f = -(*u * k) + -(v * c);
     let f_norm2 = f.norm_squared();
-    if f_norm2 <= f_max * f_max {
-        *u = *u + v * dt; // Eq. (53)
-        f
-    } else {
-        let f = f * (f_max / f_norm2.sqrt()); // Eq. (54)
-        *u = -(f + v * c) * (1.0 / k); // Eq. (55)
-        f
-    }
+    let sticking = f_norm2.le(f_max * f_max);
+    let f = V::pick(sticking, || f, || f * (f_max / f_norm2.sqrt())); // Eq. (54)
+    *u = V::pick(
+        sticking,
+        || *u + v * dt,                        // Eq. (53)
+        || -(f + v * c) * (T::splat(1.0) / k), // Eq. (55)
+    );
+    f
 }
 
 #[cfg(test)]
@@ -381,10 +359,13 @@ mod tests {
     #[test]
     fn projection_keeps_length_and_removes_normal_part() {
         let n = DVec3::Z;
-        let u = project_onto_tangent_plane(DVec3::new(3.0, 0.0, 4.0), n);
+        let u = project_onto_tangent_plane::<f64>(DVec3::new(3.0, 0.0, 4.0), n);
         assert!((u - DVec3::new(5.0, 0.0, 0.0)).length() < 1e-15);
-        assert_eq!(project_onto_tangent_plane(DVec3::Z, n), DVec3::ZERO);
-        assert_eq!(project_onto_tangent_plane(DVec3::ZERO, n), DVec3::ZERO);
+        assert_eq!(project_onto_tangent_plane::<f64>(DVec3::Z, n), DVec3::ZERO);
+        assert_eq!(
+            project_onto_tangent_plane::<f64>(DVec3::ZERO, n),
+            DVec3::ZERO
+        );
     }
 
     #[test]
@@ -397,5 +378,111 @@ mod tests {
         let f = coulomb_spring(&mut u, 2.0, 10.0, 1.0, 3.0, 0.5);
         assert_eq!(f, -3.0);
         assert!((-10.0 * u - 2.0 - f).abs() < 1e-15);
+    }
+
+    mod lanes {
+        use super::*;
+        use crate::lanes::{gather, gather_vec, scatter_vec};
+        use proptest::prelude::*;
+        use wide::f64x4;
+
+        fn vec3(range: f64) -> impl Strategy<Value = DVec3> {
+            (-range..range, -range..range, -range..range).prop_map(|(x, y, z)| DVec3::new(x, y, z))
+        }
+
+        /// One contact: bodies i and j overlapping by up to half the smaller radius, and
+        /// springs that are zero, small (sticking) or large (sliding).
+        fn contact() -> impl Strategy<Value = (Body, Body, Springs)> {
+            let spring = prop_oneof![Just(DVec3::ZERO), vec3(1e-6), vec3(1e-2)];
+            (
+                (1e-3..1e-2f64, 1e-3..1e-2f64, 0.5..0.999f64, vec3(1.0)),
+                (vec3(1.0), vec3(1.0), vec3(100.0), vec3(100.0)),
+                (spring.clone(), spring, -1e-2..1e-2f64, any::<bool>()),
+            )
+                .prop_map(
+                    |((r_i, r_j, reach, dir), (v_i, v_j, w_i, w_j), (u_s, u_r, u_t, twist))| {
+                        let dir = dir.try_normalize().unwrap_or(DVec3::X);
+                        let x_j = DVec3::new(0.3, -0.2, 0.1);
+                        let i = Body {
+                            x: x_j + dir * (r_i + r_j) * reach,
+                            radius: r_i,
+                            v: v_i,
+                            w: w_i,
+                        };
+                        let j = Body {
+                            x: x_j,
+                            radius: r_j,
+                            v: v_j,
+                            w: w_j,
+                        };
+                        let springs = Springs {
+                            u_s,
+                            u_r,
+                            u_t: if twist { u_t } else { 0.0 },
+                        };
+                        (i, j, springs)
+                    },
+                )
+        }
+
+        proptest! {
+            /// The particle-pair stage evaluates four contacts at once; each lane must give
+            /// the bits of the contact evaluated alone.
+            #[test]
+            fn four_lanes_give_the_bits_of_four_single_contacts(
+                contacts in proptest::array::uniform4(contact()),
+                e_n in 0.1..0.9f64,
+            ) {
+                let material = Material {
+                    density: 2500.0,
+                    youngs_modulus: 1e7,
+                    poisson_ratio: 0.25,
+                    restitution: e_n,
+                    friction_sliding: 0.4,
+                    friction_rolling: 0.05,
+                    friction_twisting: 0.02,
+                    viscosity: 1e-5,
+                };
+                let law = ContactLaw::new(&material, 1e-5);
+                let mass = |r: f64| 4.0 / 3.0 * std::f64::consts::PI * 2500.0 * r.powi(3);
+                let single = contacts.map(|(i, j, mut springs)| {
+                    let kin = Kinematics::between_particles(&i, &j).expect("overlapping");
+                    let other = Other::Particle { r: j.radius, m: mass(j.radius) };
+                    let force = law.evaluate(i.radius, mass(i.radius), other, &kin, &mut springs);
+                    (force, springs)
+                });
+
+                let lanes = |body: fn(&(Body, Body, Springs)) -> &Body| Body::<f64x4> {
+                    x: gather_vec(contacts.each_ref().map(|c| body(c).x)),
+                    radius: gather(contacts.each_ref().map(|c| body(c).radius)),
+                    v: gather_vec(contacts.each_ref().map(|c| body(c).v)),
+                    w: gather_vec(contacts.each_ref().map(|c| body(c).w)),
+                };
+                let (i, j) = (lanes(|c| &c.0), lanes(|c| &c.1));
+                let d = i.x - j.x;
+                let kin = Kinematics::of_touching_particles(&i, &j, d, d.mag_sq());
+                let mut springs = Springs::<f64x4> {
+                    u_s: gather_vec(contacts.map(|c| c.2.u_s)),
+                    u_r: gather_vec(contacts.map(|c| c.2.u_r)),
+                    u_t: gather(contacts.map(|c| c.2.u_t)),
+                };
+                let m = |body: &Body<f64x4>| gather(body.radius.to_array().map(mass));
+                let other = Other::Particle { r: j.radius, m: m(&j) };
+                let force = law.evaluate(i.radius, m(&i), other, &kin, &mut springs);
+                let (f, tau_i, tau_j) =
+                    (scatter_vec(force.f), scatter_vec(force.tau_i), scatter_vec(force.tau_j));
+                let (u_s, u_r, u_t) =
+                    (scatter_vec(springs.u_s), scatter_vec(springs.u_r), springs.u_t.to_array());
+                let bits = |v: DVec3| v.to_array().map(f64::to_bits);
+                for (l, (alone, springs_alone)) in single.iter().enumerate() {
+                    prop_assert_eq!(bits(f[l]), bits(alone.f), "f, lane {}", l);
+                    prop_assert_eq!(bits(tau_i[l]), bits(alone.tau_i), "tau_i, lane {}", l);
+                    prop_assert_eq!(bits(tau_j[l]), bits(alone.tau_j), "tau_j, lane {}", l);
+                    prop_assert_eq!(bits(u_s[l]), bits(springs_alone.u_s), "u_s, lane {}", l);
+                    prop_assert_eq!(bits(u_r[l]), bits(springs_alone.u_r), "u_r, lane {}", l);
+                    prop_assert_eq!(u_t[l].to_bits(), springs_alone.u_t.to_bits(), "u_t, lane {}", l);
+                }
+            }
+        }
     }
 }

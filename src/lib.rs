@@ -10,6 +10,7 @@ pub mod contact;
 pub mod csv;
 pub mod geometry;
 pub mod integrate;
+pub mod lanes;
 pub mod mesh;
 pub mod motion;
 pub mod neighbours;

@@ -11,9 +11,11 @@ use std::time::Instant;
 use anyhow::{Result, bail};
 use glam::DVec3;
 use rayon::prelude::*;
+use wide::f64x4;
 
 use crate::contact::{Body, ContactForce, ContactLaw, Kinematics, Other, Springs};
 use crate::integrate::{Inertia, State, advance};
+use crate::lanes::{gather, gather_vec, scatter_vec};
 use crate::mesh::{Face, Mesh};
 use crate::motion::{Motion, Pose, RigidVelocity};
 use crate::neighbours::{CellGrid, MIN_PARALLEL_LEN, Neighbours, face_grid};
@@ -508,7 +510,14 @@ impl Simulation {
 
     /// Stage 3 (Section 2.2): the force of every touching particle pair, once per pair.
     /// Returns the overlaps deeper than the smaller radius (a sign of instability).
+    ///
+    /// Each piece of the list first sorts its pairs into touching and apart (forgetting
+    /// the springs of the latter), then evaluates the touching ones four at a time in SIMD
+    /// lanes; a lane gives the bits the pair would give alone, so neither the pieces nor
+    /// the grouping change a result.
     fn particle_contacts(&mut self) -> Vec<Deep> {
+        /// Pairs per piece: small enough for stack buffers, large enough to fill lanes.
+        const PIECE: usize = 256;
         let deep = Mutex::new(Vec::new());
         let p = &self.particles;
         let law = &self.law;
@@ -517,41 +526,88 @@ impl Simulation {
         self.pair_forces
             .resize(list.partner.len(), ContactForce::default());
         self.pair_forces
-            .par_iter_mut()
-            .zip(list.springs.par_iter_mut())
-            .zip(list.owner.par_iter().zip(list.partner.par_iter()))
-            .with_min_len(MIN_PARALLEL_LEN)
-            .for_each(|((force, springs), (&i, &j))| {
-                let (i, j) = (i as usize, j as usize);
-                let body = |k: usize| Body {
-                    x: p.x[k],
-                    radius: p.radius[k],
-                    v: p.v[k],
-                    w: p.w[k],
-                };
-                *force = match Kinematics::between_particles(&body(i), &body(j)) {
-                    Some(kin) => {
-                        let limit = p.radius[i].min(p.radius[j]);
-                        if kin.delta > limit {
+            .par_chunks_mut(PIECE)
+            .zip(list.springs.par_chunks_mut(PIECE))
+            .zip(
+                list.owner
+                    .par_chunks(PIECE)
+                    .zip(list.partner.par_chunks(PIECE)),
+            )
+            .with_min_len(MIN_PARALLEL_LEN.div_ceil(PIECE))
+            .for_each(|((forces, springs), (owner, partner))| {
+                let mut touching = [0u16; PIECE];
+                let mut count = 0;
+                for (k, (&i, &j)) in owner.iter().zip(partner).enumerate() {
+                    let (i, j) = (i as usize, j as usize);
+                    let reach = p.radius[i] + p.radius[j];
+                    if (p.x[i] - p.x[j]).length_squared() < reach * reach {
+                        touching[count] = k as u16;
+                        count += 1;
+                    } else {
+                        forget(&mut springs[k]); // the contact ended: forget its history
+                        forces[k] = ContactForce::default();
+                    }
+                }
+                for group in touching[..count].chunks(4) {
+                    // A short last group repeats its last pair in the spare lanes.
+                    let k: [usize; 4] =
+                        std::array::from_fn(|l| group[l.min(group.len() - 1)] as usize);
+                    let i = k.map(|k| owner[k] as usize);
+                    let j = k.map(|k| partner[k] as usize);
+                    let body = |idx: [usize; 4]| Body::<f64x4> {
+                        x: gather_vec(idx.map(|i| p.x[i])),
+                        radius: gather(idx.map(|i| p.radius[i])),
+                        v: gather_vec(idx.map(|i| p.v[i])),
+                        w: gather_vec(idx.map(|i| p.w[i])),
+                    };
+                    let (body_i, body_j) = (body(i), body(j));
+                    let d = body_i.x - body_j.x; // Eq. (8)
+                    let kin = Kinematics::of_touching_particles(&body_i, &body_j, d, d.mag_sq());
+                    let mass =
+                        |idx: [usize; 4]| gather(idx.map(|i| Inertia::mass(p.radius[i], density)));
+                    let mut lanes = Springs::<f64x4> {
+                        u_s: gather_vec(k.map(|k| springs[k].u_s)),
+                        u_r: gather_vec(k.map(|k| springs[k].u_r)),
+                        u_t: gather(k.map(|k| springs[k].u_t)),
+                    };
+                    let other = Other::Particle {
+                        r: body_j.radius,
+                        m: mass(j),
+                    };
+                    let force = law.evaluate(body_i.radius, mass(i), other, &kin, &mut lanes);
+                    let (f, tau_i, tau_j) = (
+                        scatter_vec(force.f),
+                        scatter_vec(force.tau_i),
+                        scatter_vec(force.tau_j),
+                    );
+                    let (u_s, u_r, u_t) = (
+                        scatter_vec(lanes.u_s),
+                        scatter_vec(lanes.u_r),
+                        lanes.u_t.to_array(),
+                    );
+                    let delta = kin.delta.to_array();
+                    for l in 0..group.len() {
+                        forces[k[l]] = ContactForce {
+                            f: f[l],
+                            tau_i: tau_i[l],
+                            tau_j: tau_j[l],
+                        };
+                        springs[k[l]] = Springs {
+                            u_s: u_s[l],
+                            u_r: u_r[l],
+                            u_t: u_t[l],
+                        };
+                        let limit = p.radius[i[l]].min(p.radius[j[l]]);
+                        if delta[l] > limit {
                             deep.lock().expect("not poisoned").push(Deep {
-                                i,
-                                other: Partner::Particle(j),
-                                delta: kin.delta,
+                                i: i[l],
+                                other: Partner::Particle(j[l]),
+                                delta: delta[l],
                                 limit,
                             });
                         }
-                        let other = Other::Particle {
-                            r: p.radius[j],
-                            m: Inertia::mass(p.radius[j], density),
-                        };
-                        let m_i = Inertia::mass(p.radius[i], density);
-                        law.evaluate(p.radius[i], m_i, other, &kin, springs)
                     }
-                    None => {
-                        forget(springs); // the contact ended: forget its history
-                        ContactForce::default()
-                    }
-                };
+                }
             });
         deep.into_inner().expect("not poisoned")
     }
