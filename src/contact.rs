@@ -382,17 +382,19 @@ mod tests {
 
     mod lanes {
         use super::*;
-        use crate::lanes::{gather, gather_vec, scatter_vec};
+        use crate::lanes::Gather;
         use proptest::prelude::*;
-        use wide::f64x4;
+        use wide::{f64x4, f64x8};
 
         fn vec3(range: f64) -> impl Strategy<Value = DVec3> {
             (-range..range, -range..range, -range..range).prop_map(|(x, y, z)| DVec3::new(x, y, z))
         }
 
+        type Contact = (Body, Body, Springs);
+
         /// One contact: bodies i and j overlapping by up to half the smaller radius, and
         /// springs that are zero, small (sticking) or large (sliding).
-        fn contact() -> impl Strategy<Value = (Body, Body, Springs)> {
+        fn contact() -> impl Strategy<Value = Contact> {
             let spring = prop_oneof![Just(DVec3::ZERO), vec3(1e-6), vec3(1e-2)];
             (
                 (1e-3..1e-2f64, 1e-3..1e-2f64, 0.5..0.999f64, vec3(1.0)),
@@ -425,63 +427,108 @@ mod tests {
                 )
         }
 
+        fn law(e_n: f64) -> ContactLaw {
+            let material = Material {
+                density: 2500.0,
+                youngs_modulus: 1e7,
+                poisson_ratio: 0.25,
+                restitution: e_n,
+                friction_sliding: 0.4,
+                friction_rolling: 0.05,
+                friction_twisting: 0.02,
+                viscosity: 1e-5,
+            };
+            ContactLaw::new(&material, 1e-5)
+        }
+
+        fn mass(r: f64) -> f64 {
+            4.0 / 3.0 * std::f64::consts::PI * 2500.0 * r.powi(3)
+        }
+
+        /// Evaluates `N` contacts in the lanes of `T` and each alone; fails unless every
+        /// force, torque and spring has the same bits.
+        fn lanes_match_single_contacts<T, const N: usize>(
+            contacts: [Contact; N],
+            law: ContactLaw,
+        ) -> Result<(), TestCaseError>
+        where
+            T: Gather<N> + Displacement<T>,
+            T::Vec: Displacement<T>,
+        {
+            let single = contacts.map(|(i, j, mut springs)| {
+                let kin = Kinematics::between_particles(&i, &j).expect("overlapping");
+                let other = Other::Particle {
+                    r: j.radius,
+                    m: mass(j.radius),
+                };
+                let force = law.evaluate(i.radius, mass(i.radius), other, &kin, &mut springs);
+                (force, springs)
+            });
+
+            let lanes = |body: fn(&Contact) -> &Body| Body::<T> {
+                x: T::gather_vec(contacts.each_ref().map(|c| body(c).x)),
+                radius: T::gather(contacts.each_ref().map(|c| body(c).radius)),
+                v: T::gather_vec(contacts.each_ref().map(|c| body(c).v)),
+                w: T::gather_vec(contacts.each_ref().map(|c| body(c).w)),
+            };
+            let (i, j) = (lanes(|c| &c.0), lanes(|c| &c.1));
+            let d = i.x - j.x;
+            let kin = Kinematics::of_touching_particles(&i, &j, d, T::dot(d, d));
+            let mut springs = Springs::<T> {
+                u_s: T::gather_vec(contacts.map(|c| c.2.u_s)),
+                u_r: T::gather_vec(contacts.map(|c| c.2.u_r)),
+                u_t: T::gather(contacts.map(|c| c.2.u_t)),
+            };
+            let m = |body: &Body<T>| T::gather(body.radius.scatter().map(mass));
+            let other = Other::Particle {
+                r: j.radius,
+                m: m(&j),
+            };
+            let force = law.evaluate(i.radius, m(&i), other, &kin, &mut springs);
+            let (f, tau_i, tau_j) = (
+                T::scatter_vec(force.f),
+                T::scatter_vec(force.tau_i),
+                T::scatter_vec(force.tau_j),
+            );
+            let (u_s, u_r, u_t) = (
+                T::scatter_vec(springs.u_s),
+                T::scatter_vec(springs.u_r),
+                springs.u_t.scatter(),
+            );
+            let bits = |v: DVec3| v.to_array().map(f64::to_bits);
+            for (l, (alone, springs_alone)) in single.iter().enumerate() {
+                prop_assert_eq!(bits(f[l]), bits(alone.f), "f, lane {}", l);
+                prop_assert_eq!(bits(tau_i[l]), bits(alone.tau_i), "tau_i, lane {}", l);
+                prop_assert_eq!(bits(tau_j[l]), bits(alone.tau_j), "tau_j, lane {}", l);
+                prop_assert_eq!(bits(u_s[l]), bits(springs_alone.u_s), "u_s, lane {}", l);
+                prop_assert_eq!(bits(u_r[l]), bits(springs_alone.u_r), "u_r, lane {}", l);
+                prop_assert_eq!(
+                    u_t[l].to_bits(),
+                    springs_alone.u_t.to_bits(),
+                    "u_t, lane {}",
+                    l
+                );
+            }
+            Ok(())
+        }
+
         proptest! {
-            /// The particle-pair stage evaluates four contacts at once; each lane must give
-            /// the bits of the contact evaluated alone.
+            /// The particle-pair stage evaluates several contacts at once; each lane must
+            /// give the bits of the contact evaluated alone.
             #[test]
             fn four_lanes_give_the_bits_of_four_single_contacts(
                 contacts in proptest::array::uniform4(contact()),
                 e_n in 0.1..0.9f64,
             ) {
-                let material = Material {
-                    density: 2500.0,
-                    youngs_modulus: 1e7,
-                    poisson_ratio: 0.25,
-                    restitution: e_n,
-                    friction_sliding: 0.4,
-                    friction_rolling: 0.05,
-                    friction_twisting: 0.02,
-                    viscosity: 1e-5,
-                };
-                let law = ContactLaw::new(&material, 1e-5);
-                let mass = |r: f64| 4.0 / 3.0 * std::f64::consts::PI * 2500.0 * r.powi(3);
-                let single = contacts.map(|(i, j, mut springs)| {
-                    let kin = Kinematics::between_particles(&i, &j).expect("overlapping");
-                    let other = Other::Particle { r: j.radius, m: mass(j.radius) };
-                    let force = law.evaluate(i.radius, mass(i.radius), other, &kin, &mut springs);
-                    (force, springs)
-                });
+                lanes_match_single_contacts::<f64x4, 4>(contacts, law(e_n))?;
+            }
 
-                let lanes = |body: fn(&(Body, Body, Springs)) -> &Body| Body::<f64x4> {
-                    x: gather_vec(contacts.each_ref().map(|c| body(c).x)),
-                    radius: gather(contacts.each_ref().map(|c| body(c).radius)),
-                    v: gather_vec(contacts.each_ref().map(|c| body(c).v)),
-                    w: gather_vec(contacts.each_ref().map(|c| body(c).w)),
-                };
-                let (i, j) = (lanes(|c| &c.0), lanes(|c| &c.1));
-                let d = i.x - j.x;
-                let kin = Kinematics::of_touching_particles(&i, &j, d, d.mag_sq());
-                let mut springs = Springs::<f64x4> {
-                    u_s: gather_vec(contacts.map(|c| c.2.u_s)),
-                    u_r: gather_vec(contacts.map(|c| c.2.u_r)),
-                    u_t: gather(contacts.map(|c| c.2.u_t)),
-                };
-                let m = |body: &Body<f64x4>| gather(body.radius.to_array().map(mass));
-                let other = Other::Particle { r: j.radius, m: m(&j) };
-                let force = law.evaluate(i.radius, m(&i), other, &kin, &mut springs);
-                let (f, tau_i, tau_j) =
-                    (scatter_vec(force.f), scatter_vec(force.tau_i), scatter_vec(force.tau_j));
-                let (u_s, u_r, u_t) =
-                    (scatter_vec(springs.u_s), scatter_vec(springs.u_r), springs.u_t.to_array());
-                let bits = |v: DVec3| v.to_array().map(f64::to_bits);
-                for (l, (alone, springs_alone)) in single.iter().enumerate() {
-                    prop_assert_eq!(bits(f[l]), bits(alone.f), "f, lane {}", l);
-                    prop_assert_eq!(bits(tau_i[l]), bits(alone.tau_i), "tau_i, lane {}", l);
-                    prop_assert_eq!(bits(tau_j[l]), bits(alone.tau_j), "tau_j, lane {}", l);
-                    prop_assert_eq!(bits(u_s[l]), bits(springs_alone.u_s), "u_s, lane {}", l);
-                    prop_assert_eq!(bits(u_r[l]), bits(springs_alone.u_r), "u_r, lane {}", l);
-                    prop_assert_eq!(u_t[l].to_bits(), springs_alone.u_t.to_bits(), "u_t, lane {}", l);
-                }
+            #[test]
+            fn eight_lanes_give_the_bits_of_eight_single_contacts(
+                contacts in proptest::array::uniform8(contact()),
+                e_n in 0.1..0.9f64,
+            ) {
+                lanes_match_single_contacts::<f64x8, 8>(contacts, law(e_n))?;
             }
         }
     }

@@ -1,17 +1,17 @@
 //! The numbers the contact law is written for: one contact at a time (`f64` with glam's
-//! `DVec3`), or four at once in SIMD lanes (`f64x4` with ultraviolet's `DVec3x4`).
+//! `DVec3`), or several at once in SIMD lanes (`f64x4`, `f64x8` from `wide`, with [`V3`]
+//! vectors of them: no vector crate has 3-vectors of 8 double lanes).
 //!
 //! The law (`contact.rs`) is generic over [`Lanes`], so both read the same and do the same
 //! IEEE operations in the same order: a contact evaluated in a lane gives the bits it gives
 //! alone (tested below). Where the scalar law branches, the lanes take both sides and
-//! blend them, unless all four lanes agree ([`Lanes::pick`]).
+//! blend them, unless all lanes agree ([`Lanes::pick`]).
 
 use std::fmt::Debug;
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
 use glam::DVec3;
-use ultraviolet::DVec3x4;
-use wide::{CmpEq, CmpGt, CmpLe, f64x4};
+use wide::{f64x4, f64x8};
 
 /// A number of the contact law: one value, or one per lane.
 pub trait Lanes:
@@ -106,69 +106,170 @@ impl Lanes for f64 {
     }
 }
 
-impl Lanes for f64x4 {
-    type Vec = DVec3x4;
-    type Mask = f64x4;
+/// A 3-vector of lanes: component `x` holds the x of every lane.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct V3<T> {
+    pub x: T,
+    pub y: T,
+    pub z: T,
+}
+
+impl<T: Copy + Add<Output = T>> Add for V3<T> {
+    type Output = Self;
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        V3 {
+            x: self.x + o.x,
+            y: self.y + o.y,
+            z: self.z + o.z,
+        }
+    }
+}
+
+impl<T: Copy + Sub<Output = T>> Sub for V3<T> {
+    type Output = Self;
+    #[inline(always)]
+    fn sub(self, o: Self) -> Self {
+        V3 {
+            x: self.x - o.x,
+            y: self.y - o.y,
+            z: self.z - o.z,
+        }
+    }
+}
+
+impl<T: Copy + Neg<Output = T>> Neg for V3<T> {
+    type Output = Self;
+    #[inline(always)]
+    fn neg(self) -> Self {
+        V3 {
+            x: -self.x,
+            y: -self.y,
+            z: -self.z,
+        }
+    }
+}
+
+impl<T: Copy + Mul<Output = T>> Mul<T> for V3<T> {
+    type Output = Self;
+    #[inline(always)]
+    fn mul(self, s: T) -> Self {
+        V3 {
+            x: self.x * s,
+            y: self.y * s,
+            z: self.z * s,
+        }
+    }
+}
+
+/// `Lanes` for a `wide` type of `$n` double lanes. Products and the dot product associate
+/// as glam's (`x*x + y*y + z*z`; cross `a.y*b.z - b.y*a.z`, ...), so that lanes round as
+/// single contacts do.
+macro_rules! lanes {
+    ($($t:ident: $n:literal),*) => {$(
+        impl Lanes for $t {
+            type Vec = V3<$t>;
+            type Mask = $t;
+
+            #[inline(always)]
+            fn splat(x: f64) -> $t {
+                $t::splat(x)
+            }
+            #[inline(always)]
+            fn splat_vec(v: DVec3) -> V3<$t> {
+                V3 { x: $t::splat(v.x), y: $t::splat(v.y), z: $t::splat(v.z) }
+            }
+            #[inline(always)]
+            fn sqrt(self) -> $t {
+                $t::sqrt(self)
+            }
+            #[inline(always)]
+            fn abs(self) -> $t {
+                $t::abs(self)
+            }
+            #[inline(always)]
+            fn le(self, other: $t) -> $t {
+                self.simd_le(other)
+            }
+            #[inline(always)]
+            fn positive(self) -> $t {
+                self.simd_gt($t::ZERO)
+            }
+            #[inline(always)]
+            fn is_zero(self) -> $t {
+                self.simd_eq($t::ZERO)
+            }
+            #[inline(always)]
+            fn dot(a: V3<$t>, b: V3<$t>) -> $t {
+                a.x * b.x + a.y * b.y + a.z * b.z
+            }
+            #[inline(always)]
+            fn cross(a: V3<$t>, b: V3<$t>) -> V3<$t> {
+                V3 {
+                    x: a.y * b.z - b.y * a.z,
+                    y: a.z * b.x - b.z * a.x,
+                    z: a.x * b.y - b.x * a.y,
+                }
+            }
+            #[inline(always)]
+            fn pick(mask: $t, yes: impl FnOnce() -> $t, no: impl FnOnce() -> $t) -> $t {
+                if mask.all() {
+                    yes()
+                } else if mask.none() {
+                    no()
+                } else {
+                    mask.select(yes(), no())
+                }
+            }
+            #[inline(always)]
+            fn pick_vec(
+                mask: $t,
+                yes: impl FnOnce() -> V3<$t>,
+                no: impl FnOnce() -> V3<$t>,
+            ) -> V3<$t> {
+                if mask.all() {
+                    yes()
+                } else if mask.none() {
+                    no()
+                } else {
+                    let (a, b) = (yes(), no());
+                    V3 { x: mask.select(a.x, b.x), y: mask.select(a.y, b.y), z: mask.select(a.z, b.z) }
+                }
+            }
+        }
+
+        impl Gather<$n> for $t {
+            #[inline(always)]
+            fn gather(values: [f64; $n]) -> $t {
+                $t::new(values)
+            }
+            #[inline(always)]
+            fn scatter(self) -> [f64; $n] {
+                self.to_array()
+            }
+        }
+    )*};
+}
+lanes!(f64x4: 4, f64x8: 8);
+
+/// Moving values between `N` single contacts and the lanes of a group.
+pub trait Gather<const N: usize>: Lanes<Vec = V3<Self>> {
+    fn gather(values: [f64; N]) -> Self;
+    fn scatter(self) -> [f64; N];
 
     #[inline(always)]
-    fn splat(x: f64) -> f64x4 {
-        f64x4::splat(x)
-    }
-    #[inline(always)]
-    fn splat_vec(v: DVec3) -> DVec3x4 {
-        DVec3x4::new(f64x4::splat(v.x), f64x4::splat(v.y), f64x4::splat(v.z))
-    }
-    #[inline(always)]
-    fn sqrt(self) -> f64x4 {
-        f64x4::sqrt(self)
-    }
-    #[inline(always)]
-    fn abs(self) -> f64x4 {
-        f64x4::abs(self)
-    }
-    #[inline(always)]
-    fn le(self, other: f64x4) -> f64x4 {
-        self.cmp_le(other)
-    }
-    #[inline(always)]
-    fn positive(self) -> f64x4 {
-        self.cmp_gt(f64x4::ZERO)
-    }
-    #[inline(always)]
-    fn is_zero(self) -> f64x4 {
-        self.cmp_eq(f64x4::ZERO)
-    }
-    #[inline(always)]
-    fn dot(a: DVec3x4, b: DVec3x4) -> f64x4 {
-        a.dot(b)
-    }
-    #[inline(always)]
-    fn cross(a: DVec3x4, b: DVec3x4) -> DVec3x4 {
-        a.cross(b)
-    }
-    #[inline(always)]
-    fn pick(mask: f64x4, yes: impl FnOnce() -> f64x4, no: impl FnOnce() -> f64x4) -> f64x4 {
-        if mask.all() {
-            yes()
-        } else if mask.none() {
-            no()
-        } else {
-            mask.blend(yes(), no())
+    fn gather_vec(v: [DVec3; N]) -> V3<Self> {
+        V3 {
+            x: Self::gather(v.map(|v| v.x)),
+            y: Self::gather(v.map(|v| v.y)),
+            z: Self::gather(v.map(|v| v.z)),
         }
     }
+
     #[inline(always)]
-    fn pick_vec(
-        mask: f64x4,
-        yes: impl FnOnce() -> DVec3x4,
-        no: impl FnOnce() -> DVec3x4,
-    ) -> DVec3x4 {
-        if mask.all() {
-            yes()
-        } else if mask.none() {
-            no()
-        } else {
-            DVec3x4::blend(mask, yes(), no())
-        }
+    fn scatter_vec(v: V3<Self>) -> [DVec3; N] {
+        let (x, y, z) = (v.x.scatter(), v.y.scatter(), v.z.scatter());
+        std::array::from_fn(|k| DVec3::new(x[k], y[k], z[k]))
     }
 }
 
@@ -205,30 +306,7 @@ macro_rules! displacements {
         }
     )*};
 }
-displacements!(f64 => DVec3, f64x4 => DVec3x4);
-
-/// The four lanes of `f64x4` values from per-lane scalars.
-#[inline(always)]
-pub fn gather(values: [f64; 4]) -> f64x4 {
-    f64x4::from(values)
-}
-
-/// A lane vector from four vectors.
-#[inline(always)]
-pub fn gather_vec(v: [DVec3; 4]) -> DVec3x4 {
-    DVec3x4::new(
-        gather([v[0].x, v[1].x, v[2].x, v[3].x]),
-        gather([v[0].y, v[1].y, v[2].y, v[3].y]),
-        gather([v[0].z, v[1].z, v[2].z, v[3].z]),
-    )
-}
-
-/// The four vectors of a lane vector.
-#[inline(always)]
-pub fn scatter_vec(v: DVec3x4) -> [DVec3; 4] {
-    let (x, y, z) = (v.x.to_array(), v.y.to_array(), v.z.to_array());
-    std::array::from_fn(|k| DVec3::new(x[k], y[k], z[k]))
-}
+displacements!(f64 => DVec3, f64x4 => V3<f64x4>, f64x8 => V3<f64x8>);
 
 #[cfg(test)]
 mod tests {
@@ -243,8 +321,9 @@ mod tests {
             DVec3::new(2.2, 2.2, -9.9),
         ];
         let b = [a[3] * 0.7, a[2] + DVec3::ONE, -a[0], a[1] * 1e5];
-        let dot = <f64x4 as Lanes>::dot(gather_vec(a), gather_vec(b)).to_array();
-        let cross = scatter_vec(<f64x4 as Lanes>::cross(gather_vec(a), gather_vec(b)));
+        let (la, lb) = (f64x4::gather_vec(a), f64x4::gather_vec(b));
+        let dot = <f64x4 as Lanes>::dot(la, lb).scatter();
+        let cross = f64x4::scatter_vec(<f64x4 as Lanes>::cross(la, lb));
         for k in 0..4 {
             assert_eq!(dot[k].to_bits(), a[k].dot(b[k]).to_bits());
             assert_eq!(cross[k], a[k].cross(b[k]));
@@ -253,13 +332,13 @@ mod tests {
 
     #[test]
     fn pick_blends_only_where_lanes_disagree() {
-        let mask = gather([1.0, -1.0, 2.0, 0.0]).positive();
+        let mask = f64x4::gather([1.0, -1.0, 2.0, 0.0]).positive();
         let picked = <f64x4 as Lanes>::pick(mask, || f64x4::splat(1.0), || f64x4::splat(2.0));
         assert_eq!(picked.to_array(), [1.0, 2.0, 1.0, 2.0]);
-        let all = gather([1.0; 4]).positive();
+        let all = f64x8::gather([1.0; 8]).positive();
         assert_eq!(
-            <f64x4 as Lanes>::pick(all, || f64x4::splat(1.0), || unreachable!()).to_array(),
-            [1.0; 4]
+            <f64x8 as Lanes>::pick(all, || f64x8::splat(1.0), || unreachable!()).to_array(),
+            [1.0; 8]
         );
     }
 }

@@ -11,11 +11,10 @@ use std::time::Instant;
 use anyhow::{Result, bail};
 use glam::DVec3;
 use rayon::prelude::*;
-use wide::f64x4;
 
 use crate::contact::{Body, ContactForce, ContactLaw, Kinematics, Other, Springs};
 use crate::integrate::{Inertia, State, advance};
-use crate::lanes::{gather, gather_vec, scatter_vec};
+use crate::lanes::{Gather, Lanes};
 use crate::mesh::{Face, Mesh};
 use crate::motion::{Motion, Pose, RigidVelocity};
 use crate::neighbours::{CellGrid, MIN_PARALLEL_LEN, Neighbours, face_grid};
@@ -512,12 +511,15 @@ impl Simulation {
     /// Returns the overlaps deeper than the smaller radius (a sign of instability).
     ///
     /// Each piece of the list first sorts its pairs into touching and apart (forgetting
-    /// the springs of the latter), then evaluates the touching ones four at a time in SIMD
+    /// the springs of the latter), then evaluates the touching ones `WIDTH` at a time in SIMD
     /// lanes; a lane gives the bits the pair would give alone, so neither the pieces nor
     /// the grouping change a result.
     fn particle_contacts(&mut self) -> Vec<Deep> {
         /// Pairs per piece: small enough for stack buffers, large enough to fill lanes.
         const PIECE: usize = 256;
+        /// Lanes per group: 8 doubles fill an AVX-512 register, two AVX ones.
+        const WIDTH: usize = 8;
+        type Group = wide::f64x8;
         let deep = Mutex::new(Vec::new());
         let p = &self.particles;
         let law = &self.law;
@@ -548,27 +550,29 @@ impl Simulation {
                         forces[k] = ContactForce::default();
                     }
                 }
-                for group in touching[..count].chunks(4) {
+                for group in touching[..count].chunks(WIDTH) {
                     // A short last group repeats its last pair in the spare lanes.
-                    let k: [usize; 4] =
+                    let k: [usize; WIDTH] =
                         std::array::from_fn(|l| group[l.min(group.len() - 1)] as usize);
                     let i = k.map(|k| owner[k] as usize);
                     let j = k.map(|k| partner[k] as usize);
-                    let body = |idx: [usize; 4]| Body::<f64x4> {
-                        x: gather_vec(idx.map(|i| p.x[i])),
-                        radius: gather(idx.map(|i| p.radius[i])),
-                        v: gather_vec(idx.map(|i| p.v[i])),
-                        w: gather_vec(idx.map(|i| p.w[i])),
+                    let body = |idx: [usize; WIDTH]| Body::<Group> {
+                        x: Group::gather_vec(idx.map(|i| p.x[i])),
+                        radius: Group::gather(idx.map(|i| p.radius[i])),
+                        v: Group::gather_vec(idx.map(|i| p.v[i])),
+                        w: Group::gather_vec(idx.map(|i| p.w[i])),
                     };
                     let (body_i, body_j) = (body(i), body(j));
                     let d = body_i.x - body_j.x; // Eq. (8)
-                    let kin = Kinematics::of_touching_particles(&body_i, &body_j, d, d.mag_sq());
-                    let mass =
-                        |idx: [usize; 4]| gather(idx.map(|i| Inertia::mass(p.radius[i], density)));
-                    let mut lanes = Springs::<f64x4> {
-                        u_s: gather_vec(k.map(|k| springs[k].u_s)),
-                        u_r: gather_vec(k.map(|k| springs[k].u_r)),
-                        u_t: gather(k.map(|k| springs[k].u_t)),
+                    let kin =
+                        Kinematics::of_touching_particles(&body_i, &body_j, d, Group::dot(d, d));
+                    let mass = |idx: [usize; WIDTH]| {
+                        Group::gather(idx.map(|i| Inertia::mass(p.radius[i], density)))
+                    };
+                    let mut lanes = Springs::<Group> {
+                        u_s: Group::gather_vec(k.map(|k| springs[k].u_s)),
+                        u_r: Group::gather_vec(k.map(|k| springs[k].u_r)),
+                        u_t: Group::gather(k.map(|k| springs[k].u_t)),
                     };
                     let other = Other::Particle {
                         r: body_j.radius,
@@ -576,16 +580,16 @@ impl Simulation {
                     };
                     let force = law.evaluate(body_i.radius, mass(i), other, &kin, &mut lanes);
                     let (f, tau_i, tau_j) = (
-                        scatter_vec(force.f),
-                        scatter_vec(force.tau_i),
-                        scatter_vec(force.tau_j),
+                        Group::scatter_vec(force.f),
+                        Group::scatter_vec(force.tau_i),
+                        Group::scatter_vec(force.tau_j),
                     );
                     let (u_s, u_r, u_t) = (
-                        scatter_vec(lanes.u_s),
-                        scatter_vec(lanes.u_r),
-                        lanes.u_t.to_array(),
+                        Group::scatter_vec(lanes.u_s),
+                        Group::scatter_vec(lanes.u_r),
+                        lanes.u_t.scatter(),
                     );
-                    let delta = kin.delta.to_array();
+                    let delta = kin.delta.scatter();
                     for l in 0..group.len() {
                         forces[k[l]] = ContactForce {
                             f: f[l],
