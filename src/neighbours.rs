@@ -180,6 +180,10 @@ pub struct ContactList {
     pub partner: Vec<u32>,
     /// Friction springs of each slot.
     pub springs: Vec<Springs>,
+    /// Whether the slot's springs may be non-zero (its pair touched at the last force
+    /// evaluation, or had springs when listed): a pair apart needs its springs zeroed
+    /// only once, and is not looked at again while it stays apart.
+    pub touched: Vec<bool>,
 }
 
 impl ContactList {
@@ -201,7 +205,11 @@ impl ContactList {
         for &(i, j, springs) in history {
             let run = self.run(i as usize);
             match run.binary_search(&j) {
-                Ok(k) => self.springs[self.start[i as usize] as usize + k] = springs,
+                Ok(k) => {
+                    let slot = self.start[i as usize] as usize + k;
+                    self.springs[slot] = springs;
+                    self.touched[slot] = true;
+                }
                 Err(_) => return Err(format!("contact ({i}, {j}) is not within reach")),
             }
         }
@@ -237,6 +245,7 @@ impl ContactList {
             owner: Vec::new(),
             partner,
             springs,
+            touched: Vec::new(),
         }
     }
 
@@ -247,7 +256,7 @@ impl ContactList {
         for (i, w) in start.windows(2).enumerate() {
             owner.extend(std::iter::repeat_n(i as u32, (w[1] - w[0]) as usize));
         }
-        let springs = owner
+        let springs: Vec<Springs> = owner
             .par_iter()
             .zip(partner.par_iter())
             .with_min_len(MIN_PARALLEL_LEN)
@@ -259,11 +268,17 @@ impl ContactList {
                 }
             })
             .collect();
+        let touched = springs
+            .par_iter()
+            .with_min_len(MIN_PARALLEL_LEN)
+            .map(|s| *s != Springs::default())
+            .collect();
         ContactList {
             start,
             owner,
             partner,
             springs,
+            touched,
         }
     }
 }

@@ -22,14 +22,6 @@ use crate::particles::Particles;
 use crate::scenario::{MeshSource, Scenario, default_timestep};
 use crate::spawn::{Spawner, SpawnerState};
 
-/// Resets the springs of a pair that is not touching (writing only if needed).
-#[inline]
-fn forget(springs: &mut Springs) {
-    if *springs != Springs::default() {
-        *springs = Springs::default();
-    }
-}
-
 /// The stages of a step, for the timing breakdown.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Stage {
@@ -530,13 +522,14 @@ impl Simulation {
         self.pair_forces
             .par_chunks_mut(PIECE)
             .zip(list.springs.par_chunks_mut(PIECE))
+            .zip(list.touched.par_chunks_mut(PIECE))
             .zip(
                 list.owner
                     .par_chunks(PIECE)
                     .zip(list.partner.par_chunks(PIECE)),
             )
             .with_min_len(MIN_PARALLEL_LEN.div_ceil(PIECE))
-            .for_each(|((forces, springs), (owner, partner))| {
+            .for_each(|(((forces, springs), touched), (owner, partner))| {
                 let mut touching = [0u16; PIECE];
                 let mut count = 0;
                 for (k, (&i, &j)) in owner.iter().zip(partner).enumerate() {
@@ -545,8 +538,12 @@ impl Simulation {
                     if (p.x[i] - p.x[j]).length_squared() < reach * reach {
                         touching[count] = k as u16;
                         count += 1;
+                        touched[k] = true;
                     } else {
-                        forget(&mut springs[k]); // the contact ended: forget its history
+                        if touched[k] {
+                            springs[k] = Springs::default(); // the contact ended: forget its history
+                            touched[k] = false;
+                        }
                         forces[k] = ContactForce::default();
                     }
                 }
@@ -630,10 +627,10 @@ impl Simulation {
             .resize(list.partner.len(), ContactForce::default());
         self.face_forces
             .par_iter_mut()
-            .zip(list.springs.par_iter_mut())
+            .zip(list.springs.par_iter_mut().zip(list.touched.par_iter_mut()))
             .zip(list.owner.par_iter().zip(list.partner.par_iter()))
             .with_min_len(MIN_PARALLEL_LEN)
-            .for_each(|((force, springs), (&i, &f))| {
+            .for_each(|((force, (springs, touched)), (&i, &f))| {
                 let i = i as usize;
                 let face = &faces[f as usize];
                 let body = Body {
@@ -642,17 +639,16 @@ impl Simulation {
                     v: p.v[i],
                     w: p.w[i],
                 };
-                if face.certainly_beyond(body.x, body.radius + face.radius) {
-                    forget(springs);
-                    *force = ContactForce::default();
-                    return;
-                }
-                let d = face.separation(body.x);
-                let wall = match face_part[f as usize] {
-                    STATIC => RigidVelocity::default(),
-                    k => moving[k as usize].velocity,
+                let kin = if face.certainly_beyond(body.x, body.radius + face.radius) {
+                    None
+                } else {
+                    let wall = match face_part[f as usize] {
+                        STATIC => RigidVelocity::default(),
+                        k => moving[k as usize].velocity,
+                    };
+                    Kinematics::with_wall(&body, face.separation(body.x), face.radius, &wall)
                 };
-                *force = match Kinematics::with_wall(&body, d, face.radius, &wall) {
+                *force = match kin {
                     Some(kin) => {
                         if kin.delta > p.radius[i] {
                             deep.lock().expect("not poisoned").push(Deep {
@@ -662,11 +658,15 @@ impl Simulation {
                                 limit: p.radius[i],
                             });
                         }
+                        *touched = true;
                         let m_i = Inertia::mass(p.radius[i], density);
                         law.evaluate(p.radius[i], m_i, Other::Wall, &kin, springs)
                     }
                     None => {
-                        forget(springs);
+                        if *touched {
+                            *springs = Springs::default(); // the contact ended: forget its history
+                            *touched = false;
+                        }
                         ContactForce::default()
                     }
                 };

@@ -401,3 +401,56 @@ fn orientation_stays_unit_and_composes_world_spin_from_the_left() {
     let q = s.particles.q[0];
     assert!(q.dot(expected).abs() > 1.0 - 1e-12, "{q:?} vs {expected:?}");
 }
+
+/// A contact that ends forgets its friction history (Table 3: springs exist only while
+/// touching), also while the pair stays listed, for particle pairs and for faces; a new
+/// touch starts from zero springs.
+#[test]
+fn contacts_forget_their_springs_when_they_end() {
+    let mut s = sim(
+        "restitution = 0.5\nfriction_sliding = 0.5\nfriction_rolling = 0.1\nfriction_twisting = 0.1",
+        DVec3::ZERO,
+        Some(1e-6),
+        Some(FLOOR),
+        vec![
+            // A glancing, spinning collision of two grains...
+            particle(
+                DVec3::new(-R - 1e-5, 0.0, 0.1),
+                DVec3::new(0.2, 0.05, 0.0),
+                DVec3::new(0.0, 0.0, 30.0),
+            ),
+            particle(DVec3::new(R + 1e-5, 0.002, 0.1), DVec3::ZERO, DVec3::ZERO),
+            // ...and a grain that skids along the floor and jumps off it.
+            particle(
+                DVec3::new(0.3, 0.0, R - 1e-5),
+                DVec3::new(0.1, 0.0, 0.05),
+                DVec3::new(5.0, 0.0, 0.0),
+            ),
+        ],
+    );
+    let mut touched = (false, false);
+    for _ in 0..20_000 {
+        s.step().unwrap();
+        let snapshot = s.snapshot();
+        touched.0 |= !snapshot.pair_history.is_empty();
+        touched.1 |= !snapshot.face_history.is_empty();
+    }
+    assert_eq!(touched, (true, true), "both contacts built up springs");
+    let (pairs, faces) = s.list_slots();
+    assert!(
+        pairs > 0 && faces > 0,
+        "still listed: {pairs} pairs, {faces} faces"
+    );
+    let snapshot = s.snapshot();
+    assert!(
+        snapshot.pair_history.is_empty(),
+        "{:?}",
+        snapshot.pair_history
+    );
+    assert!(
+        snapshot.face_history.is_empty(),
+        "{:?}",
+        snapshot.face_history
+    );
+    assert_eq!(s.contact_count(), 0);
+}
