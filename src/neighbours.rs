@@ -180,9 +180,9 @@ pub struct ContactList {
     pub partner: Vec<u32>,
     /// Friction springs of each slot.
     pub springs: Vec<Springs>,
-    /// Whether the slot's springs may be non-zero (its pair touched at the last force
-    /// evaluation, or had springs when listed): a pair apart needs its springs zeroed
-    /// only once, and is not looked at again while it stays apart.
+    /// Whether the slot's springs (and its force, kept by the simulation) may be non-zero:
+    /// its pair touched at the last force evaluation, or had springs when listed. A pair
+    /// apart has both zeroed once, and is not looked at again while it stays apart.
     pub touched: Vec<bool>,
 }
 

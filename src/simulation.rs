@@ -496,6 +496,13 @@ impl Simulation {
         let p = &self.particles;
         self.neighbours
             .rebuild(&p.x, &p.radius, &self.mesh.faces, &self.face_grid);
+        // The new slots' forces are zero until their pairs touch; stages 3 and 4 then write
+        // a slot's force while it touches and zero it once when it stops.
+        let zero = ContactForce::default();
+        self.pair_forces.clear();
+        self.pair_forces.resize(self.neighbours.pairs.slots(), zero);
+        self.face_forces.clear();
+        self.face_forces.resize(self.neighbours.faces.slots(), zero);
         self.mark_mesh_built();
     }
 
@@ -518,8 +525,6 @@ impl Simulation {
         let density = self.scenario.material.density;
         let list = &mut self.neighbours.pairs;
         self.pair_forces
-            .resize(list.partner.len(), ContactForce::default());
-        self.pair_forces
             .par_chunks_mut(PIECE)
             .zip(list.springs.par_chunks_mut(PIECE))
             .zip(list.touched.par_chunks_mut(PIECE))
@@ -539,12 +544,11 @@ impl Simulation {
                         touching[count] = k as u16;
                         count += 1;
                         touched[k] = true;
-                    } else {
-                        if touched[k] {
-                            springs[k] = Springs::default(); // the contact ended: forget its history
-                            touched[k] = false;
-                        }
+                    } else if touched[k] {
+                        // The contact ended: forget its history and its force.
+                        springs[k] = Springs::default();
                         forces[k] = ContactForce::default();
+                        touched[k] = false;
                     }
                 }
                 for group in touching[..count].chunks(WIDTH) {
@@ -624,8 +628,6 @@ impl Simulation {
         let density = self.scenario.material.density;
         let list = &mut self.neighbours.faces;
         self.face_forces
-            .resize(list.partner.len(), ContactForce::default());
-        self.face_forces
             .par_iter_mut()
             .zip(list.springs.par_iter_mut().zip(list.touched.par_iter_mut()))
             .zip(list.owner.par_iter().zip(list.partner.par_iter()))
@@ -648,7 +650,7 @@ impl Simulation {
                     };
                     Kinematics::with_wall(&body, face.separation(body.x), face.radius, &wall)
                 };
-                *force = match kin {
+                match kin {
                     Some(kin) => {
                         if kin.delta > p.radius[i] {
                             deep.lock().expect("not poisoned").push(Deep {
@@ -660,16 +662,16 @@ impl Simulation {
                         }
                         *touched = true;
                         let m_i = Inertia::mass(p.radius[i], density);
-                        law.evaluate(p.radius[i], m_i, Other::Wall, &kin, springs)
+                        *force = law.evaluate(p.radius[i], m_i, Other::Wall, &kin, springs);
                     }
-                    None => {
-                        if *touched {
-                            *springs = Springs::default(); // the contact ended: forget its history
-                            *touched = false;
-                        }
-                        ContactForce::default()
+                    None if *touched => {
+                        // The contact ended: forget its history and its force.
+                        *springs = Springs::default();
+                        *force = ContactForce::default();
+                        *touched = false;
                     }
-                };
+                    None => {}
+                }
             });
         deep.into_inner().expect("not poisoned")
     }
