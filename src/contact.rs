@@ -448,6 +448,40 @@ mod tests {
             4.0 / 3.0 * std::f64::consts::PI * 2500.0 * r.powi(3)
         }
 
+        /// Fails unless the lanes of `force` and `springs` have the bits of the contacts
+        /// evaluated one by one.
+        fn same_bits<T: Gather<N>, const N: usize>(
+            single: &[(ContactForce, Springs); N],
+            force: ContactForce<T>,
+            springs: Springs<T>,
+        ) -> Result<(), TestCaseError> {
+            let (f, tau_i, tau_j) = (
+                T::scatter_vec(force.f),
+                T::scatter_vec(force.tau_i),
+                T::scatter_vec(force.tau_j),
+            );
+            let (u_s, u_r, u_t) = (
+                T::scatter_vec(springs.u_s),
+                T::scatter_vec(springs.u_r),
+                springs.u_t.scatter(),
+            );
+            let bits = |v: DVec3| v.to_array().map(f64::to_bits);
+            for (l, (alone, springs_alone)) in single.iter().enumerate() {
+                prop_assert_eq!(bits(f[l]), bits(alone.f), "f, lane {}", l);
+                prop_assert_eq!(bits(tau_i[l]), bits(alone.tau_i), "tau_i, lane {}", l);
+                prop_assert_eq!(bits(tau_j[l]), bits(alone.tau_j), "tau_j, lane {}", l);
+                prop_assert_eq!(bits(u_s[l]), bits(springs_alone.u_s), "u_s, lane {}", l);
+                prop_assert_eq!(bits(u_r[l]), bits(springs_alone.u_r), "u_r, lane {}", l);
+                prop_assert_eq!(
+                    u_t[l].to_bits(),
+                    springs_alone.u_t.to_bits(),
+                    "u_t, lane {}",
+                    l
+                );
+            }
+            Ok(())
+        }
+
         /// Evaluates `N` contacts in the lanes of `T` and each alone; fails unless every
         /// force, torque and spring has the same bits.
         fn lanes_match_single_contacts<T, const N: usize>(
@@ -488,34 +522,81 @@ mod tests {
                 m: m(&j),
             };
             let force = law.evaluate(i.radius, m(&i), other, &kin, &mut springs);
-            let (f, tau_i, tau_j) = (
-                T::scatter_vec(force.f),
-                T::scatter_vec(force.tau_i),
-                T::scatter_vec(force.tau_j),
-            );
-            let (u_s, u_r, u_t) = (
-                T::scatter_vec(springs.u_s),
-                T::scatter_vec(springs.u_r),
-                springs.u_t.scatter(),
-            );
-            let bits = |v: DVec3| v.to_array().map(f64::to_bits);
-            for (l, (alone, springs_alone)) in single.iter().enumerate() {
-                prop_assert_eq!(bits(f[l]), bits(alone.f), "f, lane {}", l);
-                prop_assert_eq!(bits(tau_i[l]), bits(alone.tau_i), "tau_i, lane {}", l);
-                prop_assert_eq!(bits(tau_j[l]), bits(alone.tau_j), "tau_j, lane {}", l);
-                prop_assert_eq!(bits(u_s[l]), bits(springs_alone.u_s), "u_s, lane {}", l);
-                prop_assert_eq!(bits(u_r[l]), bits(springs_alone.u_r), "u_r, lane {}", l);
-                prop_assert_eq!(
-                    u_t[l].to_bits(),
-                    springs_alone.u_t.to_bits(),
-                    "u_t, lane {}",
-                    l
+            same_bits(&single, force, springs)
+        }
+
+        /// A particle touching a static wall whose closest point is at `d` from its centre.
+        fn wall_contact() -> impl Strategy<Value = (Body, DVec3, Springs)> {
+            let spring = prop_oneof![Just(DVec3::ZERO), vec3(1e-6), vec3(1e-2)];
+            (
+                (1e-3..1e-2f64, 0.5..0.999f64, vec3(1.0)),
+                (vec3(1.0), vec3(100.0)),
+                (spring.clone(), spring, -1e-2..1e-2f64),
+            )
+                .prop_map(|((r, reach, dir), (v, w), (u_s, u_r, u_t))| {
+                    let d = dir.try_normalize().unwrap_or(DVec3::Z) * r * reach;
+                    let body = Body {
+                        x: DVec3::new(0.1, 0.2, 0.3),
+                        radius: r,
+                        v,
+                        w,
+                    };
+                    (body, d, Springs { u_s, u_r, u_t })
+                })
+        }
+
+        fn walls_in_lanes_match_single_contacts<T, const N: usize>(
+            contacts: [(Body, DVec3, Springs); N],
+            law: ContactLaw,
+        ) -> Result<(), TestCaseError>
+        where
+            T: Gather<N> + Displacement<T>,
+            T::Vec: Displacement<T>,
+        {
+            let still = RigidVelocity::default();
+            let kin = contacts.map(|(body, d, _)| {
+                Kinematics::with_wall(&body, d, 0.0, &still).expect("overlapping")
+            });
+            let single: [_; N] = std::array::from_fn(|l| {
+                let (body, _, mut springs) = contacts[l];
+                let force = law.evaluate(
+                    body.radius,
+                    mass(body.radius),
+                    Other::Wall,
+                    &kin[l],
+                    &mut springs,
                 );
-            }
-            Ok(())
+                (force, springs)
+            });
+            let lanes = Kinematics::<T> {
+                n: T::gather_vec(kin.map(|k| k.n)),
+                delta: T::gather(kin.map(|k| k.delta)),
+                r_i: T::gather(kin.map(|k| k.r_i)),
+                r_j: T::gather(kin.map(|k| k.r_j)),
+                v: T::gather_vec(kin.map(|k| k.v)),
+                omega: T::gather_vec(kin.map(|k| k.omega)),
+            };
+            let mut springs = Springs::<T> {
+                u_s: T::gather_vec(contacts.map(|c| c.2.u_s)),
+                u_r: T::gather_vec(contacts.map(|c| c.2.u_r)),
+                u_t: T::gather(contacts.map(|c| c.2.u_t)),
+            };
+            let radius = T::gather(contacts.map(|c| c.0.radius));
+            let m = T::gather(contacts.map(|c| mass(c.0.radius)));
+            let force = law.evaluate(radius, m, Other::Wall, &lanes, &mut springs);
+            same_bits(&single, force, springs)
         }
 
         proptest! {
+            /// The mesh stage evaluates the law for several wall contacts at once.
+            #[test]
+            fn wall_contacts_in_eight_lanes_give_their_single_bits(
+                contacts in proptest::array::uniform8(wall_contact()),
+                e_n in 0.1..0.9f64,
+            ) {
+                walls_in_lanes_match_single_contacts::<f64x8, 8>(contacts, law(e_n))?;
+            }
+
             /// The particle-pair stage evaluates several contacts at once; each lane must
             /// give the bits of the contact evaluated alone.
             #[test]

@@ -22,6 +22,40 @@ use crate::particles::Particles;
 use crate::scenario::{MeshSource, Scenario, default_timestep};
 use crate::spawn::{Spawner, SpawnerState};
 
+/// List slots per piece of the contact stages: small enough for stack buffers, large
+/// enough to fill lanes.
+const PIECE: usize = 256;
+/// Contacts per group evaluated together: 8 doubles fill an AVX-512 register, two AVX ones.
+const WIDTH: usize = 8;
+type Group = wide::f64x8;
+
+/// The springs of slots `k` in the lanes of a group.
+#[inline(always)]
+fn gather_springs(springs: &[Springs], k: [usize; WIDTH]) -> Springs<Group> {
+    Springs {
+        u_s: Group::gather_vec(k.map(|k| springs[k].u_s)),
+        u_r: Group::gather_vec(k.map(|k| springs[k].u_r)),
+        u_t: Group::gather(k.map(|k| springs[k].u_t)),
+    }
+}
+
+/// Puts the springs of a group's lanes back into slots `k` (the first `k.len()` lanes).
+#[inline(always)]
+fn scatter_springs(lanes: Springs<Group>, springs: &mut [Springs], k: &[usize]) {
+    let (u_s, u_r, u_t) = (
+        Group::scatter_vec(lanes.u_s),
+        Group::scatter_vec(lanes.u_r),
+        lanes.u_t.scatter(),
+    );
+    for (l, &k) in k.iter().enumerate() {
+        springs[k] = Springs {
+            u_s: u_s[l],
+            u_r: u_r[l],
+            u_t: u_t[l],
+        };
+    }
+}
+
 /// The stages of a step, for the timing breakdown.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Stage {
@@ -514,11 +548,6 @@ impl Simulation {
     /// lanes; a lane gives the bits the pair would give alone, so neither the pieces nor
     /// the grouping change a result.
     fn particle_contacts(&mut self) -> Vec<Deep> {
-        /// Pairs per piece: small enough for stack buffers, large enough to fill lanes.
-        const PIECE: usize = 256;
-        /// Lanes per group: 8 doubles fill an AVX-512 register, two AVX ones.
-        const WIDTH: usize = 8;
-        type Group = wide::f64x8;
         let deep = Mutex::new(Vec::new());
         let p = &self.particles;
         let law = &self.law;
@@ -570,25 +599,17 @@ impl Simulation {
                     let mass = |idx: [usize; WIDTH]| {
                         Group::gather(idx.map(|i| Inertia::mass(p.radius[i], density)))
                     };
-                    let mut lanes = Springs::<Group> {
-                        u_s: Group::gather_vec(k.map(|k| springs[k].u_s)),
-                        u_r: Group::gather_vec(k.map(|k| springs[k].u_r)),
-                        u_t: Group::gather(k.map(|k| springs[k].u_t)),
-                    };
+                    let mut lanes = gather_springs(springs, k);
                     let other = Other::Particle {
                         r: body_j.radius,
                         m: mass(j),
                     };
                     let force = law.evaluate(body_i.radius, mass(i), other, &kin, &mut lanes);
+                    scatter_springs(lanes, springs, &k[..group.len()]);
                     let (f, tau_i, tau_j) = (
                         Group::scatter_vec(force.f),
                         Group::scatter_vec(force.tau_i),
                         Group::scatter_vec(force.tau_j),
-                    );
-                    let (u_s, u_r, u_t) = (
-                        Group::scatter_vec(lanes.u_s),
-                        Group::scatter_vec(lanes.u_r),
-                        lanes.u_t.scatter(),
                     );
                     let delta = kin.delta.scatter();
                     for l in 0..group.len() {
@@ -596,11 +617,6 @@ impl Simulation {
                             f: f[l],
                             tau_i: tau_i[l],
                             tau_j: tau_j[l],
-                        };
-                        springs[k[l]] = Springs {
-                            u_s: u_s[l],
-                            u_r: u_r[l],
-                            u_t: u_t[l],
                         };
                         let limit = p.radius[i[l]].min(p.radius[j[l]]);
                         if delta[l] > limit {
@@ -619,6 +635,10 @@ impl Simulation {
 
     /// Stage 4 (Sections 2.2, 3.3): the force of every touching particle-face pair.
     /// Returns the overlaps deeper than the particle's radius.
+    ///
+    /// Each piece of the list finds the closest points and the kinematics of its contacts
+    /// one by one, then evaluates the law for `WIDTH` touching ones at a time in SIMD lanes
+    /// (bit for bit as alone).
     fn mesh_contacts(&mut self) -> Vec<Deep> {
         let deep = Mutex::new(Vec::new());
         let p = &self.particles;
@@ -628,51 +648,99 @@ impl Simulation {
         let density = self.scenario.material.density;
         let list = &mut self.neighbours.faces;
         self.face_forces
-            .par_iter_mut()
-            .zip(list.springs.par_iter_mut().zip(list.touched.par_iter_mut()))
-            .zip(list.owner.par_iter().zip(list.partner.par_iter()))
-            .with_min_len(MIN_PARALLEL_LEN)
-            .for_each(|((force, (springs, touched)), (&i, &f))| {
-                let i = i as usize;
-                let face = &faces[f as usize];
-                let body = Body {
-                    x: p.x[i],
-                    radius: p.radius[i],
-                    v: p.v[i],
-                    w: p.w[i],
-                };
-                let kin = if face.certainly_beyond(body.x, body.radius + face.radius) {
-                    None
-                } else {
-                    let wall = match face_part[f as usize] {
-                        STATIC => RigidVelocity::default(),
-                        k => moving[k as usize].velocity,
-                    };
-                    Kinematics::with_wall(&body, face.separation(body.x), face.radius, &wall)
-                };
-                match kin {
-                    Some(kin) => {
-                        if kin.delta > p.radius[i] {
-                            deep.lock().expect("not poisoned").push(Deep {
-                                i,
-                                other: Partner::Face(f as usize),
-                                delta: kin.delta,
-                                limit: p.radius[i],
-                            });
+            .par_chunks_mut(PIECE)
+            .zip(list.springs.par_chunks_mut(PIECE))
+            .zip(list.touched.par_chunks_mut(PIECE))
+            .zip(
+                list.owner
+                    .par_chunks(PIECE)
+                    .zip(list.partner.par_chunks(PIECE)),
+            )
+            .with_min_len(MIN_PARALLEL_LEN.div_ceil(PIECE))
+            .for_each_init(
+                || Vec::with_capacity(PIECE),
+                |touching, (((forces, springs), touched), (owner, partner))| {
+                    // The geometry of each contact alone: closest point, kinematics.
+                    touching.clear();
+                    for (k, (&i, &f)) in owner.iter().zip(partner).enumerate() {
+                        let (i, face) = (i as usize, &faces[f as usize]);
+                        let body = Body {
+                            x: p.x[i],
+                            radius: p.radius[i],
+                            v: p.v[i],
+                            w: p.w[i],
+                        };
+                        let kin = if face.certainly_beyond(body.x, body.radius + face.radius) {
+                            None
+                        } else {
+                            let wall = match face_part[f as usize] {
+                                STATIC => RigidVelocity::default(),
+                                k => moving[k as usize].velocity,
+                            };
+                            Kinematics::with_wall(
+                                &body,
+                                face.separation(body.x),
+                                face.radius,
+                                &wall,
+                            )
+                        };
+                        match kin {
+                            Some(kin) => {
+                                if kin.delta > body.radius {
+                                    deep.lock().expect("not poisoned").push(Deep {
+                                        i,
+                                        other: Partner::Face(f as usize),
+                                        delta: kin.delta,
+                                        limit: body.radius,
+                                    });
+                                }
+                                touching.push((k, kin));
+                                touched[k] = true;
+                            }
+                            None if touched[k] => {
+                                // The contact ended: forget its history and its force.
+                                springs[k] = Springs::default();
+                                forces[k] = ContactForce::default();
+                                touched[k] = false;
+                            }
+                            None => {}
                         }
-                        *touched = true;
-                        let m_i = Inertia::mass(p.radius[i], density);
-                        *force = law.evaluate(p.radius[i], m_i, Other::Wall, &kin, springs);
                     }
-                    None if *touched => {
-                        // The contact ended: forget its history and its force.
-                        *springs = Springs::default();
-                        *force = ContactForce::default();
-                        *touched = false;
+                    // The law, `WIDTH` contacts at a time (as for particle pairs).
+                    for group in touching.chunks(WIDTH) {
+                        let c: [&(usize, Kinematics); WIDTH] =
+                            std::array::from_fn(|l| &group[l.min(group.len() - 1)]);
+                        let k = c.map(|c| c.0);
+                        let i = k.map(|k| owner[k] as usize);
+                        let scalar =
+                            |get: fn(&Kinematics) -> f64| Group::gather(c.map(|c| get(&c.1)));
+                        let vector =
+                            |get: fn(&Kinematics) -> DVec3| Group::gather_vec(c.map(|c| get(&c.1)));
+                        let kin = Kinematics::<Group> {
+                            n: vector(|k| k.n),
+                            delta: scalar(|k| k.delta),
+                            r_i: scalar(|k| k.r_i),
+                            r_j: scalar(|k| k.r_j),
+                            v: vector(|k| k.v),
+                            omega: vector(|k| k.omega),
+                        };
+                        let radius = Group::gather(i.map(|i| p.radius[i]));
+                        let mass = Group::gather(i.map(|i| Inertia::mass(p.radius[i], density)));
+                        let mut lanes = gather_springs(springs, k);
+                        let force = law.evaluate(radius, mass, Other::Wall, &kin, &mut lanes);
+                        scatter_springs(lanes, springs, &k[..group.len()]);
+                        let (f, tau_i) =
+                            (Group::scatter_vec(force.f), Group::scatter_vec(force.tau_i));
+                        for l in 0..group.len() {
+                            forces[k[l]] = ContactForce {
+                                f: f[l],
+                                tau_i: tau_i[l],
+                                tau_j: DVec3::ZERO, // a wall takes no reaction
+                            };
+                        }
                     }
-                    None => {}
-                }
-            });
+                },
+            );
         deep.into_inner().expect("not poisoned")
     }
 
