@@ -17,7 +17,7 @@ use crate::integrate::{Inertia, State, advance};
 use crate::lanes::{Gather, Lanes};
 use crate::mesh::{Face, Mesh};
 use crate::motion::{Motion, Pose, RigidVelocity};
-use crate::neighbours::{CellGrid, MIN_PARALLEL_LEN, Neighbours, face_grid};
+use crate::neighbours::{CellGrid, ContactList, MIN_PARALLEL_LEN, Neighbours, face_grid};
 use crate::particles::Particles;
 use crate::scenario::{MeshSource, Scenario, default_timestep};
 use crate::spawn::{Spawner, SpawnerState};
@@ -28,6 +28,36 @@ const PIECE: usize = 256;
 /// Contacts per group evaluated together: 8 doubles fill an AVX-512 register, two AVX ones.
 const WIDTH: usize = 8;
 type Group = wide::f64x8;
+
+/// A piece of a contact list (`PIECE` slots): the forces, springs, touched flags, owners
+/// and partners of its slots.
+type Piece<'a> = (
+    &'a mut [ContactForce],
+    &'a mut [Springs],
+    &'a mut [bool],
+    &'a [u32],
+    &'a [u32],
+);
+
+/// The pieces of `list` and its slots' `forces`, for the contact stages to run in parallel.
+fn pieces<'a>(
+    forces: &'a mut [ContactForce],
+    list: &'a mut ContactList,
+) -> impl IndexedParallelIterator<Item = Piece<'a>> {
+    forces
+        .par_chunks_mut(PIECE)
+        .zip(list.springs.par_chunks_mut(PIECE))
+        .zip(list.touched.par_chunks_mut(PIECE))
+        .zip(
+            list.owner
+                .par_chunks(PIECE)
+                .zip(list.partner.par_chunks(PIECE)),
+        )
+        .map(|(((forces, springs), touched), (owner, partner))| {
+            (forces, springs, touched, owner, partner)
+        })
+        .with_min_len(MIN_PARALLEL_LEN.div_ceil(PIECE))
+}
 
 /// The springs of slots `k` in the lanes of a group.
 #[inline(always)]
@@ -553,17 +583,8 @@ impl Simulation {
         let law = &self.law;
         let density = self.scenario.material.density;
         let list = &mut self.neighbours.pairs;
-        self.pair_forces
-            .par_chunks_mut(PIECE)
-            .zip(list.springs.par_chunks_mut(PIECE))
-            .zip(list.touched.par_chunks_mut(PIECE))
-            .zip(
-                list.owner
-                    .par_chunks(PIECE)
-                    .zip(list.partner.par_chunks(PIECE)),
-            )
-            .with_min_len(MIN_PARALLEL_LEN.div_ceil(PIECE))
-            .for_each(|(((forces, springs), touched), (owner, partner))| {
+        pieces(&mut self.pair_forces, list).for_each(
+            |(forces, springs, touched, owner, partner)| {
                 let mut touching = [0u16; PIECE];
                 let mut count = 0;
                 for (k, (&i, &j)) in owner.iter().zip(partner).enumerate() {
@@ -629,7 +650,8 @@ impl Simulation {
                         }
                     }
                 }
-            });
+            },
+        );
         deep.into_inner().expect("not poisoned")
     }
 
@@ -647,100 +669,83 @@ impl Simulation {
         let (face_part, moving) = (&self.face_part, &self.moving);
         let density = self.scenario.material.density;
         let list = &mut self.neighbours.faces;
-        self.face_forces
-            .par_chunks_mut(PIECE)
-            .zip(list.springs.par_chunks_mut(PIECE))
-            .zip(list.touched.par_chunks_mut(PIECE))
-            .zip(
-                list.owner
-                    .par_chunks(PIECE)
-                    .zip(list.partner.par_chunks(PIECE)),
-            )
-            .with_min_len(MIN_PARALLEL_LEN.div_ceil(PIECE))
-            .for_each_init(
-                || Vec::with_capacity(PIECE),
-                |touching, (((forces, springs), touched), (owner, partner))| {
-                    // The geometry of each contact alone: closest point, kinematics.
-                    touching.clear();
-                    for (k, (&i, &f)) in owner.iter().zip(partner).enumerate() {
-                        let (i, face) = (i as usize, &faces[f as usize]);
-                        let body = Body {
-                            x: p.x[i],
-                            radius: p.radius[i],
-                            v: p.v[i],
-                            w: p.w[i],
+        pieces(&mut self.face_forces, list).for_each_init(
+            || Vec::with_capacity(PIECE),
+            |touching, (forces, springs, touched, owner, partner)| {
+                // The geometry of each contact alone: closest point, kinematics.
+                touching.clear();
+                for (k, (&i, &f)) in owner.iter().zip(partner).enumerate() {
+                    let (i, face) = (i as usize, &faces[f as usize]);
+                    let body = Body {
+                        x: p.x[i],
+                        radius: p.radius[i],
+                        v: p.v[i],
+                        w: p.w[i],
+                    };
+                    let kin = if face.certainly_beyond(body.x, body.radius + face.radius) {
+                        None
+                    } else {
+                        let wall = match face_part[f as usize] {
+                            STATIC => RigidVelocity::default(),
+                            k => moving[k as usize].velocity,
                         };
-                        let kin = if face.certainly_beyond(body.x, body.radius + face.radius) {
-                            None
-                        } else {
-                            let wall = match face_part[f as usize] {
-                                STATIC => RigidVelocity::default(),
-                                k => moving[k as usize].velocity,
-                            };
-                            Kinematics::with_wall(
-                                &body,
-                                face.separation(body.x),
-                                face.radius,
-                                &wall,
-                            )
-                        };
-                        match kin {
-                            Some(kin) => {
-                                if kin.delta > body.radius {
-                                    deep.lock().expect("not poisoned").push(Deep {
-                                        i,
-                                        other: Partner::Face(f as usize),
-                                        delta: kin.delta,
-                                        limit: body.radius,
-                                    });
-                                }
-                                touching.push((k, kin));
-                                touched[k] = true;
+                        Kinematics::with_wall(&body, face.separation(body.x), face.radius, &wall)
+                    };
+                    match kin {
+                        Some(kin) => {
+                            if kin.delta > body.radius {
+                                deep.lock().expect("not poisoned").push(Deep {
+                                    i,
+                                    other: Partner::Face(f as usize),
+                                    delta: kin.delta,
+                                    limit: body.radius,
+                                });
                             }
-                            None if touched[k] => {
-                                // The contact ended: forget its history and its force.
-                                springs[k] = Springs::default();
-                                forces[k] = ContactForce::default();
-                                touched[k] = false;
-                            }
-                            None => {}
+                            touching.push((k, kin));
+                            touched[k] = true;
                         }
+                        None if touched[k] => {
+                            // The contact ended: forget its history and its force.
+                            springs[k] = Springs::default();
+                            forces[k] = ContactForce::default();
+                            touched[k] = false;
+                        }
+                        None => {}
                     }
-                    // The law, `WIDTH` contacts at a time (as for particle pairs).
-                    for group in touching.chunks(WIDTH) {
-                        let c: [&(usize, Kinematics); WIDTH] =
-                            std::array::from_fn(|l| &group[l.min(group.len() - 1)]);
-                        let k = c.map(|c| c.0);
-                        let i = k.map(|k| owner[k] as usize);
-                        let scalar =
-                            |get: fn(&Kinematics) -> f64| Group::gather(c.map(|c| get(&c.1)));
-                        let vector =
-                            |get: fn(&Kinematics) -> DVec3| Group::gather_vec(c.map(|c| get(&c.1)));
-                        let kin = Kinematics::<Group> {
-                            n: vector(|k| k.n),
-                            delta: scalar(|k| k.delta),
-                            r_i: scalar(|k| k.r_i),
-                            r_j: scalar(|k| k.r_j),
-                            v: vector(|k| k.v),
-                            omega: vector(|k| k.omega),
+                }
+                // The law, `WIDTH` contacts at a time (as for particle pairs).
+                for group in touching.chunks(WIDTH) {
+                    let c: [&(usize, Kinematics); WIDTH] =
+                        std::array::from_fn(|l| &group[l.min(group.len() - 1)]);
+                    let k = c.map(|c| c.0);
+                    let i = k.map(|k| owner[k] as usize);
+                    let scalar = |get: fn(&Kinematics) -> f64| Group::gather(c.map(|c| get(&c.1)));
+                    let vector =
+                        |get: fn(&Kinematics) -> DVec3| Group::gather_vec(c.map(|c| get(&c.1)));
+                    let kin = Kinematics::<Group> {
+                        n: vector(|k| k.n),
+                        delta: scalar(|k| k.delta),
+                        r_i: scalar(|k| k.r_i),
+                        r_j: scalar(|k| k.r_j),
+                        v: vector(|k| k.v),
+                        omega: vector(|k| k.omega),
+                    };
+                    let radius = Group::gather(i.map(|i| p.radius[i]));
+                    let mass = Group::gather(i.map(|i| Inertia::mass(p.radius[i], density)));
+                    let mut lanes = gather_springs(springs, k);
+                    let force = law.evaluate(radius, mass, Other::Wall, &kin, &mut lanes);
+                    scatter_springs(lanes, springs, &k[..group.len()]);
+                    let (f, tau_i) = (Group::scatter_vec(force.f), Group::scatter_vec(force.tau_i));
+                    for l in 0..group.len() {
+                        forces[k[l]] = ContactForce {
+                            f: f[l],
+                            tau_i: tau_i[l],
+                            tau_j: DVec3::ZERO, // a wall takes no reaction
                         };
-                        let radius = Group::gather(i.map(|i| p.radius[i]));
-                        let mass = Group::gather(i.map(|i| Inertia::mass(p.radius[i], density)));
-                        let mut lanes = gather_springs(springs, k);
-                        let force = law.evaluate(radius, mass, Other::Wall, &kin, &mut lanes);
-                        scatter_springs(lanes, springs, &k[..group.len()]);
-                        let (f, tau_i) =
-                            (Group::scatter_vec(force.f), Group::scatter_vec(force.tau_i));
-                        for l in 0..group.len() {
-                            forces[k[l]] = ContactForce {
-                                f: f[l],
-                                tau_i: tau_i[l],
-                                tau_j: DVec3::ZERO, // a wall takes no reaction
-                            };
-                        }
                     }
-                },
-            );
+                }
+            },
+        );
         deep.into_inner().expect("not poisoned")
     }
 
