@@ -86,6 +86,23 @@ fn scatter_springs(lanes: Springs<Group>, springs: &mut [Springs], k: &[usize]) 
     }
 }
 
+/// Puts the forces of a group's lanes into slots `k` (the first `k.len()` lanes).
+#[inline(always)]
+fn scatter_forces(lanes: ContactForce<Group>, forces: &mut [ContactForce], k: &[usize]) {
+    let (f, tau_i, tau_j) = (
+        Group::scatter_vec(lanes.f),
+        Group::scatter_vec(lanes.tau_i),
+        Group::scatter_vec(lanes.tau_j),
+    );
+    for (l, &k) in k.iter().enumerate() {
+        forces[k] = ContactForce {
+            f: f[l],
+            tau_i: tau_i[l],
+            tau_j: tau_j[l],
+        };
+    }
+}
+
 /// The stages of a step, for the timing breakdown.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Stage {
@@ -573,10 +590,10 @@ impl Simulation {
     /// Stage 3 (Section 2.2): the force of every touching particle pair, once per pair.
     /// Returns the overlaps deeper than the smaller radius (a sign of instability).
     ///
-    /// Each piece of the list first sorts its pairs into touching and apart (forgetting
-    /// the springs of the latter), then evaluates the touching ones `WIDTH` at a time in SIMD
-    /// lanes; a lane gives the bits the pair would give alone, so neither the pieces nor
-    /// the grouping change a result.
+    /// Each piece of the list first sorts its pairs into touching and apart (a pair that
+    /// has just parted forgets its springs and force), then evaluates the touching ones
+    /// `WIDTH` at a time in SIMD lanes; a lane gives the bits the pair would give alone, so
+    /// neither the pieces nor the grouping change a result.
     fn particle_contacts(&mut self) -> Vec<Deep> {
         let deep = Mutex::new(Vec::new());
         let p = &self.particles;
@@ -627,18 +644,9 @@ impl Simulation {
                     };
                     let force = law.evaluate(body_i.radius, mass(i), other, &kin, &mut lanes);
                     scatter_springs(lanes, springs, &k[..group.len()]);
-                    let (f, tau_i, tau_j) = (
-                        Group::scatter_vec(force.f),
-                        Group::scatter_vec(force.tau_i),
-                        Group::scatter_vec(force.tau_j),
-                    );
+                    scatter_forces(force, forces, &k[..group.len()]);
                     let delta = kin.delta.scatter();
                     for l in 0..group.len() {
-                        forces[k[l]] = ContactForce {
-                            f: f[l],
-                            tau_i: tau_i[l],
-                            tau_j: tau_j[l],
-                        };
                         let limit = p.radius[i[l]].min(p.radius[j[l]]);
                         if delta[l] > limit {
                             deep.lock().expect("not poisoned").push(Deep {
@@ -735,14 +743,7 @@ impl Simulation {
                     let mut lanes = gather_springs(springs, k);
                     let force = law.evaluate(radius, mass, Other::Wall, &kin, &mut lanes);
                     scatter_springs(lanes, springs, &k[..group.len()]);
-                    let (f, tau_i) = (Group::scatter_vec(force.f), Group::scatter_vec(force.tau_i));
-                    for l in 0..group.len() {
-                        forces[k[l]] = ContactForce {
-                            f: f[l],
-                            tau_i: tau_i[l],
-                            tau_j: DVec3::ZERO, // a wall takes no reaction
-                        };
-                    }
+                    scatter_forces(force, forces, &k[..group.len()]);
                 }
             },
         );
