@@ -4,7 +4,7 @@
 //!
 //! The law (`contact.rs`) is generic over [`Lanes`], so both read the same and do the same
 //! IEEE operations in the same order: a contact evaluated in a lane gives the bits it gives
-//! alone (tested below). Where the scalar law branches, the lanes take both sides and
+//! alone (property tests in `contact.rs`). Where the scalar law branches, the lanes take both sides and
 //! blend them, unless all lanes agree ([`Lanes::pick`]).
 
 use std::fmt::Debug;
