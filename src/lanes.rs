@@ -4,8 +4,8 @@
 //!
 //! The law (`contact.rs`) is generic over [`Lanes`], so both read the same and do the same
 //! IEEE operations in the same order: a contact evaluated in a lane gives the bits it gives
-//! alone (property tests in `contact.rs`). Where the scalar law branches, the lanes take both sides and
-//! blend them, unless all lanes agree ([`Lanes::pick`]).
+//! alone (property tests in `contact.rs`). Where the scalar law branches, the lanes take
+//! both sides and blend them, unless all lanes agree ([`Lanes::pick`]).
 
 use std::fmt::Debug;
 use std::ops::{Add, Div, Mul, Neg, Sub};
