@@ -500,7 +500,7 @@ impl Neighbours {
         };
         let key = |i: u32, j: u32| ((i.min(j) as u64) << 32) | i.max(j) as u64;
 
-        // The pairs found from each occupied cell.
+        // The pairs found, in one list per piece of the parallel loop over occupied cells.
         let per_cell: Vec<Vec<u64>> = if uniform {
             // Cells sized for every pair: each pair of cells is visited once (a cell and
             // the 13 of its neighbours that come after it), so each pair of particles is
@@ -508,9 +508,8 @@ impl Neighbours {
             grid.occupied
                 .par_iter()
                 .with_min_len(MIN_PARALLEL_LEN / 16)
-                .map(|&(c, a, b)| {
+                .fold(Vec::new, |mut pairs, &(c, a, b)| {
                     let own = &grid.items[a as usize..b as usize];
-                    let mut pairs = Vec::new();
                     for (k, &i) in own.iter().enumerate() {
                         for &j in &own[k + 1..] {
                             if close(i, j) {
@@ -538,7 +537,7 @@ impl Neighbours {
             grid.occupied
                 .par_iter()
                 .with_min_len(MIN_PARALLEL_LEN / 16)
-                .map(|&(c, a, b)| {
+                .fold(Vec::new, |mut pairs, &(c, a, b)| {
                     let mut near: [&[u32]; 27] = [&[]; 27];
                     let mut k = 0;
                     for dz in -1..=1 {
@@ -549,7 +548,6 @@ impl Neighbours {
                             }
                         }
                     }
-                    let mut pairs = Vec::new();
                     for &i in &grid.items[a as usize..b as usize] {
                         let m = cells_needed(i);
                         if m == 1 {
@@ -599,32 +597,22 @@ impl Neighbours {
         self.reverse_start = count;
         self.reverse_slot = slots;
 
-        let face_runs: Vec<Vec<u32>> = (0..n)
+        // The items of a grid cell come in ascending order, so each particle's run of faces
+        // is sorted (as `ContactList` needs).
+        let face_pairs: Vec<(u32, u32)> = (0..n)
             .into_par_iter()
             .with_min_len(MIN_PARALLEL_LEN / 8)
-            .map(|i| {
+            .flat_map_iter(|i| {
                 let (xi, ri) = (x[i], radius[i]);
-                let mut run: Vec<u32> = face_grid
-                    .at(xi)
-                    .iter()
-                    .copied()
-                    .filter(|&f| {
-                        let face = &faces[f as usize];
-                        let reach = ri + face.radius + skin;
-                        face.separation(xi).length_squared() < reach * reach
-                    })
-                    .collect();
-                run.sort_unstable();
-                run
+                face_grid.at(xi).iter().copied().filter_map(move |f| {
+                    let face = &faces[f as usize];
+                    let reach = ri + face.radius + skin;
+                    let near = face.separation(xi).length_squared() < reach * reach;
+                    near.then_some((i as u32, f))
+                })
             })
             .collect();
-        let (start, partner) = compress(
-            n,
-            face_runs
-                .iter()
-                .enumerate()
-                .flat_map(|(i, run)| run.iter().map(move |&f| (i as u32, f))),
-        );
+        let (start, partner) = compress(n, face_pairs.iter().copied());
         self.faces = old_faces.rebuild(start, partner);
 
         self.find_lonely(x, radius, faces);
@@ -660,6 +648,33 @@ pub fn face_grid(faces: &[Face], max_radius: f64, skin: f64) -> CellGrid {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The face lists rely on it: every cell lists its boxes in ascending order, however
+    /// they were added.
+    #[test]
+    fn a_cell_lists_its_boxes_in_ascending_order() {
+        let boxes: Vec<(DVec3, DVec3)> = (0..50)
+            .map(|k| {
+                let lo = DVec3::new((k * 37 % 11) as f64, (k * 13 % 7) as f64, 0.0) * 0.1;
+                (lo, lo + DVec3::splat(0.05 + (k % 5) as f64 * 0.2))
+            })
+            .rev()
+            .collect();
+        let grid = CellGrid::of_boxes(&boxes, 0.1);
+        let mut seen = 0;
+        for x in 0..20 {
+            for y in 0..20 {
+                let items = grid.at(DVec3::new(
+                    x as f64 * 0.1 + 0.05,
+                    y as f64 * 0.1 + 0.05,
+                    0.01,
+                ));
+                assert!(items.windows(2).all(|w| w[0] < w[1]), "{items:?}");
+                seen += items.len();
+            }
+        }
+        assert!(seen > 100, "{seen}");
+    }
 
     /// The listed particle pairs, as (owner, partner).
     fn listed(nb: &Neighbours) -> Vec<(u32, u32)> {
