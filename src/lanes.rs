@@ -10,7 +10,7 @@
 use std::fmt::Debug;
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
-use glam::DVec3;
+use glam::{DQuat, DVec3};
 use wide::{f64x4, f64x8};
 
 /// A number of the contact law: one value, or one per lane.
@@ -34,6 +34,8 @@ pub trait Lanes:
         + Sub<Output = Self::Vec>
         + Neg<Output = Self::Vec>
         + Mul<Self, Output = Self::Vec>;
+    /// Quaternions with components of this kind.
+    type Quat: Copy;
     /// The result of a comparison: a `bool`, or one per lane.
     type Mask: Copy;
 
@@ -54,11 +56,42 @@ pub trait Lanes:
         yes: impl FnOnce() -> Self::Vec,
         no: impl FnOnce() -> Self::Vec,
     ) -> Self::Vec;
+    /// `f` applied to each lane on its own (for what has no lane version).
+    fn each(self, f: impl Fn(f64) -> f64) -> Self;
+    /// The quaternion (x, y, z, w) = (`v`, `w`).
+    fn quat(v: Self::Vec, w: Self) -> Self::Quat;
+    /// The product `a b`, as glam's `DQuat` forms it.
+    fn mul_quat(a: Self::Quat, b: Self::Quat) -> Self::Quat;
+    /// `q` times `s`, and the squared norm of `q`, as glam's `DQuat` forms them.
+    fn scale_quat(q: Self::Quat, s: Self) -> Self::Quat;
+    fn norm2_quat(q: Self::Quat) -> Self;
 }
 
 impl Lanes for f64 {
     type Vec = DVec3;
+    type Quat = DQuat;
     type Mask = bool;
+
+    #[inline(always)]
+    fn each(self, f: impl Fn(f64) -> f64) -> f64 {
+        f(self)
+    }
+    #[inline(always)]
+    fn quat(v: DVec3, w: f64) -> DQuat {
+        DQuat::from_xyzw(v.x, v.y, v.z, w)
+    }
+    #[inline(always)]
+    fn mul_quat(a: DQuat, b: DQuat) -> DQuat {
+        a * b
+    }
+    #[inline(always)]
+    fn scale_quat(q: DQuat, s: f64) -> DQuat {
+        q * s
+    }
+    #[inline(always)]
+    fn norm2_quat(q: DQuat) -> f64 {
+        q.length_squared()
+    }
 
     #[inline(always)]
     fn splat(x: f64) -> f64 {
@@ -112,6 +145,15 @@ pub struct V3<T> {
     pub x: T,
     pub y: T,
     pub z: T,
+}
+
+/// A quaternion of lanes (x, y, z, w as glam's `DQuat`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Q4<T> {
+    pub x: T,
+    pub y: T,
+    pub z: T,
+    pub w: T,
 }
 
 impl<T: Copy + Add<Output = T>> Add for V3<T> {
@@ -169,7 +211,36 @@ macro_rules! lanes {
     ($($t:ident: $n:literal),*) => {$(
         impl Lanes for $t {
             type Vec = V3<$t>;
+            type Quat = Q4<$t>;
             type Mask = $t;
+
+            #[inline(always)]
+            fn each(self, f: impl Fn(f64) -> f64) -> $t {
+                $t::new(self.to_array().map(f))
+            }
+            #[inline(always)]
+            fn quat(v: V3<$t>, w: $t) -> Q4<$t> {
+                Q4 { x: v.x, y: v.y, z: v.z, w }
+            }
+            #[inline(always)]
+            fn mul_quat(a: Q4<$t>, b: Q4<$t>) -> Q4<$t> {
+                let (x0, y0, z0, w0) = (a.x, a.y, a.z, a.w);
+                let (x1, y1, z1, w1) = (b.x, b.y, b.z, b.w);
+                Q4 {
+                    x: w0 * x1 + x0 * w1 + y0 * z1 - z0 * y1,
+                    y: w0 * y1 - x0 * z1 + y0 * w1 + z0 * x1,
+                    z: w0 * z1 + x0 * y1 - y0 * x1 + z0 * w1,
+                    w: w0 * w1 - x0 * x1 - y0 * y1 - z0 * z1,
+                }
+            }
+            #[inline(always)]
+            fn scale_quat(q: Q4<$t>, s: $t) -> Q4<$t> {
+                Q4 { x: q.x * s, y: q.y * s, z: q.z * s, w: q.w * s }
+            }
+            #[inline(always)]
+            fn norm2_quat(q: Q4<$t>) -> $t {
+                q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w
+            }
 
             #[inline(always)]
             fn splat(x: f64) -> $t {
@@ -253,7 +324,7 @@ macro_rules! lanes {
 lanes!(f64x4: 4, f64x8: 8);
 
 /// Moving values between `N` single contacts and the lanes of a group.
-pub trait Gather<const N: usize>: Lanes<Vec = V3<Self>> {
+pub trait Gather<const N: usize>: Lanes<Vec = V3<Self>, Quat = Q4<Self>> {
     fn gather(values: [f64; N]) -> Self;
     fn scatter(self) -> [f64; N];
 
@@ -270,6 +341,22 @@ pub trait Gather<const N: usize>: Lanes<Vec = V3<Self>> {
     fn scatter_vec(v: V3<Self>) -> [DVec3; N] {
         let (x, y, z) = (v.x.scatter(), v.y.scatter(), v.z.scatter());
         std::array::from_fn(|k| DVec3::new(x[k], y[k], z[k]))
+    }
+
+    #[inline(always)]
+    fn gather_quat(q: [DQuat; N]) -> Q4<Self> {
+        Q4 {
+            x: Self::gather(q.map(|q| q.x)),
+            y: Self::gather(q.map(|q| q.y)),
+            z: Self::gather(q.map(|q| q.z)),
+            w: Self::gather(q.map(|q| q.w)),
+        }
+    }
+
+    #[inline(always)]
+    fn scatter_quat(q: Q4<Self>) -> [DQuat; N] {
+        let (x, y, z, w) = (q.x.scatter(), q.y.scatter(), q.z.scatter(), q.w.scatter());
+        std::array::from_fn(|k| DQuat::from_xyzw(x[k], y[k], z[k], w[k]))
     }
 }
 

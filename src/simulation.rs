@@ -13,7 +13,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::contact::{Body, ContactForce, ContactLaw, Kinematics, Other, Springs};
-use crate::integrate::{Inertia, State, advance};
+use crate::integrate::{Inertia, Response, State, advance};
 use crate::lanes::{Gather, Lanes};
 use crate::mesh::{Face, Mesh};
 use crate::motion::{Motion, Pose, RigidVelocity};
@@ -760,39 +760,73 @@ impl Simulation {
         let (density, viscosity) = (s.material.density, s.material.viscosity);
         let nb = &self.neighbours;
         let (pair_forces, face_forces) = (&self.pair_forces, &self.face_forces);
+        // Force and torque on particle i.
+        let load = |i: usize| {
+            let mut f = DVec3::ZERO;
+            let mut tau = DVec3::ZERO;
+            let own = nb.pairs.start[i] as usize..nb.pairs.start[i + 1] as usize;
+            for c in &pair_forces[own] {
+                f += c.f;
+                tau += c.tau_i;
+            }
+            let reverse = nb.reverse_start[i] as usize..nb.reverse_start[i + 1] as usize;
+            for &slot in &nb.reverse_slot[reverse] {
+                let c = &pair_forces[slot as usize];
+                f -= c.f; // Eqs. (56), (57)
+                tau += c.tau_j; // Eqs. (58)-(60)
+            }
+            let faces = nb.faces.start[i] as usize..nb.faces.start[i + 1] as usize;
+            for c in &face_forces[faces] {
+                f += c.f;
+                tau += c.tau_i;
+            }
+            (f, tau)
+        };
         let p = &mut self.particles;
         (
-            p.x.par_iter_mut(),
-            p.v.par_iter_mut(),
-            p.q.par_iter_mut(),
-            p.w.par_iter_mut(),
-            p.radius.par_iter(),
+            p.x.par_chunks_mut(WIDTH),
+            p.v.par_chunks_mut(WIDTH),
+            p.q.par_chunks_mut(WIDTH),
+            p.w.par_chunks_mut(WIDTH),
+            p.radius.par_chunks(WIDTH),
         )
             .into_par_iter()
-            .with_min_len(MIN_PARALLEL_LEN)
+            .with_min_len(MIN_PARALLEL_LEN.div_ceil(WIDTH))
             .enumerate()
-            .map(|(i, (x, v, q, w, &radius))| {
-                let mut f = DVec3::ZERO;
-                let mut tau = DVec3::ZERO;
-                let own = nb.pairs.start[i] as usize..nb.pairs.start[i + 1] as usize;
-                for c in &pair_forces[own] {
-                    f += c.f;
-                    tau += c.tau_i;
-                }
-                let reverse = nb.reverse_start[i] as usize..nb.reverse_start[i + 1] as usize;
-                for &slot in &nb.reverse_slot[reverse] {
-                    let c = &pair_forces[slot as usize];
-                    f -= c.f; // Eqs. (56), (57)
-                    tau += c.tau_j; // Eqs. (58)-(60)
-                }
-                let faces = nb.faces.start[i] as usize..nb.faces.start[i + 1] as usize;
-                for c in &face_forces[faces] {
-                    f += c.f;
-                    tau += c.tau_i;
-                }
-                let body = Inertia::new(radius, density, viscosity);
-                advance(State { x, v, q, w }, &body, f, tau, g, dt);
-                !(x.is_finite() && v.is_finite() && w.is_finite())
+            .map(|(group, (x, v, q, w, radius))| {
+                // `WIDTH` particles at a time in lanes; a short last group repeats its last
+                // particle in the spare lanes.
+                let n = x.len();
+                let lane: [usize; WIDTH] = std::array::from_fn(|l| l.min(n - 1));
+                let loads = lane.map(|l| load(group * WIDTH + l));
+                let state = State::<Group> {
+                    x: Group::gather_vec(lane.map(|l| x[l])),
+                    v: Group::gather_vec(lane.map(|l| v[l])),
+                    q: Group::gather_quat(lane.map(|l| q[l])),
+                    w: Group::gather_vec(lane.map(|l| w[l])),
+                };
+                let body =
+                    Response::new(Group::gather(lane.map(|l| radius[l])), density, viscosity);
+                let (f, tau) = (loads.map(|l| l.0), loads.map(|l| l.1));
+                let new = advance(
+                    state,
+                    &body,
+                    Group::gather_vec(f),
+                    Group::gather_vec(tau),
+                    Group::splat_vec(g),
+                    Group::splat(dt),
+                );
+                let (new_x, new_v, new_q, new_w) = (
+                    Group::scatter_vec(new.x),
+                    Group::scatter_vec(new.v),
+                    Group::scatter_quat(new.q),
+                    Group::scatter_vec(new.w),
+                );
+                x.copy_from_slice(&new_x[..n]);
+                v.copy_from_slice(&new_v[..n]);
+                q.copy_from_slice(&new_q[..n]);
+                w.copy_from_slice(&new_w[..n]);
+                (0..n).any(|l| !(x[l].is_finite() && v[l].is_finite() && w[l].is_finite()))
             })
             .reduce(|| false, |a, b| a || b)
     }
