@@ -1,12 +1,13 @@
-//! The numbers the contact law is written for: one contact at a time (`f64` with glam's
-//! `DVec3`), or several at once in SIMD lanes (`f64x4`, `f64x8` from `wide`, with [`V3`]
-//! vectors of them: no vector crate has 3-vectors of 8 double lanes).
+//! The numbers the contact law and the integration are written for: one contact or particle
+//! at a time (`f64` with glam's `DVec3` and `DQuat`), or several at once in SIMD lanes
+//! (`f64x4`, `f64x8` from `wide`, with [`V3`] and [`Q4`] of them: no vector crate has
+//! 3-vectors of 8 double lanes).
 //!
-//! The law (`contact.rs`) is generic over [`Lanes`], so both read the same and do the same
-//! IEEE operations in the same order: a contact evaluated in a lane gives the bits it gives
-//! alone (property tests in `contact.rs`). Where the scalar law branches, the lanes take
-//! both sides and blend them, unless all lanes agree ([`Lanes::pick`]).
-
+//! The law (`contact.rs`) and SPIRAL (`integrate.rs`) are generic over [`Lanes`], so both
+//! read the same and do the same IEEE operations in the same order: a lane gives the bits
+//! of the contact or particle alone (property tests in both files). Where the scalar code
+//! branches, the lanes take both sides and blend them, unless all lanes agree
+//! ([`Lanes::pick`]).
 use std::fmt::Debug;
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
