@@ -8,6 +8,7 @@
 //! of the contact or particle alone (property tests in both files). Where the scalar code
 //! branches, the lanes take both sides and blend them, unless all lanes agree
 //! ([`Lanes::pick`]).
+
 use std::fmt::Debug;
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
