@@ -13,7 +13,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::contact::{Body, ContactForce, ContactLaw, Kinematics, Other, Springs};
-use crate::integrate::{Inertia, State, advance_each};
+use crate::integrate::{Inertia, Response, State, advance};
 use crate::lanes::{Gather, Lanes};
 use crate::mesh::{Face, Mesh};
 use crate::motion::{Motion, Pose, RigidVelocity};
@@ -799,18 +799,33 @@ impl Simulation {
                 let n = x.len();
                 let lane: [usize; WIDTH] = std::array::from_fn(|l| l.min(n - 1));
                 let loads = lane.map(|l| load(group * WIDTH + l));
-                let states = lane.map(|l| State {
-                    x: x[l],
-                    v: v[l],
-                    q: q[l],
-                    w: w[l],
-                });
-                let radii = lane.map(|l| radius[l]);
-                let new =
-                    advance_each::<Group, WIDTH>(states, radii, loads, g, dt, density, viscosity);
-                for (l, new) in new.iter().enumerate().take(n) {
-                    (x[l], v[l], q[l], w[l]) = (new.x, new.v, new.q, new.w);
-                }
+                let state = State::<Group> {
+                    x: Group::gather_vec(lane.map(|l| x[l])),
+                    v: Group::gather_vec(lane.map(|l| v[l])),
+                    q: Group::gather_quat(lane.map(|l| q[l])),
+                    w: Group::gather_vec(lane.map(|l| w[l])),
+                };
+                let body =
+                    Response::new(Group::gather(lane.map(|l| radius[l])), density, viscosity);
+                let (f, tau) = (loads.map(|l| l.0), loads.map(|l| l.1));
+                let new = advance(
+                    state,
+                    &body,
+                    Group::gather_vec(f),
+                    Group::gather_vec(tau),
+                    Group::splat_vec(g),
+                    Group::splat(dt),
+                );
+                let (new_x, new_v, new_q, new_w) = (
+                    Group::scatter_vec(new.x),
+                    Group::scatter_vec(new.v),
+                    Group::scatter_quat(new.q),
+                    Group::scatter_vec(new.w),
+                );
+                x.copy_from_slice(&new_x[..n]);
+                v.copy_from_slice(&new_v[..n]);
+                q.copy_from_slice(&new_q[..n]);
+                w.copy_from_slice(&new_w[..n]);
                 (0..n).any(|l| !(x[l].is_finite() && v[l].is_finite() && w[l].is_finite()))
             })
             .reduce(|| false, |a, b| a || b)
