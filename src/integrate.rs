@@ -1,5 +1,8 @@
 //! Time integration (paper Section 2.3): semi-implicit Euler for translation and rotation,
 //! Eqs. (42)-(46), and the SPIRAL quaternion update, Eqs. (47)-(49).
+//!
+//! Written over [`Lanes`]: one particle at a time, or a group in SIMD lanes (the simulation
+//! advances eight at once), with the same bits either way.
 
 use crate::lanes::Lanes;
 
