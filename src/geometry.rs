@@ -69,19 +69,33 @@ pub fn closest_on_triangle(x: DVec3, a: DVec3, b: DVec3, c: DVec3) -> (DVec3, Fe
     (a + ab * (vb * denom) + ac * (vc * denom), Feature::Face)
 }
 
-/// Separation `x - closest` from the triangle `a, b, c` with unit normal `n`: in the face
-/// region exactly the normal part of `x - a`.
-pub fn separation_from_triangle(x: DVec3, a: DVec3, b: DVec3, c: DVec3, n: DVec3) -> DVec3 {
+/// Separation `x - closest` from the triangle `a, b, c` with unit normal `n`, and the
+/// feature of the closest point: in the face region exactly the normal part of `x - a`.
+#[inline]
+pub fn separation_from_triangle(
+    x: DVec3,
+    a: DVec3,
+    b: DVec3,
+    c: DVec3,
+    n: DVec3,
+) -> (DVec3, Feature) {
     match closest_on_triangle(x, a, b, c) {
-        (_, Feature::Face) => (x - a).dot(n) * n,
-        (p, _) => x - p,
+        (_, Feature::Face) => ((x - a).dot(n) * n, Feature::Face),
+        (p, feature) => (x - p, feature),
     }
 }
 
 /// Separation `x - closest` from the rectangle with corner `o`, perpendicular edges `e1`,
 /// `e2` and unit normal `n` (Fig. 4D): the normal part of `x - o` plus the overhang of the
-/// in-plane coordinates beyond [0, 1].
-pub fn separation_from_rectangle(x: DVec3, o: DVec3, e1: DVec3, e2: DVec3, n: DVec3) -> DVec3 {
+/// in-plane coordinates beyond [0, 1]; and the feature of the closest point.
+#[inline]
+pub fn separation_from_rectangle(
+    x: DVec3,
+    o: DVec3,
+    e1: DVec3,
+    e2: DVec3,
+    n: DVec3,
+) -> (DVec3, Feature) {
     let d = x - o;
     let s = d.dot(e1) / e1.length_squared();
     let t = d.dot(e2) / e2.length_squared();
@@ -94,12 +108,18 @@ pub fn separation_from_rectangle(x: DVec3, o: DVec3, e1: DVec3, e2: DVec3, n: DV
             0.0
         }
     };
-    d.dot(n) * n + overhang(s) * e1 + overhang(t) * e2
+    let (os, ot) = (overhang(s), overhang(t));
+    let feature = match (os == 0.0, ot == 0.0) {
+        (true, true) => Feature::Face,
+        (false, false) => Feature::Vertex,
+        _ => Feature::Edge,
+    };
+    (d.dot(n) * n + os * e1 + ot * e2, feature)
 }
 
 /// Closest point to `x` on the rectangle (see [`separation_from_rectangle`]).
 pub fn closest_on_rectangle(x: DVec3, o: DVec3, e1: DVec3, e2: DVec3) -> DVec3 {
-    x - separation_from_rectangle(x, o, e1, e2, e1.cross(e2).normalize())
+    x - separation_from_rectangle(x, o, e1, e2, e1.cross(e2).normalize()).0
 }
 
 #[cfg(test)]

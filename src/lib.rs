@@ -21,4 +21,5 @@ pub mod run;
 pub mod scenario;
 pub mod simulation;
 pub mod spawn;
+pub mod surface;
 pub mod vtk;

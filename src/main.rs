@@ -196,6 +196,8 @@ fn execute(command: Option<Command>, resume_default: Option<PathBuf>) -> Result<
             let summary = run(s, &out, options)?;
             if !quiet {
                 report(&summary, &out);
+            } else {
+                warn(&summary);
             }
         }
         Some(Command::Bench {
@@ -268,7 +270,21 @@ fn execute(command: Option<Command>, resume_default: Option<PathBuf>) -> Result<
 }
 
 /// The closing line of a run.
+/// The end-of-run warning about overlaps past the smaller radius, if there were any.
+fn warn(summary: &Summary) {
+    let n = summary.warnings;
+    if n > 0 {
+        eprintln!(
+            "warning: {n} {} overlapped by more than the smaller radius at some step (the run \
+             went on: it stops only past the smaller diameter). Likely cause: {}",
+            if n == 1 { "pair" } else { "pairs" },
+            summary.advice
+        );
+    }
+}
+
 fn report(summary: &Summary, out: &std::path::Path) {
+    warn(summary);
     eprintln!(
         "done: {} particles, {} steps ({} neighbour-list rebuilds), {} frames in {}, {:.2} s",
         summary.particles,

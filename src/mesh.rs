@@ -1,10 +1,16 @@
-//! Static meshes (paper Section 3.3): faces of one to four vertices are points, rounded
-//! edges, triangles and rectangles, each with its own radius R_j. Read from OFF files.
+//! Meshes (paper Section 3.3): faces of one to four vertices are points, rounded edges,
+//! triangles and rectangles, each with its own radius R_j. Read from OFF or STL files.
+//!
+//! Faces of one file that share a vertex (the same position) and have the same radius form
+//! one connected surface; a particle's contacts with one surface count each touch once
+//! (see `surface.rs`).
 
 use anyhow::{Result, bail};
 use glam::DVec3;
 
-use crate::geometry::{closest_on_segment, separation_from_rectangle, separation_from_triangle};
+use crate::geometry::{
+    Feature, closest_on_segment, separation_from_rectangle, separation_from_triangle,
+};
 use crate::motion::Pose;
 
 /// The shape of one mesh face (Fig. 4A-D).
@@ -35,15 +41,27 @@ pub struct Face {
     pub shape: Primitive,
     /// R_j [L], from the scenario's `mesh_radii`.
     pub radius: f64,
+    /// The connected surface the face belongs to (an index unique within a [`Mesh`]).
+    pub surface: u32,
+    /// Whether the contacts of the face's file are merged per surface or counted per face.
+    pub contacts: Contacts,
 }
 
 impl Face {
     /// Separation vector `x - p` from the closest point `p` of the (undilated) primitive.
     #[inline]
     pub fn separation(&self, x: DVec3) -> DVec3 {
+        self.separation_and_feature(x).0
+    }
+
+    /// Separation vector `x - p` from the closest point `p`, and the feature `p` lies on:
+    /// `Face` (the interior of a triangle or rectangle: `x - p` is along the normal), `Edge`
+    /// or `Vertex`. A segment's interior is an edge, a point a vertex.
+    #[inline]
+    pub fn separation_and_feature(&self, x: DVec3) -> (DVec3, Feature) {
         match self.shape {
-            Primitive::Point(p) => x - p,
-            Primitive::Segment(a, b) => x - closest_on_segment(x, a, b),
+            Primitive::Point(p) => (x - p, Feature::Vertex),
+            Primitive::Segment(a, b) => (x - closest_on_segment(x, a, b), Feature::Edge),
             Primitive::Triangle { a, b, c, n } => separation_from_triangle(x, a, b, c, n),
             Primitive::Rectangle { o, e1, e2, n } => separation_from_rectangle(x, o, e1, e2, n),
         }
@@ -85,10 +103,7 @@ impl Face {
                 n: v(n),
             },
         };
-        Face {
-            shape,
-            radius: self.radius,
-        }
+        Face { shape, ..*self }
     }
 
     /// The corner points of the primitive.
@@ -122,12 +137,54 @@ impl Face {
     }
 }
 
-/// A static mesh: a list of faces.
+/// A mesh: a list of faces.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Mesh {
     pub faces: Vec<Face>,
     /// All vertices, for output and pictures.
     pub vertices: Vec<DVec3>,
+}
+
+/// How a mesh file's faces are grouped into surfaces (`mesh_contacts`, `[[meshes]]
+/// contacts`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Contacts {
+    /// Faces that share a vertex and a radius form one surface, touched once per touch.
+    #[default]
+    Merged,
+    /// Every face is a surface of its own: a contact per face touched, as in the original
+    /// program.
+    PerFace,
+}
+
+/// Labels each face with its connected surface: faces whose corners `corners(f)` share a
+/// position and whose radii are equal get the same label; labels count up from 0 in the
+/// order of first appearance.
+fn connect<'a>(faces: &mut [Face], corners: impl Fn(usize) -> &'a [DVec3]) {
+    let mut parent: Vec<usize> = (0..faces.len()).collect();
+    fn root(parent: &mut [usize], mut f: usize) -> usize {
+        while parent[f] != f {
+            parent[f] = parent[parent[f]];
+            f = parent[f];
+        }
+        f
+    }
+    // `+ 0.0` makes -0 and 0 one position.
+    let bits = |v: DVec3| (v + DVec3::ZERO).to_array().map(f64::to_bits);
+    let mut first = rustc_hash::FxHashMap::default();
+    for (f, face) in faces.iter().enumerate() {
+        for &v in corners(f) {
+            let other = *first.entry((bits(v), face.radius.to_bits())).or_insert(f);
+            let (a, b) = (root(&mut parent, f), root(&mut parent, other));
+            parent[a.max(b)] = a.min(b);
+        }
+    }
+    let mut label = rustc_hash::FxHashMap::default();
+    for (f, face) in faces.iter_mut().enumerate() {
+        let r = root(&mut parent, f);
+        let next = label.len() as u32;
+        face.surface = *label.entry(r).or_insert(next);
+    }
 }
 
 /// Strips an OFF comment (`#` to the end of the line).
@@ -209,6 +266,7 @@ impl Mesh {
         }
 
         let mut faces = Vec::with_capacity(nf);
+        let mut corners = Vec::with_capacity(nf);
         for k in 0..nf {
             let Some((n, line)) = lines.next() else {
                 bail!("{file}: ends after {k} of {nf} faces");
@@ -270,12 +328,42 @@ impl Mesh {
             faces.push(Face {
                 shape,
                 radius: radii[ri as usize],
+                surface: 0,
+                contacts: Contacts::Merged,
             });
+            corners.push(v[..count].to_vec());
         }
         if let Some((n, line)) = lines.next() {
             bail!("{file}:{n}: unexpected line '{line}' after the {nf} faces the header announced");
         }
+        connect(&mut faces, |f| &corners[f]);
         Ok(Mesh { faces, vertices })
+    }
+
+    /// Number of surfaces (one more than the largest label).
+    pub fn surfaces(&self) -> u32 {
+        self.faces.iter().map(|f| f.surface + 1).max().unwrap_or(0)
+    }
+
+    /// Groups the faces as `contacts` says: `PerFace` makes every face a surface of its own.
+    pub fn with_contacts(mut self, contacts: Contacts) -> Mesh {
+        for (k, f) in self.faces.iter_mut().enumerate() {
+            f.contacts = contacts;
+            if contacts == Contacts::PerFace {
+                f.surface = k as u32;
+            }
+        }
+        self
+    }
+
+    /// Adds the faces and vertices of `other`, its surfaces after this mesh's own.
+    pub fn append(&mut self, other: Mesh) {
+        let offset = self.surfaces();
+        self.faces.extend(other.faces.into_iter().map(|f| Face {
+            surface: f.surface + offset,
+            ..f
+        }));
+        self.vertices.extend(other.vertices);
     }
 
     /// Reads a mesh file: STL (ASCII or binary) if its name ends in `.stl`, else OFF.
@@ -325,8 +413,12 @@ impl Mesh {
                     n: normal.normalize(),
                 },
                 radius,
+                surface: 0,
+                contacts: Contacts::Merged,
             });
         }
+        let vertices = &mesh.vertices;
+        connect(&mut mesh.faces, |f| &vertices[3 * f..3 * f + 3]);
         Ok(mesh)
     }
 }
@@ -485,6 +577,35 @@ mod tests {
             }
         }
         assert!(rejected > 10_000, "the test rejects something: {rejected}");
+    }
+
+    #[test]
+    fn faces_that_share_a_position_and_a_radius_form_one_surface() {
+        // Two squares side by side (the shared corners written twice, once as -0), and a
+        // third apart; a rounded edge along the shared side with another radius.
+        let m = Mesh::parse_off(
+            "OFF\n12 4 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n1 -0 0\n2 0 0\n2 1 0\n1 1 0\n\
+             5 0 0\n6 0 0\n6 1 0\n5 1 0\n4 0 1 2 3\n4 4 5 6 7\n4 8 9 10 11\n2 1 2 1\n",
+            "m.off",
+            &[0.0, 0.001],
+        )
+        .unwrap();
+        let s: Vec<u32> = m.faces.iter().map(|f| f.surface).collect();
+        assert_eq!(s, vec![0, 0, 1, 2]);
+        assert_eq!(m.surfaces(), 3);
+        let m = m.with_contacts(Contacts::PerFace);
+        let s: Vec<u32> = m.faces.iter().map(|f| f.surface).collect();
+        assert_eq!(s, vec![0, 1, 2, 3]);
+        // STL repeats every vertex: triangles are joined by position.
+        let stl = "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 1 1 0\n\
+                   endloop\nendfacet\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 1 0\n\
+                   vertex 0 1 0\nendloop\nendfacet\nendsolid s\n";
+        assert_eq!(
+            Mesh::parse_stl(stl.as_bytes(), "s.stl", 0.0)
+                .unwrap()
+                .surfaces(),
+            1
+        );
     }
 
     fn err(text: &str) -> String {

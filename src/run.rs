@@ -12,7 +12,8 @@ use crate::checkpoint;
 use crate::contact::ContactLaw;
 use crate::csv::{frame_name, write_frame};
 use crate::integrate::Inertia;
-use crate::scenario::{Formats, MeshSource, Scenario};
+use crate::mesh::Contacts;
+use crate::scenario::{Formats, Scenario};
 use crate::simulation::{Simulation, StageTimes};
 
 /// Name of the checkpoint file in the output directory.
@@ -52,7 +53,14 @@ pub struct Summary {
     /// Wall time per stage of the step, and for writing frames and checkpoints.
     pub stage_times: StageTimes,
     pub output_seconds: f64,
+    /// Pairs that overlapped by more than the smaller radius (warned of, not stopped), and
+    /// the likely cause.
+    pub warnings: usize,
+    pub advice: String,
 }
+
+/// Per-pair warning lines shown during a run; further pairs are only counted.
+const WARNING_LINES: usize = 10;
 
 /// A run stopped on request, with its checkpoint written.
 #[derive(Clone, Debug)]
@@ -185,21 +193,39 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
             bar.set_position(sim.steps);
             bar
         });
-    let status = |sim: &Simulation, frame: u64| {
+    let mut warned = 0;
+    let mut status = |sim: &mut Simulation, frame: u64| {
+        let fresh = sim.take_new_warnings();
         if options.verbosity == Verbosity::Normal {
-            let line = format!(
-                "frame {frame:>6}  t = {:.6e} s  particles {}",
+            let mut lines = Vec::new();
+            for w in fresh {
+                warned += 1;
+                if warned <= WARNING_LINES {
+                    lines.push(format!("warning: {w}"));
+                }
+                if warned == WARNING_LINES {
+                    lines.push("warning: further deep overlaps are only counted".into());
+                }
+            }
+            let deep = match sim.warnings().count() {
+                0 => String::new(),
+                n => format!("  deep overlaps {n}"),
+            };
+            lines.push(format!(
+                "frame {frame:>6}  t = {:.6e} s  particles {}{deep}",
                 sim.time,
                 sim.particles.len()
-            );
-            match &bar {
-                Some(bar) => bar.println(line),
-                None => eprintln!("{line}"),
+            ));
+            for line in lines {
+                match &bar {
+                    Some(bar) => bar.println(line),
+                    None => eprintln!("{line}"),
+                }
             }
         }
     };
     if options.resume.is_none() {
-        status(&sim, 0);
+        status(&mut sim, 0);
     }
 
     while sim.steps < total_steps {
@@ -225,7 +251,7 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
             let frame = sim.steps / steps_per_frame;
             out.write(frame, &sim)?;
             frames_written += 1;
-            status(&sim, frame);
+            status(&mut sim, frame);
             if checkpoint_every > 0 && frame.is_multiple_of(checkpoint_every) {
                 checkpoint::save(
                     &output_dir.join(CHECKPOINT),
@@ -265,6 +291,8 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
         wall_seconds: start.elapsed().as_secs_f64(),
         stage_times: sim.stage_times.clone(),
         output_seconds,
+        warnings: sim.warnings().count(),
+        advice: sim.advice(),
     })
 }
 
@@ -288,15 +316,41 @@ pub fn describe(s: &Scenario) -> Result<String> {
     let period = std::f64::consts::PI * (0.5 * m_min / k_10).sqrt();
     let max_n = (s.simulation.max_particles as usize).max(sim.particles.len());
     let frame_bytes = 40 + max_n * 14 * 22;
-    let mesh = match &g.mesh {
-        MeshSource::None => "none".to_string(),
-        MeshSource::File(p) => p.display().to_string(),
-        MeshSource::Embedded { name, .. } => name.to_string(),
-    };
+    let mut meshes = String::new();
+    for (k, file) in sim.mesh_files.iter().enumerate() {
+        if file.faces.is_empty() && k == 0 {
+            meshes += "mesh                   none\n";
+            continue;
+        }
+        let faces = &sim.mesh.faces[file.faces.clone()];
+        let surfaces: std::collections::BTreeSet<u32> = faces.iter().map(|f| f.surface).collect();
+        let contacts = match file.contacts {
+            Contacts::Merged => format!(
+                "merged (one per touch of a connected surface; {} {})",
+                surfaces.len(),
+                if surfaces.len() == 1 {
+                    "surface"
+                } else {
+                    "surfaces"
+                }
+            ),
+            Contacts::PerFace => "per face (the original program's)".to_string(),
+        };
+        meshes += &format!(
+            "{:<23}{}: {} faces, contacts {contacts}\n",
+            if k == 0 {
+                "mesh".to_string()
+            } else {
+                format!("mesh {k}")
+            },
+            file.name,
+            faces.len()
+        );
+    }
     let default_dt = crate::scenario::default_timestep(g.radius_min, m);
     Ok(format!(
         "scenario is valid\n\
-         mesh                   {mesh}: {} faces\n\
+         {meshes}\
          initial particles      {}\n\
          time step              {dt:.6e} s ({:.3} x Eq. 50)\n\
          particle mass          {m_min:.6e} .. {m_max:.6e} kg\n\
@@ -304,7 +358,6 @@ pub fn describe(s: &Scenario) -> Result<String> {
          half contact period    {period:.6e} s = {:.1} time steps\n\
          total simulated time   {:.6} s ({} frames x {} steps)\n\
          output                 {} files, up to {} each, {} in all\n",
-        sim.mesh.faces.len(),
         sim.particles.len(),
         dt / default_dt,
         period / dt,

@@ -2,12 +2,13 @@
 //! place. Physics code receives a [`Scenario`] and never parses.
 //!
 //! ```toml
-//! [geometry]   radius_min, radius_max, mesh, mesh_radii, spawn_min, spawn_max
+//! [geometry]   radius_min, radius_max, mesh, mesh_radii, mesh_contacts, spawn_min,
+//!              spawn_max
 //! [material]   density, youngs_modulus, poisson_ratio, restitution, friction_sliding,
 //!              friction_rolling, friction_twisting, viscosity
 //! [kinetics]   initial_velocity, initial_angular_velocity, gravity
 //! [simulation] timestep, max_particles, frames, steps_per_frame, spawn_attempts, seed
-//! [[meshes]]   file, radii, motion = { type = "harmonic", amplitude, frequency, direction,
+//! [[meshes]]   file, radii, contacts, motion = { type = "harmonic", amplitude, frequency, direction,
 //!              phase } | { type = "velocity", velocity } | { type = "rotation", center, axis,
 //!              angular_velocity }   (any number of these)
 //! [[tags]]     min, max, tag   (a box that labels particles entering it; any number)
@@ -23,6 +24,7 @@ use anyhow::{Context, Result, bail};
 use glam::DVec3;
 use serde::Deserialize;
 
+use crate::mesh::Contacts;
 use crate::motion::Motion;
 
 /// The geometry of the paper's default hourglass (Fig. 5A), embedded so that `tinydem`
@@ -50,6 +52,8 @@ pub struct Geometry {
     pub mesh: MeshSource,
     /// R_mesh [L], selected per face by the OFF colour index.
     pub mesh_radii: Vec<f64>,
+    /// Contacts with the main mesh: merged per surface, or one per face.
+    pub mesh_contacts: Contacts,
     /// s_min, s_max [L]: the spawn box.
     pub spawn_min: DVec3,
     pub spawn_max: DVec3,
@@ -105,6 +109,7 @@ pub struct MeshSpec {
     pub file: PathBuf,
     /// R_mesh of this file's faces, picked by the OFF colour index (STL: the first).
     pub radii: Vec<f64>,
+    pub contacts: Contacts,
     pub motion: Option<Motion>,
 }
 
@@ -187,6 +192,7 @@ pub fn default_timestep(radius_min: f64, material: &Material) -> f64 {
 struct RawMesh {
     file: PathBuf,
     radii: Option<Vec<f64>>,
+    contacts: Option<String>,
     motion: Option<RawMotion>,
 }
 
@@ -245,6 +251,7 @@ struct RawGeometry {
     radius_max: Option<f64>,
     mesh: Option<PathBuf>,
     mesh_radii: Option<Vec<f64>>,
+    mesh_contacts: Option<String>,
     spawn_min: Option<[f64; 3]>,
     spawn_max: Option<[f64; 3]>,
 }
@@ -348,6 +355,17 @@ fn check_vec(key: &str, v: [f64; 3]) -> Result<DVec3> {
     Ok(DVec3::from_array(v))
 }
 
+/// The value of a `mesh_contacts` or `contacts` key (default "merged").
+fn contacts(key: &str, value: Option<String>) -> Result<Contacts> {
+    match value.as_deref() {
+        None | Some("merged") => Ok(Contacts::Merged),
+        Some("per_face") => Ok(Contacts::PerFace),
+        Some(other) => bail!(
+            "{key} = \"{other}\" is not allowed: it must be \"merged\" (one contact per touch of a connected surface) or \"per_face\" (a contact per face, as the original program)"
+        ),
+    }
+}
+
 /// Validates one `[[meshes]]` entry.
 fn mesh_spec(k: usize, m: RawMesh, base: &Path) -> Result<MeshSpec> {
     let key = |name: &str| format!("[[meshes]] #{} {name}", k + 1);
@@ -398,6 +416,7 @@ fn mesh_spec(k: usize, m: RawMesh, base: &Path) -> Result<MeshSpec> {
     Ok(MeshSpec {
         file: base.join(m.file),
         radii,
+        contacts: contacts(&key("contacts"), m.contacts)?,
         motion,
     })
 }
@@ -480,6 +499,7 @@ impl Scenario {
                 .mesh
                 .map_or(MeshSource::None, |p| MeshSource::File(base.join(p))),
             mesh_radii,
+            mesh_contacts: contacts("[geometry] mesh_contacts", g.mesh_contacts)?,
             spawn_min,
             spawn_max,
         };

@@ -15,12 +15,13 @@ use rayon::prelude::*;
 use crate::contact::{Body, ContactForce, ContactLaw, Kinematics, Other, Springs};
 use crate::integrate::{Inertia, Response, State, advance};
 use crate::lanes::{Gather, Lanes};
-use crate::mesh::{Face, Mesh};
+use crate::mesh::{Contacts, Face, Mesh};
 use crate::motion::{Motion, Pose, RigidVelocity};
 use crate::neighbours::{CellGrid, ContactList, MIN_PARALLEL_LEN, Neighbours, face_grid};
 use crate::particles::Particles;
 use crate::scenario::{MeshSource, Scenario, default_timestep};
 use crate::spawn::{Spawner, SpawnerState};
+use crate::surface::{self, Candidate, Fate};
 
 /// List slots per piece of the contact stages: small enough for stack buffers, large
 /// enough to fill lanes.
@@ -53,6 +54,65 @@ fn pieces<'a>(
                 .par_chunks(PIECE)
                 .zip(list.partner.par_chunks(PIECE)),
         )
+        .map(|(((forces, springs), touched), (owner, partner))| {
+            (forces, springs, touched, owner, partner)
+        })
+        .with_min_len(MIN_PARALLEL_LEN.div_ceil(PIECE))
+}
+
+/// Boundaries of pieces of at least `PIECE` slots (the last may be shorter) that keep each
+/// owner's run of slots whole; `start` is a compressed list's run starts.
+fn owner_aligned_bounds(start: &[u32]) -> Vec<usize> {
+    let mut bounds = vec![0];
+    for &k in start {
+        let k = k as usize;
+        if k - bounds[bounds.len() - 1] >= PIECE {
+            bounds.push(k);
+        }
+    }
+    let end = start.last().map_or(0, |&k| k as usize);
+    if end > bounds[bounds.len() - 1] {
+        bounds.push(end);
+    }
+    bounds
+}
+
+/// `slice` cut at `bounds` (ascending, from 0 to its length).
+fn cut<'a, T>(mut slice: &'a mut [T], bounds: &[usize]) -> Vec<&'a mut [T]> {
+    bounds
+        .windows(2)
+        .map(|w| {
+            let (piece, rest) = std::mem::take(&mut slice).split_at_mut(w[1] - w[0]);
+            slice = rest;
+            piece
+        })
+        .collect()
+}
+
+/// The pieces of `list` cut at `bounds` (see [`owner_aligned_bounds`]), with its slots'
+/// `forces`: every owner's slots lie in one piece.
+fn owner_pieces<'a>(
+    forces: &'a mut [ContactForce],
+    list: &'a mut ContactList,
+    bounds: &[usize],
+) -> impl IndexedParallelIterator<Item = Piece<'a>> {
+    let mut owner: &[u32] = &list.owner;
+    let mut partner: &[u32] = &list.partner;
+    let fixed: Vec<(&[u32], &[u32])> = bounds
+        .windows(2)
+        .map(|w| {
+            let n = w[1] - w[0];
+            let (o, rest_o) = owner.split_at(n);
+            let (p, rest_p) = partner.split_at(n);
+            (owner, partner) = (rest_o, rest_p);
+            (o, p)
+        })
+        .collect();
+    cut(forces, bounds)
+        .into_par_iter()
+        .zip(cut(&mut list.springs, bounds))
+        .zip(cut(&mut list.touched, bounds))
+        .zip(fixed)
         .map(|(((forces, springs), touched), (owner, partner))| {
             (forces, springs, touched, owner, partner)
         })
@@ -101,6 +161,29 @@ fn scatter_forces(lanes: ContactForce<Group>, forces: &mut [ContactForce], k: &[
             tau_j: tau_j[l],
         };
     }
+}
+
+/// A face within reach of a particle, in stage 4.
+struct Near {
+    /// Its slot in the particle-face list.
+    slot: usize,
+    kin: Kinematics,
+    /// Separation x - p_F and whether p_F counts as inside the face (see `surface::snap`).
+    d: DVec3,
+    interior: bool,
+}
+
+/// Buffers of one piece of the mesh-contact stage.
+#[derive(Default)]
+struct MeshScratch {
+    /// The piece's faces within reach.
+    near: Vec<Near>,
+    /// Which of `near` are contacts of their own, for the law.
+    contacts: Vec<u32>,
+    /// One particle's faces within reach as candidates, and what becomes of them.
+    candidates: Vec<Candidate>,
+    order: Vec<usize>,
+    fates: Vec<Fate>,
 }
 
 /// The stages of a step, for the timing breakdown.
@@ -182,19 +265,64 @@ pub struct Snapshot {
 }
 
 /// The partner of a particle in a contact.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Partner {
     Particle(usize),
     Face(usize),
 }
 
-/// An overlap deeper than `limit` (the smaller radius): a sign of instability.
+/// An overlap deeper than `limit`, the smaller radius (the particle's, against a face):
+/// a warning; deeper than twice that, a sign of instability.
 #[derive(Clone, Copy, Debug)]
 pub struct Deep {
     i: usize,
     other: Partner,
     delta: f64,
     limit: f64,
+}
+
+impl Deep {
+    /// Whether the overlap passes the smaller diameter: the smaller body is wholly inside
+    /// the other, which no transient of a stable run does.
+    fn through(&self) -> bool {
+        self.delta > 2.0 * self.limit
+    }
+
+    /// "particles 1 and 2 overlap by ..., more than the smaller radius ..." (or diameter).
+    fn describe(&self) -> String {
+        let (bound, size) = if self.through() {
+            ("diameter", 2.0 * self.limit)
+        } else {
+            ("radius", self.limit)
+        };
+        match self.other {
+            Partner::Particle(j) => format!(
+                "particles {} and {j} overlap by {:.3e} m, more than the smaller {bound} {size:.3e} m",
+                self.i, self.delta
+            ),
+            Partner::Face(f) => format!(
+                "particle {} overlaps mesh face {f} by {:.3e} m, more than its {bound} {size:.3e} m",
+                self.i, self.delta
+            ),
+        }
+    }
+}
+
+/// Overlaps deeper than the smaller radius that did not stop the run, each pair counted
+/// once.
+#[derive(Clone, Debug, Default)]
+pub struct Warnings {
+    seen: rustc_hash::FxHashSet<(usize, Partner)>,
+    /// Descriptions of the pairs seen for the first time since the last
+    /// [`Simulation::take_new_warnings`], with their step.
+    fresh: Vec<String>,
+}
+
+impl Warnings {
+    /// Number of pairs that have overlapped by more than the smaller radius.
+    pub fn count(&self) -> usize {
+        self.seen.len()
+    }
 }
 
 /// A run that has become numerically unstable.
@@ -238,11 +366,22 @@ struct MovingPart {
     pose_at_build: Pose,
 }
 
+/// Where a mesh file's faces are in [`Simulation::mesh`]: `[geometry] mesh` first, then the
+/// `[[meshes]]` in order.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshFile {
+    pub name: String,
+    pub faces: std::ops::Range<usize>,
+    pub contacts: Contacts,
+}
+
 /// A running simulation.
 pub struct Simulation {
     pub scenario: Scenario,
     pub particles: Particles,
     pub mesh: Mesh,
+    /// The mesh files `mesh` was put together from.
+    pub mesh_files: Vec<MeshFile>,
     law: ContactLaw,
     neighbours: Neighbours,
     face_grid: CellGrid,
@@ -250,6 +389,8 @@ pub struct Simulation {
     /// Force of each particle pair slot and each particle-face slot, this step.
     pair_forces: Vec<ContactForce>,
     face_forces: Vec<ContactForce>,
+    /// Pieces of the particle-face list for stage 4, each holding whole runs of owners.
+    face_pieces: Vec<usize>,
     /// The mesh as read (at t = 0).
     rest_faces: Vec<Face>,
     /// Parts of the mesh that follow a prescribed motion.
@@ -263,32 +404,50 @@ pub struct Simulation {
     pub steps: u64,
     /// Wall time per stage.
     pub stage_times: StageTimes,
+    /// Overlaps past the smaller radius that did not stop the run.
+    warnings: Warnings,
 }
 
 impl Simulation {
     /// Sets up a simulation: reads the mesh and the initial particles.
     pub fn new(scenario: Scenario) -> Result<Simulation> {
-        let radii = &scenario.geometry.mesh_radii;
-        let mut mesh = match &scenario.geometry.mesh {
-            MeshSource::None => Mesh::default(),
-            MeshSource::File(path) => Mesh::load(path, radii)?,
-            MeshSource::Embedded { name, text } => Mesh::parse_off(text, name, radii)?,
+        let g = &scenario.geometry;
+        let (mut mesh, name) = match &g.mesh {
+            MeshSource::None => (Mesh::default(), String::new()),
+            MeshSource::File(path) => {
+                (Mesh::load(path, &g.mesh_radii)?, path.display().to_string())
+            }
+            MeshSource::Embedded { name, text } => (
+                Mesh::parse_off(text, name, &g.mesh_radii)?,
+                name.to_string(),
+            ),
         };
+        mesh = mesh.with_contacts(g.mesh_contacts);
+        let mut files = vec![MeshFile {
+            name,
+            faces: 0..mesh.faces.len(),
+            contacts: g.mesh_contacts,
+        }];
         let mut moving = Vec::new();
         for spec in &scenario.meshes {
-            let part = Mesh::load(&spec.file, &spec.radii)?;
+            let part = Mesh::load(&spec.file, &spec.radii)?.with_contacts(spec.contacts);
             let faces = mesh.faces.len()..mesh.faces.len() + part.faces.len();
             if let Some(motion) = spec.motion {
-                moving.push((faces, motion));
+                moving.push((faces.clone(), motion));
             }
-            mesh.faces.extend(part.faces);
-            mesh.vertices.extend(part.vertices);
+            files.push(MeshFile {
+                name: spec.file.display().to_string(),
+                faces,
+                contacts: spec.contacts,
+            });
+            mesh.append(part);
         }
         let particles = match &scenario.particles {
             Some(path) => crate::csv::load_particles(path)?,
             None => Particles::default(),
         };
         let mut sim = Simulation::from_parts(scenario, mesh, particles)?;
+        sim.mesh_files = files;
         for (faces, motion) in moving {
             for f in faces.clone() {
                 sim.face_part[f] = sim.moving.len() as u32;
@@ -357,6 +516,7 @@ impl Simulation {
             spawner: Spawner::new(scenario.simulation.seed),
             pair_forces: Vec::new(),
             face_forces: Vec::new(),
+            face_pieces: vec![0],
             rest_faces: mesh.faces.clone(),
             moving: Vec::new(),
             face_part: vec![STATIC; mesh.faces.len()],
@@ -364,6 +524,15 @@ impl Simulation {
             time: 0.0,
             steps: 0,
             stage_times: StageTimes::default(),
+            warnings: Warnings::default(),
+            mesh_files: vec![MeshFile {
+                name: "mesh".into(),
+                faces: 0..mesh.faces.len(),
+                contacts: mesh
+                    .faces
+                    .first()
+                    .map_or_else(Contacts::default, |f| f.contacts),
+            }],
             scenario,
             particles,
             mesh,
@@ -439,14 +608,23 @@ impl Simulation {
         !self.scenario.tags.is_empty() || self.particles.tagged()
     }
 
-    /// Stage 6: stop loudly rather than continue a run that has blown up. `deep` lists the
-    /// overlaps deeper than the smaller radius found in this step's contact stages, `bad`
-    /// whether the integration produced a non-finite state.
-    fn check_stability(&self, mut deep: Vec<Deep>, bad: bool) -> Result<(), Unstable> {
+    /// Stage 6: stop loudly rather than continue a run that has blown up: a non-finite
+    /// state (`bad`, from the integration) or an overlap past the smaller diameter. `deep`
+    /// lists the overlaps deeper than the smaller radius found in this step's contact
+    /// stages; those within the diameter are a legitimate transient of a crowded packing
+    /// (a small grain squeezed by a large one) and only warned of, once per pair.
+    fn check_stability(&mut self, mut deep: Vec<Deep>, bad: bool) -> Result<(), Unstable> {
         let p = &self.particles;
         let non_finite =
             |k: usize| !(p.x[k].is_finite() && p.v[k].is_finite() && p.w[k].is_finite());
-        if !bad && deep.is_empty() {
+        if !bad && deep.iter().all(|d| !d.through()) {
+            for d in deep {
+                if self.warnings.seen.insert((d.i, d.other)) {
+                    self.warnings
+                        .fresh
+                        .push(format!("step {}: {}", self.steps, d.describe()));
+                }
+            }
             return Ok(());
         }
         let mut what = Vec::new();
@@ -456,18 +634,10 @@ impl Simulation {
                 p.x[k], p.v[k], p.w[k]
             ));
         }
+        deep.retain(Deep::through);
         deep.sort_by_key(|d| (d.i, d.other));
         for d in deep.iter().take(5 - what.len().min(5)) {
-            what.push(match d.other {
-                Partner::Particle(j) => format!(
-                    "particles {} and {j} overlap by {:.3e} m, more than the smaller radius {:.3e} m",
-                    d.i, d.delta, d.limit
-                ),
-                Partner::Face(f) => format!(
-                    "particle {} overlaps mesh face {f} by {:.3e} m, more than its radius {:.3e} m",
-                    d.i, d.delta, d.limit
-                ),
-            });
+            what.push(d.describe());
         }
         Err(Unstable {
             step: self.steps,
@@ -477,8 +647,19 @@ impl Simulation {
         })
     }
 
+    /// Overlaps past the smaller radius so far (each pair once).
+    pub fn warnings(&self) -> &Warnings {
+        &self.warnings
+    }
+
+    /// Descriptions of the pairs that overlapped past the smaller radius for the first time
+    /// since the last call.
+    pub fn take_new_warnings(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.warnings.fresh)
+    }
+
     /// The likely cause of an instability, from the time step and the material.
-    fn advice(&self) -> String {
+    pub fn advice(&self) -> String {
         let s = &self.scenario;
         let dt = s.simulation.timestep;
         let eq50 = default_timestep(s.geometry.radius_min, &s.material);
@@ -584,6 +765,7 @@ impl Simulation {
         self.pair_forces.resize(self.neighbours.pairs.slots(), zero);
         self.face_forces.clear();
         self.face_forces.resize(self.neighbours.faces.slots(), zero);
+        self.face_pieces = owner_aligned_bounds(&self.neighbours.faces.start);
         self.mark_mesh_built();
     }
 
@@ -663,12 +845,15 @@ impl Simulation {
         deep.into_inner().expect("not poisoned")
     }
 
-    /// Stage 4 (Sections 2.2, 3.3): the force of every touching particle-face pair.
-    /// Returns the overlaps deeper than the particle's radius.
+    /// Stage 4 (Sections 2.2, 3.3): the force of every particle-face contact. Returns the
+    /// overlaps deeper than the particle's radius.
     ///
-    /// Each piece of the list finds the closest points and the kinematics of its contacts
-    /// one by one, then evaluates the law for `WIDTH` touching ones at a time in SIMD lanes
-    /// (bit for bit as alone).
+    /// Each piece of the list holds whole runs of owners. For each particle it finds the
+    /// faces within reach (closest point, kinematics), decides which of them are contacts
+    /// of their own (one per touch of a connected surface, `surface.rs`; with `per_face`
+    /// every face is a surface of its own), hands the springs of the others to the contact
+    /// that absorbs them, then evaluates the law for `WIDTH` contacts at a time in SIMD
+    /// lanes (bit for bit as alone).
     fn mesh_contacts(&mut self) -> Vec<Deep> {
         let deep = Mutex::new(Vec::new());
         let p = &self.particles;
@@ -677,74 +862,139 @@ impl Simulation {
         let (face_part, moving) = (&self.face_part, &self.moving);
         let density = self.scenario.material.density;
         let list = &mut self.neighbours.faces;
-        pieces(&mut self.face_forces, list).for_each_init(
-            || Vec::with_capacity(PIECE),
-            |touching, (forces, springs, touched, owner, partner)| {
-                // The geometry of each contact alone: closest point, kinematics.
-                touching.clear();
-                for (k, (&i, &f)) in owner.iter().zip(partner).enumerate() {
-                    let (i, face) = (i as usize, &faces[f as usize]);
-                    let body = Body {
-                        x: p.x[i],
-                        radius: p.radius[i],
-                        v: p.v[i],
-                        w: p.w[i],
-                    };
-                    let kin = if face.certainly_beyond(body.x, body.radius + face.radius) {
-                        None
-                    } else {
-                        let wall = match face_part[f as usize] {
-                            STATIC => RigidVelocity::default(),
-                            k => moving[k as usize].velocity,
+        thread_local! {
+            static SCRATCH: std::cell::RefCell<MeshScratch> = Default::default();
+        }
+        owner_pieces(&mut self.face_forces, list, &self.face_pieces).for_each(
+            |(forces, springs, touched, owner, partner)| {
+                SCRATCH.with_borrow_mut(|scratch| {
+                    let MeshScratch {
+                        near,
+                        candidates,
+                        contacts,
+                        order,
+                        fates,
+                    } = scratch;
+                    // The faces within reach, each with its closest point and kinematics; the
+                    // slots of a particle are consecutive, so are its candidates.
+                    near.clear();
+                    for (k, (&i, &f)) in owner.iter().zip(partner).enumerate() {
+                        let (i, face) = (i as usize, &faces[f as usize]);
+                        let body = Body {
+                            x: p.x[i],
+                            radius: p.radius[i],
+                            v: p.v[i],
+                            w: p.w[i],
                         };
-                        Kinematics::with_wall(&body, face.separation(body.x), face.radius, &wall)
-                    };
-                    match kin {
-                        Some(kin) => {
-                            if kin.delta > body.radius {
-                                deep.lock().expect("not poisoned").push(Deep {
-                                    i,
-                                    other: Partner::Face(f as usize),
-                                    delta: kin.delta,
-                                    limit: body.radius,
-                                });
+                        let contact = if face.certainly_beyond(body.x, body.radius + face.radius) {
+                            None
+                        } else {
+                            let wall = match face_part[f as usize] {
+                                STATIC => RigidVelocity::default(),
+                                part => moving[part as usize].velocity,
+                            };
+                            let (d, feature) = face.separation_and_feature(body.x);
+                            let (d, interior) =
+                                surface::snap(face, body.x, body.radius, d, feature);
+                            Kinematics::with_wall(&body, d, face.radius, &wall)
+                                .map(|kin| (kin, d, interior))
+                        };
+                        match contact {
+                            Some((kin, d, interior)) => near.push(Near {
+                                slot: k,
+                                kin,
+                                d,
+                                interior,
+                            }),
+                            None if touched[k] => {
+                                // The contact ended: forget its history and its force.
+                                springs[k] = Springs::default();
+                                forces[k] = ContactForce::default();
+                                touched[k] = false;
                             }
-                            touching.push((k, kin));
-                            touched[k] = true;
+                            None => {}
                         }
-                        None if touched[k] => {
-                            // The contact ended: forget its history and its force.
-                            springs[k] = Springs::default();
-                            forces[k] = ContactForce::default();
-                            touched[k] = false;
-                        }
-                        None => {}
                     }
-                }
-                // The law, `WIDTH` contacts at a time (as for particle pairs).
-                for group in touching.chunks(WIDTH) {
-                    let c: [&(usize, Kinematics); WIDTH] =
-                        std::array::from_fn(|l| &group[l.min(group.len() - 1)]);
-                    let k = c.map(|c| c.0);
-                    let i = k.map(|k| owner[k] as usize);
-                    let scalar = |get: fn(&Kinematics) -> f64| Group::gather(c.map(|c| get(&c.1)));
-                    let vector =
-                        |get: fn(&Kinematics) -> DVec3| Group::gather_vec(c.map(|c| get(&c.1)));
-                    let kin = Kinematics::<Group> {
-                        n: vector(|k| k.n),
-                        delta: scalar(|k| k.delta),
-                        r_i: scalar(|k| k.r_i),
-                        r_j: scalar(|k| k.r_j),
-                        v: vector(|k| k.v),
-                        omega: vector(|k| k.omega),
-                    };
-                    let radius = Group::gather(i.map(|i| p.radius[i]));
-                    let mass = Group::gather(i.map(|i| Inertia::mass(p.radius[i], density)));
-                    let mut lanes = gather_springs(springs, k);
-                    let force = law.evaluate(radius, mass, Other::Wall, &kin, &mut lanes);
-                    scatter_springs(lanes, springs, &k[..group.len()]);
-                    scatter_forces(force, forces, &k[..group.len()]);
-                }
+                    // One contact per touch, particle by particle (its slots, so its faces
+                    // within reach, are consecutive); the absorbed hand over their springs
+                    // and are treated as apart.
+                    contacts.clear();
+                    let mut a = 0;
+                    while a < near.len() {
+                        let i = owner[near[a].slot];
+                        let mut b = a + 1;
+                        while b < near.len() && owner[near[b].slot] == i {
+                            b += 1;
+                        }
+                        let (x, radius) = (p.x[i as usize], p.radius[i as usize]);
+                        let several = b - a > 1;
+                        if several {
+                            candidates.clear();
+                            candidates.extend(near[a..b].iter().map(|c| Candidate {
+                                face: partner[c.slot],
+                                point: x - c.d,
+                                dist2: c.d.length_squared(),
+                                interior: c.interior,
+                            }));
+                            let tol = surface::tolerance(x, radius);
+                            surface::resolve(candidates, faces, tol, order, fates);
+                            for (c, fate) in near[a..b].iter().zip(fates.iter()) {
+                                if let Fate::Absorbed(s) = *fate {
+                                    let s = near[a + s].slot;
+                                    if springs[s] == Springs::default() {
+                                        springs[s] = springs[c.slot];
+                                    }
+                                }
+                            }
+                        }
+                        for (c, near) in near[a..b].iter().enumerate() {
+                            let k = near.slot;
+                            if !several || fates[c] == Fate::Contact {
+                                if near.kin.delta > radius {
+                                    deep.lock().expect("not poisoned").push(Deep {
+                                        i: i as usize,
+                                        other: Partner::Face(partner[k] as usize),
+                                        delta: near.kin.delta,
+                                        limit: radius,
+                                    });
+                                }
+                                contacts.push((a + c) as u32);
+                                touched[k] = true;
+                            } else if touched[k] {
+                                springs[k] = Springs::default();
+                                forces[k] = ContactForce::default();
+                                touched[k] = false;
+                            }
+                        }
+                        a = b;
+                    }
+                    // The law, `WIDTH` contacts at a time (as for particle pairs).
+                    for group in contacts.chunks(WIDTH) {
+                        let c: [&Near; WIDTH] =
+                            std::array::from_fn(|l| &near[group[l.min(group.len() - 1)] as usize]);
+                        let k = c.map(|c| c.slot);
+                        let i = k.map(|k| owner[k] as usize);
+                        let scalar =
+                            |get: fn(&Kinematics) -> f64| Group::gather(c.map(|c| get(&c.kin)));
+                        let vector = |get: fn(&Kinematics) -> DVec3| {
+                            Group::gather_vec(c.map(|c| get(&c.kin)))
+                        };
+                        let kin = Kinematics::<Group> {
+                            n: vector(|k| k.n),
+                            delta: scalar(|k| k.delta),
+                            r_i: scalar(|k| k.r_i),
+                            r_j: scalar(|k| k.r_j),
+                            v: vector(|k| k.v),
+                            omega: vector(|k| k.omega),
+                        };
+                        let radius = Group::gather(i.map(|i| p.radius[i]));
+                        let mass = Group::gather(i.map(|i| Inertia::mass(p.radius[i], density)));
+                        let mut lanes = gather_springs(springs, k);
+                        let force = law.evaluate(radius, mass, Other::Wall, &kin, &mut lanes);
+                        scatter_springs(lanes, springs, &k[..group.len()]);
+                        scatter_forces(force, forces, &k[..group.len()]);
+                    }
+                });
             },
         );
         deep.into_inner().expect("not poisoned")

@@ -187,6 +187,29 @@ fn check_prints_derived_quantities() {
     }
 }
 
+#[test]
+fn check_says_which_meshes_merge_their_contacts() {
+    let t = tempfile::tempdir().unwrap();
+    let square = "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n";
+    write(t.path(), "a.off", square);
+    write(t.path(), "b.off", square);
+    write(
+        t.path(),
+        "s.toml",
+        "[geometry]\nmesh = \"a.off\"\nmesh_radii = [0.0]\n\
+         [[meshes]]\nfile = \"b.off\"\ncontacts = \"per_face\"\n",
+    );
+    let o = tinydem(&["check", "s.toml"], t.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    for line in [
+        "a.off: 2 faces, contacts merged (one per touch of a connected surface; 1 surface)",
+        "mesh 1                 b.off: 2 faces, contacts per face (the original program's)",
+    ] {
+        assert!(out.contains(line), "missing {line} in\n{out}");
+    }
+}
+
 /// The frames of a short hourglass run (spawning, mesh and particle contacts).
 fn hourglass_frames(threads: &str, dir: &Path) -> Vec<Vec<u8>> {
     let mesh = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/hourglass.off");

@@ -13,42 +13,125 @@ use tinydem::csv::load_particles;
 
 const HEADER: &str = "x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz\n";
 
-#[test]
-fn too_large_timestep_is_caught_and_explained() {
-    let t = tempfile::tempdir().unwrap();
+/// Writes `particles` (CSV rows after the header) and a scenario of them without gravity
+/// (with extra `[simulation]` and `[material]` lines) into `dir`.
+fn two_body(dir: &Path, particles: &str, simulation: &str, material: &str) {
+    std::fs::write(dir.join("p.csv"), format!("{HEADER}{particles}")).unwrap();
     std::fs::write(
-        t.path().join("p.csv"),
+        dir.join("s.toml"),
         format!(
-            "{HEADER}-0.0052,0,0,0.005,2,0,0,1,0,0,0,0,0,0\n0.0052,0,0,0.005,-2,0,0,1,0,0,0,0,0,0\n"
+            "[geometry]\nradius_min = 0.002\nradius_max = 0.01\n[material]\n{material}\n\
+             [kinetics]\ngravity = [0.0, 0.0, 0.0]\n\
+             [simulation]\nframes = 10\nsteps_per_frame = 10\nmax_particles = 0\n{simulation}\n\
+             [input]\nparticles = \"p.csv\"\n"
         ),
     )
     .unwrap();
+}
+
+fn assert_contains(text: &str, expected: &[&str]) {
+    for e in expected {
+        assert!(text.contains(e), "message\n  {text}\nlacks\n  {e}");
+    }
+}
+
+#[test]
+fn too_large_timestep_is_warned_of_once_with_advice() {
+    // Two equal spheres at 20 x Eq. 50's step pass halfway through each other in one step:
+    // past the smaller radius, a warning (once for the pair) with the cause, not a stop.
+    let t = tempfile::tempdir().unwrap();
+    two_body(
+        t.path(),
+        "-0.0052,0,0,0.005,2,0,0,1,0,0,0,0,0,0\n0.0052,0,0,0.005,-2,0,0,1,0,0,0,0,0,0\n",
+        "timestep = 3e-3",
+        "",
+    );
     std::fs::write(
         t.path().join("s.toml"),
-        "[geometry]\nradius_min = 0.005\nradius_max = 0.005\n[kinetics]\ngravity = [0.0, 0.0, 0.0]\n\
-         [simulation]\ntimestep = 3e-3\nframes = 10\nsteps_per_frame = 10\nmax_particles = 0\n\
-         [input]\nparticles = \"p.csv\"\n",
+        std::fs::read_to_string(t.path().join("s.toml"))
+            .unwrap()
+            .replace("radius_min = 0.002", "radius_min = 0.005"),
+    )
+    .unwrap();
+    let o = tinydem(&["run", "s.toml"], t.path());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert_contains(
+        &err,
+        &[
+            "warning: step 2: particles 0 and 1 overlap by 8.400e-3 m, more than the smaller radius 5.000e-3 m",
+            "deep overlaps 1",
+            "warning: 1 pair overlapped by more than the smaller radius",
+            "timestep 3.000e-3 s exceeds Eq. 50's 1.508e-4 s",
+            "try timestep <= 1.508e-4 s",
+        ],
+    );
+    assert_eq!(err.matches("warning: step").count(), 1, "{err}");
+    // Quiet runs still say it at the end.
+    let o = tinydem(&["run", "s.toml", "-q", "-o", "quiet"], t.path());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success());
+    assert_contains(
+        &err,
+        &["warning: 1 pair overlapped by more than the smaller radius"],
+    );
+}
+
+#[test]
+fn an_overlap_past_the_smaller_diameter_stops_the_run() {
+    // A 2 mm grain shot at a 10 mm one gets wholly inside it within one step.
+    let t = tempfile::tempdir().unwrap();
+    two_body(
+        t.path(),
+        "-0.0125,0,0,0.002,5,0,0,1,0,0,0,0,0,0\n0,0,0,0.01,0,0,0,1,0,0,0,0,0,0\n",
+        "timestep = 1e-3",
+        "",
+    );
+    let o = tinydem(&["run", "s.toml", "-q"], t.path());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success());
+    assert!(!err.contains("panicked"), "{err}");
+    assert_contains(
+        &err,
+        &[
+            // Step 1 moves it 5 mm; step 2 finds the overlap.
+            "became unstable at step 2",
+            "particles 0 and 1 overlap by 4.500e-3 m, more than the smaller diameter 4.000e-3 m",
+            "timestep 1.000e-3 s exceeds Eq. 50's",
+            "last complete frame",
+            "unstable.csv",
+        ],
+    );
+    let state = load_particles(&t.path().join("output/unstable.csv")).unwrap();
+    assert_eq!(state.len(), 2);
+}
+
+#[test]
+fn a_non_finite_state_stops_the_run() {
+    let t = tempfile::tempdir().unwrap();
+    two_body(
+        t.path(),
+        "0,0,0,0.005,0,0,0,1,0,0,0,0,0,0\n",
+        "timestep = 10.0",
+        "",
+    );
+    std::fs::write(
+        t.path().join("s.toml"),
+        std::fs::read_to_string(t.path().join("s.toml"))
+            .unwrap()
+            .replace("gravity = [0.0, 0.0, 0.0]", "gravity = [0.0, 0.0, -1e308]"),
     )
     .unwrap();
     let o = tinydem(&["run", "s.toml", "-q"], t.path());
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success());
-    assert!(!err.contains("panicked"), "{err}");
-    for expected in [
-        "became unstable at step",
-        "particles 0 and 1 overlap by",
-        "timestep 3.000e-3 s exceeds Eq. 50's 1.508e-4 s",
-        "try timestep <= 1.508e-4 s",
-        "last complete frame",
-        "unstable.csv",
-    ] {
-        assert!(
-            err.contains(expected),
-            "message\n  {err}\nlacks\n  {expected}"
-        );
-    }
-    let state = load_particles(&t.path().join("output/unstable.csv")).unwrap();
-    assert_eq!(state.len(), 2);
+    assert_contains(
+        &err,
+        &[
+            "became unstable at step 1",
+            "particle 0 has a non-finite state",
+        ],
+    );
 }
 
 /// A pile that spawns particles and keeps them in contact: spring history matters.
@@ -286,4 +369,51 @@ fn finished_run_with_a_moving_mesh_extends_from_its_checkpoint_bit_for_bit() {
     for ((name, p), (_, q)) in x.iter().zip(&y) {
         assert!(p == q, "{name} differs after extending the run");
     }
+}
+
+#[test]
+fn a_pair_squeezed_past_the_smaller_radius_goes_on_with_one_warning() {
+    // Elastic Hertz impact of a 2 mm grain on a 10 mm one at 15 m/s: the largest overlap,
+    // (15 m* v² / (16 E* sqrt(R*)))^(2/5) = 2.5 mm, lies between the small radius and its
+    // diameter. The grain rebounds; the run goes on with one warning for the pair.
+    use glam::{DQuat, DVec3};
+    use tinydem::particles::{Particle, Particles};
+    use tinydem::simulation::Simulation;
+    let s = common::scenario(
+        "[geometry]\nradius_min = 0.002\nradius_max = 0.01\n\
+         [material]\nrestitution = 1.0\nfriction_sliding = 0.0\nfriction_rolling = 0.0\n\
+         [kinetics]\ngravity = [0.0, 0.0, 0.0]\n\
+         [simulation]\ntimestep = 1e-6\nmax_particles = 0\n",
+    );
+    let grain = |x: f64, radius: f64, v: f64| Particle {
+        x: DVec3::X * x,
+        radius,
+        v: DVec3::X * v,
+        q: DQuat::IDENTITY,
+        w: DVec3::ZERO,
+        tag: 0,
+    };
+    let particles: Particles = [grain(-0.01201, 0.002, 15.0), grain(0.0, 0.01, 0.0)]
+        .into_iter()
+        .collect();
+    let mut sim = Simulation::from_parts(s, Default::default(), particles).unwrap();
+    let mut deepest: f64 = 0.0;
+    for _ in 0..2000 {
+        sim.step()
+            .expect("a transient within the diameter does not stop the run");
+        let p = &sim.particles;
+        deepest = deepest.max(0.012 - p.x[0].distance(p.x[1]));
+    }
+    assert!(
+        deepest > 0.002 && deepest < 0.004,
+        "deepest overlap {deepest}"
+    );
+    assert_eq!(sim.warnings().count(), 1);
+    let fresh = sim.take_new_warnings();
+    assert_eq!(fresh.len(), 1, "{fresh:?}");
+    assert!(
+        fresh[0].contains("particles 0 and 1 overlap by"),
+        "{fresh:?}"
+    );
+    assert!(sim.particles.v[0].x < 0.0, "the grain rebounds");
 }

@@ -3,6 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
+use tinydem::mesh::Contacts;
 use tinydem::scenario::Scenario;
 use tinydem::simulation::Simulation;
 
@@ -42,9 +43,14 @@ fn full_scenario_sets_every_key() {
     assert_eq!(s.simulation.seed, 42);
     assert_eq!(s.particles, Some(dir.join("two.csv")));
     assert_eq!(s.output_dir, dir.join("out"));
+    assert_eq!(s.geometry.mesh_contacts, Contacts::PerFace);
+    assert_eq!(s.meshes[0].contacts, Contacts::Merged);
     let sim = Simulation::new(s).unwrap();
-    assert_eq!(sim.mesh.faces.len(), 5);
+    assert_eq!(sim.mesh.faces.len(), 10);
     assert_eq!(sim.mesh.faces[1].radius, 0.001);
+    // The main box per face (five surfaces), the second one merged: its four faces of
+    // radius 0 one surface, the face of radius 0.001 another.
+    assert_eq!(sim.mesh.surfaces(), 7);
     assert_eq!(sim.particles.len(), 2);
 }
 
