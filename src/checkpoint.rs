@@ -2,11 +2,18 @@
 //! that a resumed run is bitwise identical to an uninterrupted one.
 //!
 //! Layout (little endian): magic `TINYDEM CKPT`, format version (u32), scenario fingerprint
-//! (u64), step (u64), spawner word position (u128), pending radius flag (u8) and value
-//! (f64), particle count (u64) and per particle 14 f64 (x, y, z, R, vx, vy, vz, q0..q3, wx,
-//! wy, wz) and its tag (u32), then the particle-pair and particle-face histories: count (u64) and per entry
-//! owner, partner (u32) and the springs u_s, u_r (3 f64 each), u_t (f64); last a CRC-32 of
-//! everything before it.
+//! (u64), step (u64), step of the last neighbour-list rebuild (u64), spawner word position
+//! (u128), pending radius flag (u8) and value (f64), the next particle id (u32), particle
+//! count (u64) and per particle, in storage order: its id (u32), 14 f64 (x, y, z, R, vx, vy,
+//! vz, q0..q3, wx, wy, wz) and its tag (u32); whether the lists were built (u8) and if so
+//! each particle's position at the last rebuild (3 f64); the lonely particles of the last
+//! rebuild: count (u64) and per entry storage index (u32) and allowance (f64); then the particle-pair and particle-face histories: count (u64) and per
+//! entry the ids (lower, higher) or the id and face (u32, u32) and the springs u_s, u_r (3 f64
+//! each), u_t (f64); last a CRC-32 of everything before it.
+//!
+//! The storage order and the positions of the last rebuild let a resumed run rebuild the
+//! very lists the interrupted one had; its results depend on them (the order in which
+//! forces are summed), so that is what makes it bitwise identical.
 
 use std::path::Path;
 
@@ -21,7 +28,7 @@ use crate::simulation::Snapshot;
 use crate::spawn::SpawnerState;
 
 const MAGIC: &[u8; 12] = b"TINYDEM CKPT";
-const VERSION: u32 = 1;
+const VERSION: u32 = 2;
 
 /// A fingerprint of everything a checkpoint's state depends on: the physics, time step,
 /// spawning and mesh. The number of frames and the output may change on resume.
@@ -70,16 +77,19 @@ fn put_history(out: &mut Vec<u8>, h: &[(u32, u32, Springs)]) {
 /// Encodes a snapshot.
 pub fn encode(snapshot: &Snapshot, fingerprint: u64) -> Vec<u8> {
     let p = &snapshot.particles;
-    let mut out = Vec::with_capacity(64 + p.len() * 112);
+    let mut out = Vec::with_capacity(64 + p.len() * 144);
     out.extend_from_slice(MAGIC);
     out.extend_from_slice(&VERSION.to_le_bytes());
     out.extend_from_slice(&fingerprint.to_le_bytes());
     out.extend_from_slice(&snapshot.steps.to_le_bytes());
+    out.extend_from_slice(&snapshot.built_at.to_le_bytes());
     out.extend_from_slice(&snapshot.spawner.word_pos.to_le_bytes());
     out.push(snapshot.spawner.pending_radius.is_some() as u8);
     put_f64s(&mut out, &[snapshot.spawner.pending_radius.unwrap_or(0.0)]);
+    out.extend_from_slice(&p.next_id.to_le_bytes());
     out.extend_from_slice(&(p.len() as u64).to_le_bytes());
-    for q in p.iter() {
+    for (k, q) in p.iter().enumerate() {
+        out.extend_from_slice(&p.id[k].to_le_bytes());
         put_f64s(
             &mut out,
             &[
@@ -88,6 +98,18 @@ pub fn encode(snapshot: &Snapshot, fingerprint: u64) -> Vec<u8> {
             ],
         );
         out.extend_from_slice(&q.tag.to_le_bytes());
+    }
+    let built = snapshot.anchors.len() == p.len() && !p.is_empty();
+    out.push(built as u8);
+    if built {
+        for a in &snapshot.anchors {
+            put_f64s(&mut out, &[a.x, a.y, a.z]);
+        }
+    }
+    out.extend_from_slice(&(snapshot.lonely.len() as u64).to_le_bytes());
+    for &(i, allowance) in &snapshot.lonely {
+        out.extend_from_slice(&i.to_le_bytes());
+        put_f64s(&mut out, &[allowance]);
     }
     put_history(&mut out, &snapshot.pair_history);
     put_history(&mut out, &snapshot.face_history);
@@ -181,12 +203,19 @@ pub fn decode(bytes: &[u8], expected_fingerprint: u64) -> Result<Snapshot> {
         );
     }
     let steps = r.u64()?;
+    let built_at = r.u64()?;
+    if built_at > steps {
+        bail!("corrupt checkpoint: last rebuild at step {built_at}, after step {steps}");
+    }
     let word_pos = r.u128()?;
     let has_pending = r.u8()? != 0;
     let pending = r.f64()?;
-    let n = r.count(14 * 8 + 4)?;
+    let next_id = r.u32()?;
+    let n = r.count(4 + 14 * 8 + 4)?;
     let mut particles = Particles::default();
+    let mut ids = Vec::with_capacity(n);
     for _ in 0..n {
+        ids.push(r.u32()?);
         let x = r.vec3()?;
         let radius = r.f64()?;
         let v = r.vec3()?;
@@ -202,6 +231,23 @@ pub fn decode(bytes: &[u8], expected_fingerprint: u64) -> Result<Snapshot> {
             tag,
         });
     }
+    let anchors = match r.u8()? {
+        0 => Vec::new(),
+        _ => (0..n).map(|_| r.vec3()).collect::<Result<_>>()?,
+    };
+    let mut sorted = ids.clone();
+    sorted.sort_unstable();
+    if sorted.windows(2).any(|w| w[0] == w[1]) || sorted.last().is_some_and(|&m| m >= next_id) {
+        bail!("corrupt checkpoint: particle ids repeat or reach the next id {next_id}");
+    }
+    (particles.id, particles.next_id) = (ids, next_id);
+    let lonely_count = r.count(4 + 8)?;
+    let lonely = (0..lonely_count)
+        .map(|_| Ok((r.u32()?, r.f64()?)))
+        .collect::<Result<Vec<(u32, f64)>>>()?;
+    if lonely.iter().any(|&(i, _)| i as usize >= n) || !lonely.is_sorted_by_key(|l| l.0) {
+        bail!("corrupt checkpoint: lonely particles out of order or range");
+    }
     let pair_history = r.history()?;
     let face_history = r.history()?;
     if r.at != body.len() {
@@ -212,11 +258,14 @@ pub fn decode(bytes: &[u8], expected_fingerprint: u64) -> Result<Snapshot> {
     }
     Ok(Snapshot {
         steps,
+        built_at,
         particles,
         spawner: SpawnerState {
             word_pos,
             pending_radius: has_pending.then_some(pending),
         },
+        anchors,
+        lonely,
         pair_history,
         face_history,
     })
@@ -264,15 +313,20 @@ mod tests {
             u_r: DVec3::ZERO,
             u_t: -3e-7,
         };
+        particles.id = vec![3];
+        particles.next_id = 5;
         Snapshot {
             steps: 12345,
+            built_at: 12300,
             particles,
             spawner: SpawnerState {
                 word_pos: 987654321,
                 pending_radius: Some(0.0042),
             },
-            pair_history: vec![(0, 1, s)],
-            face_history: vec![(0, 3, s)],
+            anchors: vec![DVec3::new(0.1, 0.2, 0.2999)],
+            lonely: vec![(0, 0.25)],
+            pair_history: vec![(3, 4, s)],
+            face_history: vec![(3, 3, s)],
         }
     }
 

@@ -19,13 +19,13 @@ pub fn frame_name(k: u64) -> String {
     format!("particles{k:06}.csv")
 }
 
-/// Writes all particles as CSV text, with the `tag` column if `tags`.
+/// Writes all particles as CSV text in id order, with the `tag` column if `tags`.
 pub fn write_particles(out: &mut impl Write, p: &Particles, tags: bool) -> std::io::Result<()> {
     let mut line = String::with_capacity(512);
     out.write_all(COLUMNS.join(",").as_bytes())?;
     out.write_all(if tags { b",tag\n" } else { b"\n" })?;
     let mut buf = ryu::Buffer::new();
-    for q in p.iter() {
+    for (_, q) in p.iter_by_id() {
         line.clear();
         let values = [
             q.x.x, q.x.y, q.x.z, q.radius, q.v.x, q.v.y, q.v.z, q.q.w, q.q.x, q.q.y, q.q.z, q.w.x,

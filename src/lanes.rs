@@ -332,26 +332,79 @@ pub trait Gather<const N: usize>: Lanes<Vec = V3<Self>, Quat = Q4<Self>> {
 
     #[inline(always)]
     fn gather_vec(v: [DVec3; N]) -> V3<Self> {
+        let (mut x, mut y, mut z) = ([0.0; N], [0.0; N], [0.0; N]);
+        for l in 0..N {
+            (x[l], y[l], z[l]) = (v[l].x, v[l].y, v[l].z);
+        }
         V3 {
-            x: Self::gather(v.map(|v| v.x)),
-            y: Self::gather(v.map(|v| v.y)),
-            z: Self::gather(v.map(|v| v.z)),
+            x: Self::gather(x),
+            y: Self::gather(y),
+            z: Self::gather(z),
+        }
+    }
+
+    /// `values[idx[l]]` in lane `l`.
+    #[inline(always)]
+    fn gather_at(values: &[f64], idx: &[usize; N]) -> Self {
+        let mut a = [0.0; N];
+        for l in 0..N {
+            a[l] = values[idx[l]];
+        }
+        Self::gather(a)
+    }
+
+    /// `values[idx[l]]` in lane `l`.
+    #[inline(always)]
+    fn gather_vec_at(values: &[DVec3], idx: &[usize; N]) -> V3<Self> {
+        let (mut x, mut y, mut z) = ([0.0; N], [0.0; N], [0.0; N]);
+        for l in 0..N {
+            let v = values[idx[l]];
+            (x[l], y[l], z[l]) = (v.x, v.y, v.z);
+        }
+        V3 {
+            x: Self::gather(x),
+            y: Self::gather(y),
+            z: Self::gather(z),
         }
     }
 
     #[inline(always)]
     fn scatter_vec(v: V3<Self>) -> [DVec3; N] {
         let (x, y, z) = (v.x.scatter(), v.y.scatter(), v.z.scatter());
-        std::array::from_fn(|k| DVec3::new(x[k], y[k], z[k]))
+        let mut out = [DVec3::ZERO; N];
+        for l in 0..N {
+            out[l] = DVec3::new(x[l], y[l], z[l]);
+        }
+        out
     }
 
     #[inline(always)]
     fn gather_quat(q: [DQuat; N]) -> Q4<Self> {
+        let (mut x, mut y, mut z, mut w) = ([0.0; N], [0.0; N], [0.0; N], [0.0; N]);
+        for l in 0..N {
+            (x[l], y[l], z[l], w[l]) = (q[l].x, q[l].y, q[l].z, q[l].w);
+        }
         Q4 {
-            x: Self::gather(q.map(|q| q.x)),
-            y: Self::gather(q.map(|q| q.y)),
-            z: Self::gather(q.map(|q| q.z)),
-            w: Self::gather(q.map(|q| q.w)),
+            x: Self::gather(x),
+            y: Self::gather(y),
+            z: Self::gather(z),
+            w: Self::gather(w),
+        }
+    }
+
+    /// `values[idx[l]]` in lane `l`.
+    #[inline(always)]
+    fn gather_quat_at(values: &[DQuat], idx: &[usize; N]) -> Q4<Self> {
+        let (mut x, mut y, mut z, mut w) = ([0.0; N], [0.0; N], [0.0; N], [0.0; N]);
+        for l in 0..N {
+            let q = values[idx[l]];
+            (x[l], y[l], z[l], w[l]) = (q.x, q.y, q.z, q.w);
+        }
+        Q4 {
+            x: Self::gather(x),
+            y: Self::gather(y),
+            z: Self::gather(z),
+            w: Self::gather(w),
         }
     }
 

@@ -19,35 +19,12 @@ use rustc_hash::FxHashMap;
 
 use crate::contact::Springs;
 use crate::mesh::Face;
+use crate::particles::Particles;
 
 /// Below this many items a parallel loop runs on one thread (spawn overhead dominates).
 pub const MIN_PARALLEL_LEN: usize = 64;
 
 const CELL_BIAS: i32 = 1 << 20;
-
-/// The 13 neighbours of a cell that come after it (z, then y, then x): with the cell itself,
-/// every pair of neighbouring cells once.
-const FORWARD: [IVec3; 13] = {
-    let mut d = [IVec3::ZERO; 13];
-    let mut k = 0;
-    let mut dz = -1;
-    while dz <= 1 {
-        let mut dy = -1;
-        while dy <= 1 {
-            let mut dx = -1;
-            while dx <= 1 {
-                if dz > 0 || (dz == 0 && (dy > 0 || (dy == 0 && dx > 0))) {
-                    d[k] = IVec3::new(dx, dy, dz);
-                    k += 1;
-                }
-                dx += 1;
-            }
-            dy += 1;
-        }
-        dz += 1;
-    }
-    d
-};
 
 /// Integer cell of a position; clamped so that far-flung particles share the outermost
 /// cells (still correct, as pairs are always tested by distance).
@@ -76,8 +53,6 @@ pub struct CellGrid {
     items: Vec<u32>,
     /// Cell key -> range in `items`.
     cells: FxHashMap<u64, (u32, u32)>,
-    /// Occupied cells in key order: cell coordinates and range in `items`.
-    occupied: Vec<(IVec3, u32, u32)>,
 }
 
 impl CellGrid {
@@ -91,25 +66,16 @@ impl CellGrid {
             .map(|(i, &x)| (key(cell_of(x, inv_h)), i as u32))
             .collect();
         keyed.par_sort_unstable();
-        CellGrid::from_sorted(keyed, inv_h, |i| Some(cell_of(x[i as usize], inv_h)))
+        CellGrid::from_sorted(keyed, inv_h)
     }
 
-    /// The grid of `(cell key, item)` pairs sorted by key; `cell` gives an item's cell
-    /// coordinates where the list of occupied cells is wanted.
-    fn from_sorted(
-        keyed: Vec<(u64, u32)>,
-        inv_h: f64,
-        cell: impl Fn(u32) -> Option<IVec3>,
-    ) -> CellGrid {
+    /// The grid of `(cell key, item)` pairs sorted by key.
+    fn from_sorted(keyed: Vec<(u64, u32)>, inv_h: f64) -> CellGrid {
         let mut cells = FxHashMap::default();
-        let mut occupied = Vec::new();
         let mut start = 0;
         for k in 1..=keyed.len() {
             if k == keyed.len() || keyed[k].0 != keyed[start].0 {
                 cells.insert(keyed[start].0, (start as u32, k as u32));
-                if let Some(c) = cell(keyed[start].1) {
-                    occupied.push((c, start as u32, k as u32));
-                }
                 start = k;
             }
         }
@@ -117,7 +83,6 @@ impl CellGrid {
             inv_h,
             items: keyed.into_iter().map(|(_, i)| i).collect(),
             cells,
-            occupied,
         }
     }
 
@@ -136,7 +101,7 @@ impl CellGrid {
             }
         }
         keyed.sort_unstable();
-        CellGrid::from_sorted(keyed, inv_h, |_| None)
+        CellGrid::from_sorted(keyed, inv_h)
     }
 
     /// Items in the cell containing `x`.
@@ -169,20 +134,20 @@ impl CellGrid {
     }
 }
 
-/// A compressed list: for each owner `i`, a sorted run of partners, each with springs.
+/// A compressed list: for each owner `i` (a storage index), a run of partners, each slot
+/// with the friction springs of its contact.
 #[derive(Clone, Debug, Default)]
 pub struct ContactList {
     /// Run of owner `i` is `start[i]..start[i+1]`.
     pub start: Vec<u32>,
-    /// Owner of each slot.
-    pub owner: Vec<u32>,
-    /// Partner of each slot (particle `j > i`, or face index).
+    /// Partner of each slot: a particle `j > i` (storage index), or a face index.
     pub partner: Vec<u32>,
-    /// Friction springs of each slot.
+    /// Friction springs of each slot; those of a particle pair as seen from the particle of
+    /// the lower id (body i of the contact law), whatever the storage order.
     pub springs: Vec<Springs>,
-    /// Whether the slot's springs (and its force, kept by the simulation) may be non-zero:
-    /// its pair touched at the last force evaluation, or had springs when listed. A pair
-    /// apart has both zeroed once, and is not looked at again while it stays apart.
+    /// Whether the slot's springs may be non-zero: its pair touched at the last force
+    /// evaluation, or had springs when listed. A pair apart has them zeroed once, and is not
+    /// looked at again while it stays apart.
     pub touched: Vec<bool>,
 }
 
@@ -191,115 +156,183 @@ impl ContactList {
         self.partner.len()
     }
 
-    /// Every slot with non-zero springs: the contact history.
-    pub fn history(&self) -> Vec<(u32, u32, Springs)> {
-        (0..self.slots())
-            .filter(|&k| self.springs[k] != Springs::default())
-            .map(|k| (self.owner[k], self.partner[k], self.springs[k]))
+    /// The slots of owner `i`.
+    #[inline]
+    pub fn run(&self, i: usize) -> std::ops::Range<usize> {
+        self.start[i] as usize..self.start[i + 1] as usize
+    }
+
+    /// Number of owners.
+    pub fn owners(&self) -> usize {
+        self.start.len().saturating_sub(1)
+    }
+
+    /// The contact history of the list by id: for each slot with springs, the key that
+    /// `key(owner, partner)` gives it and its springs.
+    fn history(&self, ids: usize, key: impl Fn(usize, u32) -> (u32, u32) + Sync) -> History {
+        let live = |k: usize| self.touched[k] && self.springs[k] != Springs::default();
+        let entries = || {
+            (0..self.owners())
+                .flat_map(move |i| self.run(i).filter(move |&k| live(k)).map(move |k| (i, k)))
+        };
+        History::from_entries(
+            ids,
+            entries().map(|(i, k)| key(i, self.partner[k]).0),
+            entries().map(|(i, k)| {
+                let (id, other) = key(i, self.partner[k]);
+                (id, other, self.springs[k])
+            }),
+        )
+    }
+}
+
+/// A contact history by particle id: the springs of particle pairs keyed by (lower id,
+/// higher id), or of particle-face contacts by (id, face). It carries the springs across
+/// rebuilds, which re-sort the particles, and into checkpoints.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct History {
+    /// The entries of id `a` are `start[a]..start[a+1]`, ordered by the other key.
+    start: Vec<u32>,
+    other: Vec<u32>,
+    springs: Vec<Springs>,
+}
+
+impl History {
+    /// The history of `(id, other, springs)` entries, ids below `ids`: a counting sort by id
+    /// (`first` yields the same ids in the same order), then each id's run by `other`.
+    fn from_entries(
+        ids: usize,
+        first: impl Iterator<Item = u32>,
+        entries: impl Iterator<Item = (u32, u32, Springs)>,
+    ) -> History {
+        let mut start = vec![0u32; ids + 1];
+        for id in first {
+            start[id as usize + 1] += 1;
+        }
+        for k in 0..ids {
+            start[k + 1] += start[k];
+        }
+        let total = start[ids] as usize;
+        let mut fill = start.clone();
+        let mut other = vec![0u32; total];
+        let mut springs = vec![Springs::default(); total];
+        for (id, o, s) in entries {
+            let k = fill[id as usize] as usize;
+            (other[k], springs[k]) = (o, s);
+            fill[id as usize] += 1;
+        }
+        drop(fill);
+        for a in 0..ids {
+            let run = start[a] as usize..start[a + 1] as usize;
+            if run.len() > 1 {
+                let mut pairs: Vec<(u32, Springs)> =
+                    run.clone().map(|k| (other[k], springs[k])).collect();
+                pairs.sort_by_key(|p| p.0);
+                for (k, (o, s)) in run.zip(pairs) {
+                    (other[k], springs[k]) = (o, s);
+                }
+            }
+        }
+        History {
+            start,
+            other,
+            springs,
+        }
+    }
+
+    /// The history of saved `(id, other, springs)` entries (a checkpoint's).
+    pub fn new(ids: usize, entries: &[(u32, u32, Springs)]) -> Result<History, String> {
+        if let Some(&(id, ..)) = entries.iter().find(|e| e.0 as usize >= ids) {
+            return Err(format!("contact of particle id {id}, of {ids} ids"));
+        }
+        Ok(History::from_entries(
+            ids,
+            entries.iter().map(|e| e.0),
+            entries.iter().copied(),
+        ))
+    }
+
+    /// Every entry, ordered by id and then by the other key.
+    pub fn entries(&self) -> Vec<(u32, u32, Springs)> {
+        (0..self.start.len().saturating_sub(1))
+            .flat_map(|a| {
+                (self.start[a] as usize..self.start[a + 1] as usize)
+                    .map(move |k| (a as u32, self.other[k], self.springs[k]))
+            })
             .collect()
     }
 
-    /// Puts back a contact history saved by [`ContactList::history`]; every pair in it must
-    /// be listed (it was touching when saved).
-    pub fn restore(&mut self, history: &[(u32, u32, Springs)]) -> Result<(), String> {
-        for &(i, j, springs) in history {
-            let run = self.run(i as usize);
-            match run.binary_search(&j) {
-                Ok(k) => {
-                    let slot = self.start[i as usize] as usize + k;
-                    self.springs[slot] = springs;
-                    self.touched[slot] = true;
-                }
-                Err(_) => return Err(format!("contact ({i}, {j}) is not within reach")),
-            }
-        }
-        Ok(())
+    pub fn len(&self) -> usize {
+        self.other.len()
     }
 
-    fn run(&self, i: usize) -> &[u32] {
-        if i + 1 >= self.start.len() {
-            return &[];
-        }
-        &self.partner[self.start[i] as usize..self.start[i + 1] as usize]
+    pub fn is_empty(&self) -> bool {
+        self.other.is_empty()
     }
 
-    /// Only the slots with non-zero springs (the touching pairs), in a compact list; the rest
-    /// of the memory is freed. Used to carry the contact history across a rebuild.
-    fn touching(self) -> ContactList {
-        let n = self.start.len().saturating_sub(1);
-        let mut start = Vec::with_capacity(n + 1);
-        let mut partner = Vec::new();
-        let mut springs = Vec::new();
-        start.push(0u32);
-        for i in 0..n {
-            for k in self.start[i] as usize..self.start[i + 1] as usize {
-                if self.springs[k] != Springs::default() {
-                    partner.push(self.partner[k]);
-                    springs.push(self.springs[k]);
-                }
-            }
-            start.push(partner.len() as u32);
+    /// The springs of `(id, other)`, or zero.
+    #[inline]
+    fn get(&self, id: u32, other: u32) -> Springs {
+        let id = id as usize;
+        if id + 1 >= self.start.len() {
+            return Springs::default();
         }
-        ContactList {
-            start,
-            owner: Vec::new(),
-            partner,
-            springs,
-            touched: Vec::new(),
-        }
-    }
-
-    /// A new list from per-owner partner runs (`start`, `partner` in compressed form, each
-    /// run sorted), carrying over the springs of pairs that were listed before.
-    fn rebuild(&self, start: Vec<u32>, partner: Vec<u32>) -> ContactList {
-        let mut owner = Vec::with_capacity(partner.len());
-        for (i, w) in start.windows(2).enumerate() {
-            owner.extend(std::iter::repeat_n(i as u32, (w[1] - w[0]) as usize));
-        }
-        let springs: Vec<Springs> = owner
-            .par_iter()
-            .zip(partner.par_iter())
-            .with_min_len(MIN_PARALLEL_LEN)
-            .map(|(&i, &j)| {
-                let old = self.run(i as usize);
-                match old.binary_search(&j) {
-                    Ok(k) => self.springs[self.start[i as usize] as usize + k],
-                    Err(_) => Springs::default(),
-                }
-            })
-            .collect();
-        let touched = springs
-            .par_iter()
-            .with_min_len(MIN_PARALLEL_LEN)
-            .map(|s| *s != Springs::default())
-            .collect();
-        ContactList {
-            start,
-            owner,
-            partner,
-            springs,
-            touched,
+        let run = self.start[id] as usize..self.start[id + 1] as usize;
+        match self.other[run.clone()].binary_search(&other) {
+            Ok(k) => self.springs[run.start + k],
+            Err(_) => Springs::default(),
         }
     }
 }
 
-/// Compressed form of `(owner, partner)` pairs: a counting sort by owner that keeps the
-/// order of each owner's partners.
-fn compress(n: usize, pairs: impl Iterator<Item = (u32, u32)> + Clone) -> (Vec<u32>, Vec<u32>) {
-    let mut start = vec![0u32; n + 1];
-    for (i, _) in pairs.clone() {
-        start[i as usize + 1] += 1;
+/// The contact histories of both lists.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Histories {
+    pub pairs: History,
+    pub faces: History,
+}
+
+/// The history of particle pairs of a list, by (lower id, higher id).
+fn pair_key(ids: &[u32]) -> impl Fn(usize, u32) -> (u32, u32) + Sync + '_ {
+    move |i, j| {
+        let (a, b) = (ids[i], ids[j as usize]);
+        (a.min(b), a.max(b))
     }
-    for k in 0..n {
-        start[k + 1] += start[k];
+}
+
+/// How particles are binned for the lists: cells of edge `h`, and whether they are sized
+/// for the largest radius (`uniform`: then every pair is within neighbouring cells).
+#[derive(Clone, Copy, Debug)]
+struct Layout {
+    h: f64,
+    uniform: bool,
+}
+
+impl Layout {
+    /// Cells sized for the largest radius, or for the 90th percentile of the radii when the
+    /// largest is more than twice that, so that a few large particles do not make every
+    /// cell hold many small ones.
+    fn of(radius: &[f64], skin: f64) -> Layout {
+        let n = radius.len();
+        let max_r = radius.iter().copied().fold(0.0, f64::max);
+        let typical_r = if n > 0 {
+            let mut r = radius.to_vec();
+            let k = (9 * n / 10).min(n - 1);
+            *r.select_nth_unstable_by(k, f64::total_cmp).1
+        } else {
+            0.0
+        };
+        let cell_r = if max_r <= 2.0 * typical_r {
+            max_r
+        } else {
+            typical_r
+        };
+        let h = 2.0 * cell_r + skin;
+        Layout {
+            h: if h > 0.0 { h } else { 1.0 },
+            uniform: cell_r == max_r,
+        }
     }
-    let mut fill = start.clone();
-    let mut partner = vec![0u32; start[n] as usize];
-    for (i, j) in pairs {
-        partner[fill[i as usize] as usize] = j;
-        fill[i as usize] += 1;
-    }
-    (start, partner)
 }
 
 /// Verlet lists of particle pairs and particle-face pairs.
@@ -307,20 +340,56 @@ fn compress(n: usize, pairs: impl Iterator<Item = (u32, u32)> + Clone) -> (Vec<u
 pub struct Neighbours {
     /// Extra distance listed beyond contact.
     pub skin: f64,
-    /// Particle pairs i < j.
+    /// Particle pairs i < j (storage indices).
     pub pairs: ContactList,
-    /// For each particle j, the pair slots in which it is the partner (sorted).
-    pub reverse_start: Vec<u32>,
-    pub reverse_slot: Vec<u32>,
     /// Particle-face pairs.
     pub faces: ContactList,
-    /// Positions at the last rebuild.
+    /// Slabs of owners for the pair-force stage: slab `s` is owners `slabs[s]..slabs[s+1]`,
+    /// and every partner of an owner in slab `s` lies in slab `s` or `s + 1`. So the even
+    /// slabs can add their forces to their particles at the same time, then the odd ones.
+    pub slabs: Vec<u32>,
+    /// Positions at the last rebuild (the anchors of the Verlet criterion).
     x_at_build: Vec<DVec3>,
     /// Particles with nothing within reach at the last rebuild, each with how far it may
     /// move before the lists can miss a contact (half its clearance, at least skin / 2).
     lonely: Vec<(u32, f64)>,
     /// Number of rebuilds so far.
     pub rebuilds: u64,
+}
+
+/// The fewest owners in a slab (a task of the pair stage).
+const MIN_SLAB: usize = 64;
+
+/// Slab bounds over owners such that the partners of slab `s` lie in slabs `s` and `s + 1`:
+/// slab `s + 2` starts beyond the last partner of slab `s`.
+fn slabs_of(pairs: &ContactList) -> Vec<u32> {
+    let n = pairs.owners();
+    let reach = |i: usize| {
+        let run = pairs.run(i);
+        if run.is_empty() {
+            i
+        } else {
+            pairs.partner[run.end - 1] as usize
+        }
+    };
+    let mut bounds = vec![0u32];
+    if n == 0 {
+        return bounds;
+    }
+    // `need`: where the slab after next must start at the earliest.
+    let (mut start, mut need) = (0usize, 0usize);
+    let mut furthest = 0usize;
+    for i in 0..n {
+        furthest = furthest.max(reach(i));
+        if i + 1 - start >= MIN_SLAB && i + 1 >= need && i + 1 < n {
+            bounds.push((i + 1) as u32);
+            need = furthest + 1;
+            start = i + 1;
+            furthest = 0;
+        }
+    }
+    bounds.push(n as u32);
+    bounds
 }
 
 impl Neighbours {
@@ -430,10 +499,12 @@ impl Neighbours {
     /// <= c_i. Clearances are found by brute force, so only while that stays cheap.
     fn find_lonely(&mut self, x: &[DVec3], radius: &[f64], faces: &[Face]) {
         let n = x.len();
+        let mut partnered = vec![false; n];
+        for &j in &self.pairs.partner {
+            partnered[j as usize] = true;
+        }
         let listed = |i: usize| {
-            self.pairs.start[i] != self.pairs.start[i + 1]
-                || self.reverse_start[i] != self.reverse_start[i + 1]
-                || self.faces.start[i] != self.faces.start[i + 1]
+            !self.pairs.run(i).is_empty() || partnered[i] || !self.faces.run(i).is_empty()
         };
         let candidates: Vec<usize> = (0..n).filter(|&i| !listed(i)).collect();
         const BUDGET: usize = 4_000_000;
@@ -455,150 +526,160 @@ impl Neighbours {
             .collect();
     }
 
-    /// Rebuilds both lists for particles at `x` with radii `radius`.
+    /// The contact histories of the current lists by id.
+    pub fn history(&self, ids: &[u32], id_count: usize) -> Histories {
+        Histories {
+            pairs: self.pairs.history(id_count, pair_key(ids)),
+            faces: self.faces.history(id_count, |i, f| (ids[i], f)),
+        }
+    }
+
+    /// The positions the lists were built at and the lonely particles' allowances: with
+    /// the storage order, all a checkpoint needs to restore the very same lists.
+    pub fn anchors(&self) -> (&[DVec3], &[(u32, f64)]) {
+        (&self.x_at_build, &self.lonely)
+    }
+
+    /// Rebuilds both lists for `particles`, re-sorting them into spatial order first.
     ///
-    /// Cells are sized for the largest radius, or for the 90th percentile of the radii when
-    /// the largest is more than twice that, so that a few large particles do not make every
-    /// cell hold many small ones. Each pair is found by its larger particle (ties: the lower
-    /// index), which searches as many cells as its own reach needs.
-    pub fn rebuild(&mut self, x: &[DVec3], radius: &[f64], faces: &[Face], face_grid: &CellGrid) {
+    /// The springs of touching pairs are carried by particle id. Particles are stored in the
+    /// order of their cells (cell key, then id), so that neighbours in space are neighbours
+    /// in memory, and the lists are built from their positions (see [`Neighbours::build`]).
+    pub fn rebuild(&mut self, particles: &mut Particles, faces: &[Face], face_grid: &CellGrid) {
+        let history = self.history(&particles.id, particles.next_id as usize);
+        // The old lists go before the new ones are made.
+        self.pairs = ContactList::default();
+        self.faces = ContactList::default();
+        let layout = Layout::of(&particles.radius, self.skin);
+        let inv_h = 1.0 / layout.h;
+        let keys: Vec<(u64, u32)> = particles
+            .x
+            .par_iter()
+            .zip(particles.id.par_iter())
+            .with_min_len(MIN_PARALLEL_LEN)
+            .map(|(&x, &id)| (key(cell_of(x, inv_h)), id))
+            .collect();
+        if !keys.is_sorted() {
+            let mut order: Vec<u32> = (0..keys.len() as u32).collect();
+            order.par_sort_unstable_by_key(|&i| keys[i as usize]);
+            drop(keys);
+            particles.permute(&order);
+        }
+        let x = particles.x.clone();
+        self.build(&x, particles, faces, face_grid, layout, &history);
+        self.find_lonely(&x, &particles.radius, faces);
+        self.x_at_build = x;
+        self.rebuilds += 1;
+    }
+
+    /// Builds again the lists of a checkpoint: the particles in their saved storage order,
+    /// the positions of the last rebuild (`anchors`) and its lonely particles, and the
+    /// contact histories. The lists are those the run had, slot for slot.
+    pub fn restore(
+        &mut self,
+        particles: &Particles,
+        anchors: Vec<DVec3>,
+        lonely: Vec<(u32, f64)>,
+        faces: &[Face],
+        face_grid: &CellGrid,
+        history: &Histories,
+    ) {
+        let layout = Layout::of(&particles.radius, self.skin);
+        self.build(&anchors, particles, faces, face_grid, layout, history);
+        self.x_at_build = anchors;
+        self.lonely = lonely;
+        self.rebuilds += 1;
+    }
+
+    /// Both lists for particles at `x` (radii and ids from `particles`, in storage order),
+    /// with the springs of `history`, and the slabs.
+    ///
+    /// Each pair is listed once, under its lower storage index, with its partners in
+    /// ascending order. Cells sized for every radius (`uniform`): each particle looks for
+    /// its partners of higher index in the 27 cells around its own. Otherwise each pair is
+    /// found by its larger particle (ties: the lower index), which searches as many cells
+    /// as its own reach needs, and the pairs are sorted afterwards.
+    fn build(
+        &mut self,
+        x: &[DVec3],
+        particles: &Particles,
+        faces: &[Face],
+        face_grid: &CellGrid,
+        layout: Layout,
+        history: &Histories,
+    ) {
+        let (radius, ids) = (&particles.radius, &particles.id);
         let n = x.len();
-        // Keep only the history of touching pairs while the new lists are built.
-        let old_pairs = std::mem::take(&mut self.pairs).touching();
-        let old_faces = std::mem::take(&mut self.faces).touching();
         let skin = self.skin;
-        let max_r = radius.iter().copied().fold(0.0, f64::max);
-        let typical_r = if n > 0 {
-            let mut r = radius.to_vec();
-            let k = (9 * n / 10).min(n - 1);
-            *r.select_nth_unstable_by(k, f64::total_cmp).1
-        } else {
-            0.0
-        };
-        // Sized for the largest particle unless it is far larger than most (then every
-        // cell would hold many small particles).
-        let cell_r = if max_r <= 2.0 * typical_r {
-            max_r
-        } else {
-            typical_r
-        };
-        let h = 2.0 * cell_r + skin;
-        let h = if h > 0.0 { h } else { 1.0 };
-        let grid = CellGrid::of_points(x, h);
-        let uniform = cell_r == max_r;
-        // With cells for ordinary sizes (not `uniform`): whether i finds its pair with j (the
-        // larger radius, ties: the lower index), and how many cells around its own it must
-        // search (its partners are no larger, so within 2 R_i + skin).
-        let finds = |i: u32, j: u32| {
-            let (ri, rj) = (radius[i as usize], radius[j as usize]);
-            rj < ri || (rj == ri && j > i)
-        };
-        let cells_needed = |i: u32| ((2.0 * radius[i as usize] + skin) / h).ceil().max(1.0) as i32;
+        let grid = CellGrid::of_points(x, layout.h);
         let close = |i: u32, j: u32| {
             let reach = radius[i as usize] + radius[j as usize] + skin;
             (x[i as usize] - x[j as usize]).length_squared() < reach * reach
         };
-        let key = |i: u32, j: u32| ((i.min(j) as u64) << 32) | i.max(j) as u64;
-
-        // The pairs found, in one list per piece of the parallel loop over occupied cells.
-        let per_cell: Vec<Vec<u64>> = if uniform {
-            // Cells sized for every pair: each pair of cells is visited once (a cell and
-            // the 13 of its neighbours that come after it), so each pair of particles is
-            // tested once; the pairs are sorted afterwards.
-            grid.occupied
-                .par_iter()
-                .with_min_len(MIN_PARALLEL_LEN / 16)
-                .fold(Vec::new, |mut pairs, &(c, a, b)| {
-                    let own = &grid.items[a as usize..b as usize];
-                    for (k, &i) in own.iter().enumerate() {
-                        for &j in &own[k + 1..] {
-                            if close(i, j) {
-                                pairs.push(key(i, j));
-                            }
+        let (start, partner) = if layout.uniform {
+            // Per owner, its partners of higher index from the 27 cells around its cell;
+            // a run is sorted (cells in key order hold ascending indices when the storage
+            // is in cell order, and the run is sorted in any case).
+            let runs: Vec<Vec<u32>> = (0..n as u32)
+                .into_par_iter()
+                .with_min_len(4 * MIN_PARALLEL_LEN)
+                .fold(Vec::new, |mut out: Vec<u32>, i| {
+                    let at = out.len();
+                    out.push(0); // the run's length, filled below
+                    grid.for_each_near(x[i as usize], |j| {
+                        if j > i && close(i, j) {
+                            out.push(j);
                         }
-                    }
-                    for d in FORWARD {
-                        let other = grid.in_cell(c + d);
-                        for &i in own {
-                            for &j in other {
-                                if close(i, j) {
-                                    pairs.push(key(i, j));
-                                }
-                            }
-                        }
-                    }
-                    pairs
+                    });
+                    out[at + 1..].sort_unstable();
+                    out[at] = (out.len() - at - 1) as u32;
+                    out
                 })
-                .collect()
+                .collect();
+            runs_to_csr(n, runs)
         } else {
-            // Cells for ordinary sizes: the 27 neighbour ranges are looked up once for the
-            // cell's particles of ordinary size; larger particles search their own wider
-            // block, and find only partners no larger than themselves.
-            grid.occupied
-                .par_iter()
-                .with_min_len(MIN_PARALLEL_LEN / 16)
-                .fold(Vec::new, |mut pairs, &(c, a, b)| {
-                    let mut near: [&[u32]; 27] = [&[]; 27];
-                    let mut k = 0;
-                    for dz in -1..=1 {
-                        for dy in -1..=1 {
-                            for dx in -1..=1 {
-                                near[k] = grid.in_cell(c + IVec3::new(dx, dy, dz));
-                                k += 1;
-                            }
-                        }
-                    }
-                    for &i in &grid.items[a as usize..b as usize] {
-                        let m = cells_needed(i);
-                        if m == 1 {
-                            for &j in near.iter().flat_map(|r| r.iter()) {
-                                if finds(i, j) & close(i, j) {
-                                    pairs.push(key(i, j));
-                                }
-                            }
-                        } else {
-                            for dz in -m..=m {
-                                for dy in -m..=m {
-                                    for dx in -m..=m {
-                                        for &j in grid.in_cell(c + IVec3::new(dx, dy, dz)) {
-                                            if finds(i, j) & close(i, j) {
-                                                pairs.push(key(i, j));
-                                            }
-                                        }
+            let finds = |i: u32, j: u32| {
+                let (ri, rj) = (radius[i as usize], radius[j as usize]);
+                rj < ri || (rj == ri && j > i)
+            };
+            let cells_needed = |i: u32| {
+                ((2.0 * radius[i as usize] + skin) / layout.h)
+                    .ceil()
+                    .max(1.0) as i32
+            };
+            let mut pairs: Vec<u64> = (0..n as u32)
+                .into_par_iter()
+                .with_min_len(4 * MIN_PARALLEL_LEN)
+                .fold(Vec::new, |mut out: Vec<u64>, i| {
+                    let c = cell_of(x[i as usize], 1.0 / layout.h);
+                    let m = cells_needed(i);
+                    for dz in -m..=m {
+                        for dy in -m..=m {
+                            for dx in -m..=m {
+                                for &j in grid.in_cell(c + IVec3::new(dx, dy, dz)) {
+                                    if finds(i, j) && close(i, j) {
+                                        out.push(((i.min(j) as u64) << 32) | i.max(j) as u64);
                                     }
                                 }
                             }
                         }
                     }
-                    pairs
+                    out
                 })
-                .collect()
+                .flatten()
+                .collect();
+            pairs.par_sort_unstable();
+            compress(n, pairs.iter().map(|&k| ((k >> 32) as u32, k as u32)))
         };
-        let mut pairs: Vec<u64> = per_cell.into_iter().flatten().collect();
-        // Pairs of one owner came from several cells: bring them together in order.
-        pairs.par_sort_unstable();
-        let (start, partner) = compress(n, pairs.iter().map(|&k| ((k >> 32) as u32, k as u32)));
-        self.pairs = old_pairs.rebuild(start, partner);
-
-        // Reverse index by counting sort over partners (keeps slots in ascending order).
-        let mut count = vec![0u32; n + 1];
-        for &j in &self.pairs.partner {
-            count[j as usize + 1] += 1;
-        }
-        for k in 0..n {
-            count[k + 1] += count[k];
-        }
-        let mut fill = count.clone();
-        let mut slots = vec![0u32; self.pairs.slots()];
-        for (slot, &j) in self.pairs.partner.iter().enumerate() {
-            slots[fill[j as usize] as usize] = slot as u32;
-            fill[j as usize] += 1;
-        }
-        self.reverse_start = count;
-        self.reverse_slot = slots;
+        drop(grid);
+        let pair_of = pair_key(ids);
+        self.pairs = ContactList::with_springs(start, partner, |i, j| {
+            let (a, b) = pair_of(i, j);
+            history.pairs.get(a, b)
+        });
 
         // The items of a grid cell come in ascending order, so each particle's run of faces
-        // is sorted (as `ContactList` needs).
+        // is sorted.
         let face_pairs: Vec<(u32, u32)> = (0..n)
             .into_par_iter()
             .with_min_len(MIN_PARALLEL_LEN / 8)
@@ -613,12 +694,81 @@ impl Neighbours {
             })
             .collect();
         let (start, partner) = compress(n, face_pairs.iter().copied());
-        self.faces = old_faces.rebuild(start, partner);
-
-        self.find_lonely(x, radius, faces);
-        self.x_at_build = x.to_vec();
-        self.rebuilds += 1;
+        drop(face_pairs);
+        self.faces = ContactList::with_springs(start, partner, |i, f| history.faces.get(ids[i], f));
+        self.slabs = slabs_of(&self.pairs);
     }
+}
+
+impl ContactList {
+    /// A list from runs in compressed form, each slot with the springs `springs(owner,
+    /// partner)` gives it.
+    fn with_springs(
+        start: Vec<u32>,
+        partner: Vec<u32>,
+        springs: impl Fn(usize, u32) -> Springs + Sync,
+    ) -> ContactList {
+        let owners = start.len().saturating_sub(1);
+        let springs: Vec<Springs> = (0..owners)
+            .into_par_iter()
+            .with_min_len(MIN_PARALLEL_LEN)
+            .flat_map_iter(|i| {
+                let run = start[i] as usize..start[i + 1] as usize;
+                let springs = &springs;
+                partner[run].iter().map(move |&j| springs(i, j))
+            })
+            .collect();
+        let touched = springs
+            .par_iter()
+            .with_min_len(MIN_PARALLEL_LEN)
+            .map(|s| *s != Springs::default())
+            .collect();
+        ContactList {
+            start,
+            partner,
+            springs,
+            touched,
+        }
+    }
+}
+
+/// Runs collected as `[length, partners...]` blocks, `n` of them in owner order, in
+/// compressed form.
+fn runs_to_csr(n: usize, runs: Vec<Vec<u32>>) -> (Vec<u32>, Vec<u32>) {
+    let total = runs.iter().map(Vec::len).sum::<usize>() - n;
+    let mut start = Vec::with_capacity(n + 1);
+    let mut partner = Vec::with_capacity(total);
+    start.push(0u32);
+    for block in runs {
+        let mut k = 0;
+        while k < block.len() {
+            let len = block[k] as usize;
+            partner.extend_from_slice(&block[k + 1..k + 1 + len]);
+            start.push(partner.len() as u32);
+            k += 1 + len;
+        }
+    }
+    debug_assert_eq!(start.len(), n + 1);
+    (start, partner)
+}
+
+/// Compressed form of `(owner, partner)` pairs: a counting sort by owner that keeps the
+/// order of each owner's partners.
+fn compress(n: usize, pairs: impl Iterator<Item = (u32, u32)> + Clone) -> (Vec<u32>, Vec<u32>) {
+    let mut start = vec![0u32; n + 1];
+    for (i, _) in pairs.clone() {
+        start[i as usize + 1] += 1;
+    }
+    for k in 0..n {
+        start[k + 1] += start[k];
+    }
+    let mut fill = start.clone();
+    let mut partner = vec![0u32; start[n] as usize];
+    for (i, j) in pairs {
+        partner[fill[i as usize] as usize] = j;
+        fill[i as usize] += 1;
+    }
+    (start, partner)
 }
 
 /// The smallest gap between a particle at `x` of radius `r` and the faces (brute force).
@@ -676,14 +826,41 @@ mod tests {
         assert!(seen > 100, "{seen}");
     }
 
-    /// The listed particle pairs, as (owner, partner).
-    fn listed(nb: &Neighbours) -> Vec<(u32, u32)> {
-        let p = &nb.pairs;
-        p.owner
-            .iter()
-            .copied()
-            .zip(p.partner.iter().copied())
+    /// Particles at `x` with radii `radius` (ids in that order).
+    fn particles(x: &[DVec3], radius: &[f64]) -> Particles {
+        x.iter()
+            .zip(radius)
+            .map(|(&x, &radius)| crate::particles::Particle {
+                x,
+                radius,
+                v: DVec3::ZERO,
+                q: glam::DQuat::IDENTITY,
+                w: DVec3::ZERO,
+                tag: 0,
+            })
             .collect()
+    }
+
+    /// The listed particle pairs by id, (lower, higher), sorted; and a check that every
+    /// owner's partners follow it, in order, within the next slab.
+    fn listed(nb: &Neighbours, p: &Particles) -> Vec<(u32, u32)> {
+        let list = &nb.pairs;
+        let mut pairs = Vec::new();
+        let slabs = &nb.slabs;
+        for s in 0..slabs.len() - 1 {
+            let limit = slabs.get(s + 2).copied().unwrap_or(slabs[slabs.len() - 1]);
+            for i in slabs[s] as usize..slabs[s + 1] as usize {
+                let run = &list.partner[list.run(i)];
+                assert!(run.windows(2).all(|w| w[0] < w[1]), "{run:?}");
+                for &j in run {
+                    assert!(j as usize > i && j < limit, "{i} {j} slabs {slabs:?}");
+                    let (a, b) = (p.id[i], p.id[j as usize]);
+                    pairs.push((a.min(b), a.max(b)));
+                }
+            }
+        }
+        pairs.sort_unstable();
+        pairs
     }
 
     /// Brute-force pairs within reach, as (i, j) with i < j.
@@ -714,12 +891,13 @@ mod tests {
             .map(|i| if i % 101 == 0 { 0.02 } else { 0.002 })
             .collect();
         let mut nb = Neighbours::new(0.001);
-        nb.rebuild(&x, &radius, &[], &CellGrid::default());
-        assert_eq!(listed(&nb), brute(&x, &radius, 0.001));
+        let mut p = particles(&x, &radius);
+        nb.rebuild(&mut p, &[], &CellGrid::default());
+        assert_eq!(listed(&nb, &p), brute(&x, &radius, 0.001));
     }
 
     #[test]
-    fn lists_every_pair_within_reach_once() {
+    fn lists_every_pair_within_reach_once_in_spatial_order() {
         // A small lattice with jitter; compare with brute force.
         let mut x = Vec::new();
         let mut s = 7u64;
@@ -734,25 +912,66 @@ mod tests {
             .map(|i| 0.005 + 0.001 * (i % 3) as f64)
             .collect();
         let mut nb = Neighbours::new(0.002);
-        nb.rebuild(&x, &radius, &[], &CellGrid::default());
-        let brute = brute(&x, &radius, 0.002);
-        assert_eq!(listed(&nb), brute);
-        // The reverse index names every slot once, under its partner.
-        for j in 0..x.len() {
-            for &slot in
-                &nb.reverse_slot[nb.reverse_start[j] as usize..nb.reverse_start[j + 1] as usize]
-            {
-                assert_eq!(nb.pairs.partner[slot as usize] as usize, j);
+        let mut p = particles(&x, &radius);
+        nb.rebuild(&mut p, &[], &CellGrid::default());
+        assert_eq!(listed(&nb, &p), brute(&x, &radius, 0.002));
+        // The particles are stored in the order of their cells, each one unchanged.
+        let h = 2.0 * 0.007 + 0.002;
+        let keys: Vec<u64> = p.x.iter().map(|&x| key(cell_of(x, 1.0 / h))).collect();
+        assert!(keys.is_sorted());
+        for k in 0..p.len() {
+            assert_eq!(p.x[k], x[p.id[k] as usize]);
+        }
+        assert!(nb.slabs.len() > 3, "{:?}", nb.slabs);
+    }
+
+    #[test]
+    fn springs_follow_their_pairs_through_a_re_sort() {
+        let x = vec![
+            DVec3::new(0.5, 0.0, 0.0),
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(0.009, 0.0, 0.0),
+            DVec3::new(0.509, 0.0, 0.0),
+        ];
+        let radius = vec![0.005; 4];
+        let mut p = particles(&x, &radius);
+        let mut nb = Neighbours::new(0.002);
+        nb.rebuild(&mut p, &[], &CellGrid::default());
+        assert_eq!(listed(&nb, &p), vec![(0, 3), (1, 2)]);
+        // Give each pair springs that name it, then move the pairs past each other.
+        for i in 0..p.len() {
+            for k in nb.pairs.run(i) {
+                let id = p.id[i].min(p.id[nb.pairs.partner[k] as usize]);
+                nb.pairs.springs[k].u_t = id as f64 + 1.0;
+                nb.pairs.touched[k] = true;
             }
         }
-        assert_eq!(nb.reverse_slot.len(), brute.len());
+        for x in &mut p.x {
+            x.x = 1.0 - x.x;
+        }
+        nb.rebuild(&mut p, &[], &CellGrid::default());
+        assert_eq!(p.id, vec![3, 0, 2, 1]);
+        let pairs = nb.history(&p.id, 4).pairs;
+        assert_eq!(
+            pairs
+                .entries()
+                .iter()
+                .map(|e| (e.0, e.1, e.2.u_t))
+                .collect::<Vec<_>>(),
+            vec![(0, 3, 1.0), (1, 2, 2.0)]
+        );
+    }
+
+    /// The storage index of the particle with id `id`.
+    fn at(p: &Particles, id: u32) -> usize {
+        p.id.iter().position(|&i| i == id).expect("present")
     }
 
     #[test]
     fn a_lonely_particle_may_move_half_its_clearance() {
         // A particle 0.5 m from a small cluster falls towards it in 1 mm steps.
         let radius = vec![0.01; 4];
-        let mut x = vec![
+        let x = vec![
             DVec3::new(0.0, 0.0, 0.5),
             DVec3::new(0.0, 0.0, 0.0),
             DVec3::new(0.02, 0.0, 0.0),
@@ -760,22 +979,24 @@ mod tests {
         ];
         let skin = 0.005;
         let mut nb = Neighbours::new(skin);
-        nb.rebuild(&x, &radius, &[], &CellGrid::default());
+        let mut p = particles(&x, &radius);
+        nb.rebuild(&mut p, &[], &CellGrid::default());
         assert_eq!(nb.lonely.len(), 1, "{:?}", nb.lonely);
         let mut rebuilds = 0;
-        while x[0].z > 0.015 {
-            x[0].z -= 0.001;
-            if nb.stale(&x, &radius, &[], 0.0) {
-                nb.rebuild(&x, &radius, &[], &CellGrid::default());
+        while p.x[at(&p, 0)].z > 0.015 {
+            let k = at(&p, 0);
+            p.x[k].z -= 0.001;
+            if nb.stale(&p.x, &p.radius, &[], 0.0) {
+                nb.rebuild(&mut p, &[], &CellGrid::default());
                 rebuilds += 1;
             }
             // Whatever touches is listed.
-            if x[0].distance(x[1]) < 0.02 {
-                assert_eq!(
-                    &nb.pairs.partner[..1],
-                    &[1],
+            let (a, b) = (at(&p, 0), at(&p, 1));
+            if p.x[a].distance(p.x[b]) < 0.02 {
+                assert!(
+                    listed(&nb, &p).contains(&(0, 1)),
                     "contact missed at z = {}",
-                    x[0].z
+                    p.x[a].z
                 );
             }
         }
@@ -783,31 +1004,39 @@ mod tests {
         assert!(rebuilds < 20, "{rebuilds} rebuilds");
         // An ordinary particle still triggers a rebuild after skin / 2.
         let mut nb = Neighbours::new(skin);
-        nb.rebuild(&x, &radius, &[], &CellGrid::default());
-        x[2].x += 0.6 * skin;
-        assert!(nb.stale(&x, &radius, &[], 0.0));
+        nb.rebuild(&mut p, &[], &CellGrid::default());
+        let k = at(&p, 2);
+        p.x[k].x += 0.6 * skin;
+        assert!(nb.stale(&p.x, &p.radius, &[], 0.0));
     }
 
     #[test]
     fn two_lonely_particles_meeting_head_on_are_listed_before_they_touch() {
         let radius = vec![0.01; 2];
-        let mut x = vec![DVec3::new(-0.5, 0.0, 0.0), DVec3::new(0.5, 0.0, 0.0)];
+        let x = vec![DVec3::new(-0.5, 0.0, 0.0), DVec3::new(0.5, 0.0, 0.0)];
         let mut nb = Neighbours::new(0.005);
-        nb.rebuild(&x, &radius, &[], &CellGrid::default());
+        let mut p = particles(&x, &radius);
+        nb.rebuild(&mut p, &[], &CellGrid::default());
         assert_eq!(nb.lonely.len(), 2);
         let mut rebuilds = 0;
         for _ in 0..600 {
-            x[0].x += 0.001;
-            x[1].x -= 0.0013;
-            if nb.stale(&x, &radius, &[], 0.0) {
-                nb.rebuild(&x, &radius, &[], &CellGrid::default());
+            let (a, b) = (at(&p, 0), at(&p, 1));
+            p.x[a].x += 0.001;
+            p.x[b].x -= 0.0013;
+            if nb.stale(&p.x, &p.radius, &[], 0.0) {
+                nb.rebuild(&mut p, &[], &CellGrid::default());
                 rebuilds += 1;
             }
-            if x[0].distance(x[1]) < 0.02 {
-                assert_eq!(nb.pairs.partner, vec![1], "contact missed at {:?}", x);
+            let (a, b) = (at(&p, 0), at(&p, 1));
+            if p.x[a].distance(p.x[b]) < 0.02 {
+                assert_eq!(listed(&nb, &p), vec![(0, 1)], "contact missed at {:?}", p.x);
             }
         }
-        assert!(x[0].x > x[1].x, "they passed through each other's place");
+        let (a, b) = (at(&p, 0), at(&p, 1));
+        assert!(
+            p.x[a].x > p.x[b].x,
+            "they passed through each other's place"
+        );
         assert!(rebuilds < 150, "{rebuilds} rebuilds");
     }
 }

@@ -1,11 +1,19 @@
-//! Particle storage (paper Table 3), struct-of-arrays, in creation order.
+//! Particle storage (paper Table 3), struct-of-arrays.
+//!
+//! A particle's identity is its id, given at creation (0, 1, 2, ... in creation order) and
+//! never reused; frames, checkpoints and messages speak in ids and list particles in id
+//! order. The storage index of a particle is where its state lives now, which the
+//! simulation may change (it keeps particles in spatial order).
 
 use glam::{DQuat, DVec3};
 
-/// The state of every particle. Index `i` is the particle's identity: particles keep their
-/// creation order, which is also their order in every output frame.
+/// The state of every particle.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Particles {
+    /// The id of the particle stored at each index.
+    pub id: Vec<u32>,
+    /// The id the next particle created gets.
+    pub next_id: u32,
     /// R [L]
     pub radius: Vec<f64>,
     /// x [L]
@@ -41,7 +49,10 @@ impl Particles {
         self.x.is_empty()
     }
 
+    /// Adds a particle with the next id.
     pub fn push(&mut self, p: Particle) {
+        self.id.push(self.next_id);
+        self.next_id += 1;
         self.radius.push(p.radius);
         self.x.push(p.x);
         self.v.push(p.v);
@@ -61,8 +72,44 @@ impl Particles {
         }
     }
 
+    /// The particles in storage order.
     pub fn iter(&self) -> impl Iterator<Item = Particle> + '_ {
         (0..self.len()).map(|i| self.get(i))
+    }
+
+    /// Puts the particle stored at `order[k]` at index `k`, for every `k`.
+    pub fn permute(&mut self, order: &[u32]) {
+        use rayon::prelude::*;
+        fn gather<T: Copy + Send + Sync>(v: &mut Vec<T>, order: &[u32]) {
+            *v = order
+                .par_iter()
+                .with_min_len(1024)
+                .map(|&i| v[i as usize])
+                .collect();
+        }
+        gather(&mut self.id, order);
+        gather(&mut self.radius, order);
+        gather(&mut self.x, order);
+        gather(&mut self.v, order);
+        gather(&mut self.q, order);
+        gather(&mut self.w, order);
+        gather(&mut self.tag, order);
+    }
+
+    /// The storage indices in id order.
+    pub fn id_order(&self) -> Vec<usize> {
+        let mut order: Vec<usize> = (0..self.len()).collect();
+        if !self.id.is_sorted() {
+            order.sort_unstable_by_key(|&i| self.id[i]);
+        }
+        order
+    }
+
+    /// The particles in id order, with their ids.
+    pub fn iter_by_id(&self) -> impl Iterator<Item = (u32, Particle)> + '_ {
+        self.id_order()
+            .into_iter()
+            .map(|i| (self.id[i], self.get(i)))
     }
 
     /// Whether any particle carries a tag.

@@ -12,12 +12,14 @@ use anyhow::{Result, bail};
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::contact::{Body, ContactForce, ContactLaw, Kinematics, Other, Springs};
+use crate::contact::{Body, ContactLaw, Kinematics, Other, Springs};
 use crate::integrate::{Inertia, Response, State, advance};
 use crate::lanes::{Gather, Lanes};
 use crate::mesh::{Contacts, Face, Mesh};
 use crate::motion::{Motion, Pose, RigidVelocity};
-use crate::neighbours::{CellGrid, ContactList, MIN_PARALLEL_LEN, Neighbours, face_grid};
+use crate::neighbours::{
+    CellGrid, ContactList, Histories, History, MIN_PARALLEL_LEN, Neighbours, face_grid,
+};
 use crate::particles::Particles;
 use crate::scenario::{MeshSource, Scenario, default_timestep};
 use crate::spawn::{Spawner, SpawnerState};
@@ -30,49 +32,33 @@ const PIECE: usize = 256;
 const WIDTH: usize = 8;
 type Group = wide::f64x8;
 
-/// A piece of a contact list (`PIECE` slots): the forces, springs, touched flags, owners
-/// and partners of its slots.
-type Piece<'a> = (
-    &'a mut [ContactForce],
-    &'a mut [Springs],
-    &'a mut [bool],
-    &'a [u32],
-    &'a [u32],
-);
-
-/// The pieces of `list` and its slots' `forces`, for the contact stages to run in parallel.
-fn pieces<'a>(
-    forces: &'a mut [ContactForce],
-    list: &'a mut ContactList,
-) -> impl IndexedParallelIterator<Item = Piece<'a>> {
-    forces
-        .par_chunks_mut(PIECE)
-        .zip(list.springs.par_chunks_mut(PIECE))
-        .zip(list.touched.par_chunks_mut(PIECE))
-        .zip(
-            list.owner
-                .par_chunks(PIECE)
-                .zip(list.partner.par_chunks(PIECE)),
-        )
-        .map(|(((forces, springs), touched), (owner, partner))| {
-            (forces, springs, touched, owner, partner)
-        })
-        .with_min_len(MIN_PARALLEL_LEN.div_ceil(PIECE))
+/// Force and torque on one particle, summed over its contacts during a step (Eqs. 1-2).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Load {
+    f: DVec3,
+    tau: DVec3,
 }
 
-/// Boundaries of pieces of at least `PIECE` slots (the last may be shorter) that keep each
-/// owner's run of slots whole; `start` is a compressed list's run starts.
-fn owner_aligned_bounds(start: &[u32]) -> Vec<usize> {
+impl Load {
+    #[inline(always)]
+    fn add(&mut self, f: DVec3, tau: DVec3) {
+        self.f += f;
+        self.tau += tau;
+    }
+}
+
+/// Owner bounds of pieces of at least `PIECE` slots of a list with run starts `start` (the
+/// last piece may be shorter): every owner's slots lie in one piece.
+fn owner_pieces(start: &[u32]) -> Vec<usize> {
     let mut bounds = vec![0];
-    for &k in start {
-        let k = k as usize;
-        if k - bounds[bounds.len() - 1] >= PIECE {
-            bounds.push(k);
+    let owners = start.len().saturating_sub(1);
+    for i in 1..owners {
+        if (start[i] - start[bounds[bounds.len() - 1]]) as usize >= PIECE {
+            bounds.push(i);
         }
     }
-    let end = start.last().map_or(0, |&k| k as usize);
-    if end > bounds[bounds.len() - 1] {
-        bounds.push(end);
+    if owners > 0 {
+        bounds.push(owners);
     }
     bounds
 }
@@ -89,43 +75,53 @@ fn cut<'a, T>(mut slice: &'a mut [T], bounds: &[usize]) -> Vec<&'a mut [T]> {
         .collect()
 }
 
-/// The pieces of `list` cut at `bounds` (see [`owner_aligned_bounds`]), with its slots'
-/// `forces`: every owner's slots lie in one piece.
-fn owner_pieces<'a>(
-    forces: &'a mut [ContactForce],
-    list: &'a mut ContactList,
+/// A piece of owners `owners` of a contact list: their loads, and the springs and touched
+/// flags of their slots (which start at slot `first`).
+struct Piece<'a> {
+    owners: std::ops::Range<usize>,
+    first: usize,
+    loads: &'a mut [Load],
+    springs: &'a mut [Springs],
+    touched: &'a mut [bool],
+}
+
+/// The pieces of owners cut at `bounds`, with their `loads` and the `springs` and `touched`
+/// flags of their slots in a list with run starts `start`.
+fn pieces<'a>(
     bounds: &[usize],
-) -> impl IndexedParallelIterator<Item = Piece<'a>> {
-    let mut owner: &[u32] = &list.owner;
-    let mut partner: &[u32] = &list.partner;
-    let fixed: Vec<(&[u32], &[u32])> = bounds
-        .windows(2)
-        .map(|w| {
-            let n = w[1] - w[0];
-            let (o, rest_o) = owner.split_at(n);
-            let (p, rest_p) = partner.split_at(n);
-            (owner, partner) = (rest_o, rest_p);
-            (o, p)
+    loads: &'a mut [Load],
+    start: &[u32],
+    springs: &'a mut [Springs],
+    touched: &'a mut [bool],
+) -> Vec<Piece<'a>> {
+    let slots: Vec<usize> = bounds.iter().map(|&o| start[o] as usize).collect();
+    cut(loads, bounds)
+        .into_iter()
+        .zip(cut(springs, &slots))
+        .zip(cut(touched, &slots))
+        .enumerate()
+        .map(|(k, ((loads, springs), touched))| Piece {
+            owners: bounds[k]..bounds[k + 1],
+            first: slots[k],
+            loads,
+            springs,
+            touched,
         })
-        .collect();
-    cut(forces, bounds)
-        .into_par_iter()
-        .zip(cut(&mut list.springs, bounds))
-        .zip(cut(&mut list.touched, bounds))
-        .zip(fixed)
-        .map(|(((forces, springs), touched), (owner, partner))| {
-            (forces, springs, touched, owner, partner)
-        })
-        .with_min_len(MIN_PARALLEL_LEN.div_ceil(PIECE))
+        .collect()
 }
 
 /// The springs of slots `k` in the lanes of a group.
 #[inline(always)]
 fn gather_springs(springs: &[Springs], k: [usize; WIDTH]) -> Springs<Group> {
+    let (mut u_s, mut u_r, mut u_t) = ([DVec3::ZERO; WIDTH], [DVec3::ZERO; WIDTH], [0.0; WIDTH]);
+    for l in 0..WIDTH {
+        let s = &springs[k[l]];
+        (u_s[l], u_r[l], u_t[l]) = (s.u_s, s.u_r, s.u_t);
+    }
     Springs {
-        u_s: Group::gather_vec(k.map(|k| springs[k].u_s)),
-        u_r: Group::gather_vec(k.map(|k| springs[k].u_r)),
-        u_t: Group::gather(k.map(|k| springs[k].u_t)),
+        u_s: Group::gather_vec(u_s),
+        u_r: Group::gather_vec(u_r),
+        u_t: Group::gather(u_t),
     }
 }
 
@@ -146,26 +142,10 @@ fn scatter_springs(lanes: Springs<Group>, springs: &mut [Springs], k: &[usize]) 
     }
 }
 
-/// Puts the forces of a group's lanes into slots `k` (the first `k.len()` lanes).
-#[inline(always)]
-fn scatter_forces(lanes: ContactForce<Group>, forces: &mut [ContactForce], k: &[usize]) {
-    let (f, tau_i, tau_j) = (
-        Group::scatter_vec(lanes.f),
-        Group::scatter_vec(lanes.tau_i),
-        Group::scatter_vec(lanes.tau_j),
-    );
-    for (l, &k) in k.iter().enumerate() {
-        forces[k] = ContactForce {
-            f: f[l],
-            tau_i: tau_i[l],
-            tau_j: tau_j[l],
-        };
-    }
-}
-
 /// A face within reach of a particle, in stage 4.
 struct Near {
-    /// Its slot in the particle-face list.
+    /// The particle, and the face's slot in the piece of the particle-face list.
+    owner: u32,
     slot: usize,
     kin: Kinematics,
     /// Separation x - p_F and whether p_F counts as inside the face (see `surface::snap`).
@@ -252,14 +232,20 @@ impl StageTimes {
 /// Verlet skin as a fraction of R_max.
 const SKIN_PER_RADIUS: f64 = 0.5;
 
-/// Everything needed to continue a run bit for bit: particles, step count, the spawner's
-/// place in its random stream, and the contact history (the friction springs of every
-/// touching pair, Table 3).
+/// Everything needed to continue a run bit for bit: particles (in storage order, with their
+/// ids), step count, the spawner's place in its random stream, the contact history (the
+/// friction springs of every touching pair, Table 3, by particle id), and what rebuilds the
+/// neighbour lists of the last rebuild exactly: its step, the positions it anchored the
+/// particles at and its lonely particles.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Snapshot {
     pub steps: u64,
+    pub built_at: u64,
     pub particles: Particles,
     pub spawner: SpawnerState,
+    pub anchors: Vec<DVec3>,
+    pub lonely: Vec<(u32, f64)>,
+    /// Particle pairs by (lower id, higher id) and particle-face contacts by (id, face).
     pub pair_history: Vec<(u32, u32, Springs)>,
     pub face_history: Vec<(u32, u32, Springs)>,
 }
@@ -288,22 +274,36 @@ impl Deep {
         self.delta > 2.0 * self.limit
     }
 
-    /// "particles 1 and 2 overlap by ..., more than the smaller radius ..." (or diameter).
-    fn describe(&self) -> String {
+    /// "particles 1 and 2 overlap by ..., more than the smaller radius ..." (or diameter),
+    /// naming the particles by their `ids`.
+    fn describe(&self, ids: &[u32]) -> String {
         let (bound, size) = if self.through() {
             ("diameter", 2.0 * self.limit)
         } else {
             ("radius", self.limit)
         };
+        let i = ids[self.i];
         match self.other {
-            Partner::Particle(j) => format!(
-                "particles {} and {j} overlap by {:.3e} m, more than the smaller {bound} {size:.3e} m",
-                self.i, self.delta
-            ),
+            Partner::Particle(j) => {
+                let (a, b) = (i.min(ids[j]), i.max(ids[j]));
+                format!(
+                    "particles {a} and {b} overlap by {:.3e} m, more than the smaller {bound} {size:.3e} m",
+                    self.delta
+                )
+            }
             Partner::Face(f) => format!(
-                "particle {} overlaps mesh face {f} by {:.3e} m, more than its {bound} {size:.3e} m",
-                self.i, self.delta
+                "particle {i} overlaps mesh face {f} by {:.3e} m, more than its {bound} {size:.3e} m",
+                self.delta
             ),
+        }
+    }
+
+    /// The pair in ids, the same whatever the storage order.
+    fn key(&self, ids: &[u32]) -> (u32, Partner) {
+        let i = ids[self.i];
+        match self.other {
+            Partner::Particle(j) => (i.min(ids[j]), Partner::Particle(i.max(ids[j]) as usize)),
+            face => (i, face),
         }
     }
 }
@@ -312,7 +312,8 @@ impl Deep {
 /// once.
 #[derive(Clone, Debug, Default)]
 pub struct Warnings {
-    seen: rustc_hash::FxHashSet<(usize, Partner)>,
+    /// Pairs by id: the particle (the lower id of a particle pair) and its partner.
+    seen: rustc_hash::FxHashSet<(u32, Partner)>,
     /// Descriptions of the pairs seen for the first time since the last
     /// [`Simulation::take_new_warnings`], with their step.
     fresh: Vec<String>,
@@ -386,10 +387,10 @@ pub struct Simulation {
     neighbours: Neighbours,
     face_grid: CellGrid,
     spawner: Spawner,
-    /// Force of each particle pair slot and each particle-face slot, this step.
-    pair_forces: Vec<ContactForce>,
-    face_forces: Vec<ContactForce>,
-    /// Pieces of the particle-face list for stage 4, each holding whole runs of owners.
+    /// Force and torque on each particle (storage order), summed by stages 3 and 4 and used
+    /// up by stage 5.
+    loads: Vec<Load>,
+    /// Owner bounds of the pieces of the particle-face list for stage 4.
     face_pieces: Vec<usize>,
     /// The mesh as read (at t = 0).
     rest_faces: Vec<Face>,
@@ -399,6 +400,8 @@ pub struct Simulation {
     face_part: Vec<u32>,
     /// Largest displacement of a moving face since the last neighbour-list rebuild.
     mesh_drift: f64,
+    /// Step of the last neighbour-list rebuild.
+    built_at: u64,
     /// Simulated time [T] and number of steps taken.
     pub time: f64,
     pub steps: u64,
@@ -475,28 +478,70 @@ impl Simulation {
             particles: None,
             ..scenario
         })?;
+        let misfit = |what: String| anyhow::anyhow!("the checkpoint does not fit: {what}");
+        let built = !snapshot.anchors.is_empty();
+        if built && snapshot.anchors.len() != snapshot.particles.len() {
+            return Err(misfit("one anchor per particle".into()));
+        }
         sim.particles = snapshot.particles;
-        sim.steps = snapshot.steps;
-        sim.time = sim.steps as f64 * sim.scenario.simulation.timestep;
         sim.spawner = Spawner::resume(sim.scenario.simulation.seed, snapshot.spawner);
+        let ids = sim.particles.next_id as usize;
+        let history = Histories {
+            pairs: History::new(ids, &snapshot.pair_history).map_err(misfit)?,
+            faces: History::new(ids, &snapshot.face_history).map_err(misfit)?,
+        };
+        if let Some(&(_, f, _)) = snapshot
+            .face_history
+            .iter()
+            .find(|e| e.1 as usize >= sim.mesh.faces.len())
+        {
+            return Err(misfit(format!(
+                "contact with face {f}, which the mesh lacks"
+            )));
+        }
+        let dt = sim.scenario.simulation.timestep;
+        if !built {
+            // Taken before the first step: the lists are made as that step would make them.
+            sim.steps = snapshot.steps;
+            sim.time = sim.steps as f64 * dt;
+            sim.move_meshes();
+            sim.neighbours = Neighbours::new(sim.neighbours.skin);
+            return Ok(sim);
+        }
+        // The lists of the last rebuild, built again with the mesh where it was then.
+        sim.steps = snapshot.built_at;
+        sim.time = sim.steps as f64 * dt;
         sim.move_meshes();
-        sim.rebuild_lists(true);
-        sim.neighbours
-            .pairs
-            .restore(&snapshot.pair_history)
-            .and_then(|()| sim.neighbours.faces.restore(&snapshot.face_history))
-            .map_err(|e| anyhow::anyhow!("the checkpoint does not fit its particles: {e}"))?;
+        sim.regrid_faces();
+        sim.neighbours.restore(
+            &sim.particles,
+            snapshot.anchors,
+            snapshot.lonely,
+            &sim.mesh.faces,
+            &sim.face_grid,
+            &history,
+        );
+        sim.built();
+        sim.steps = snapshot.steps;
+        sim.time = sim.steps as f64 * dt;
+        sim.move_meshes();
         Ok(sim)
     }
 
     /// The complete state of the run.
     pub fn snapshot(&self) -> Snapshot {
+        let p = &self.particles;
+        let history = self.neighbours.history(&p.id, p.next_id as usize);
+        let (anchors, lonely) = self.neighbours.anchors();
         Snapshot {
             steps: self.steps,
-            particles: self.particles.clone(),
+            built_at: self.built_at,
+            particles: p.clone(),
             spawner: self.spawner.state(),
-            pair_history: self.neighbours.pairs.history(),
-            face_history: self.neighbours.faces.history(),
+            anchors: anchors.to_vec(),
+            lonely: lonely.to_vec(),
+            pair_history: history.pairs.entries(),
+            face_history: history.faces.entries(),
         }
     }
 
@@ -514,13 +559,13 @@ impl Simulation {
             neighbours: Neighbours::new(skin),
             face_grid,
             spawner: Spawner::new(scenario.simulation.seed),
-            pair_forces: Vec::new(),
-            face_forces: Vec::new(),
+            loads: Vec::new(),
             face_pieces: vec![0],
             rest_faces: mesh.faces.clone(),
             moving: Vec::new(),
             face_part: vec![STATIC; mesh.faces.len()],
             mesh_drift: 0.0,
+            built_at: 0,
             time: 0.0,
             steps: 0,
             stage_times: StageTimes::default(),
@@ -551,9 +596,9 @@ impl Simulation {
 
     /// Number of particle-particle and particle-face contacts in the last step.
     pub fn contact_count(&self) -> usize {
-        let touching = |f: &ContactForce| *f != ContactForce::default();
-        self.pair_forces.iter().filter(|f| touching(f)).count()
-            + self.face_forces.iter().filter(|f| touching(f)).count()
+        let nb = &self.neighbours;
+        let touching = |t: &[bool]| t.iter().filter(|&&t| t).count();
+        touching(&nb.pairs.touched) + touching(&nb.faces.touched)
     }
 
     /// Advances the simulation by one time step Δt.
@@ -584,6 +629,7 @@ impl Simulation {
     }
 
     /// Stage 5b: particles whose centre is inside a `[[tags]]` box take its tag.
+    #[inline(never)] // a stage of its own in profiles
     fn tag(&mut self) {
         let regions = &self.scenario.tags;
         if regions.is_empty() {
@@ -613,31 +659,32 @@ impl Simulation {
     /// lists the overlaps deeper than the smaller radius found in this step's contact
     /// stages; those within the diameter are a legitimate transient of a crowded packing
     /// (a small grain squeezed by a large one) and only warned of, once per pair.
+    #[inline(never)] // a stage of its own in profiles
     fn check_stability(&mut self, mut deep: Vec<Deep>, bad: bool) -> Result<(), Unstable> {
         let p = &self.particles;
         let non_finite =
             |k: usize| !(p.x[k].is_finite() && p.v[k].is_finite() && p.w[k].is_finite());
         if !bad && deep.iter().all(|d| !d.through()) {
             for d in deep {
-                if self.warnings.seen.insert((d.i, d.other)) {
+                if self.warnings.seen.insert(d.key(&p.id)) {
                     self.warnings
                         .fresh
-                        .push(format!("step {}: {}", self.steps, d.describe()));
+                        .push(format!("step {}: {}", self.steps, d.describe(&p.id)));
                 }
             }
             return Ok(());
         }
         let mut what = Vec::new();
-        for k in (0..p.len()).filter(|&k| non_finite(k)).take(5) {
+        for k in p.id_order().into_iter().filter(|&k| non_finite(k)).take(5) {
             what.push(format!(
-                "particle {k} has a non-finite state (x = {}, v = {}, w = {})",
-                p.x[k], p.v[k], p.w[k]
+                "particle {} has a non-finite state (x = {}, v = {}, w = {})",
+                p.id[k], p.x[k], p.v[k], p.w[k]
             ));
         }
         deep.retain(Deep::through);
-        deep.sort_by_key(|d| (d.i, d.other));
+        deep.sort_by_key(|d| d.key(&p.id));
         for d in deep.iter().take(5 - what.len().min(5)) {
-            what.push(d.describe());
+            what.push(d.describe(&p.id));
         }
         Err(Unstable {
             step: self.steps,
@@ -728,6 +775,7 @@ impl Simulation {
     }
 
     /// Stage 1 (Section 3.1): new particles in the spawn box.
+    #[inline(never)] // a stage of its own in profiles
     fn spawn(&mut self) {
         let s = &self.scenario;
         if self.particles.len() < s.simulation.max_particles as usize {
@@ -737,6 +785,7 @@ impl Simulation {
     }
 
     /// Stage 2 (Section 3.3): rebuild the Verlet lists when they may miss a contact.
+    #[inline(never)] // a stage of its own in profiles
     fn update_neighbours(&mut self) {
         let p = &self.particles;
         if self
@@ -747,101 +796,174 @@ impl Simulation {
         }
     }
 
-    /// Rebuilds the Verlet lists, re-binning the faces first if `regrid_faces` (they moved,
-    /// or larger particles appeared).
+    /// Rebuilds the Verlet lists (re-sorting the particles into spatial order), re-binning
+    /// the faces first if `regrid_faces` (they moved, or larger particles appeared).
     fn rebuild_lists(&mut self, regrid_faces: bool) {
         if regrid_faces {
-            let g = &self.scenario.geometry;
-            let max_radius = g.radius_max.max(self.particles.max_radius());
-            self.face_grid = face_grid(&self.mesh.faces, max_radius, self.neighbours.skin);
+            self.regrid_faces();
         }
-        let p = &self.particles;
         self.neighbours
-            .rebuild(&p.x, &p.radius, &self.mesh.faces, &self.face_grid);
-        // The new slots' forces are zero until their pairs touch; stages 3 and 4 then write
-        // a slot's force while it touches and zero it once when it stops.
-        let zero = ContactForce::default();
-        self.pair_forces.clear();
-        self.pair_forces.resize(self.neighbours.pairs.slots(), zero);
-        self.face_forces.clear();
-        self.face_forces.resize(self.neighbours.faces.slots(), zero);
-        self.face_pieces = owner_aligned_bounds(&self.neighbours.faces.start);
+            .rebuild(&mut self.particles, &self.mesh.faces, &self.face_grid);
+        self.built();
+    }
+
+    /// Bins the faces as they are now for particles up to the largest radius.
+    fn regrid_faces(&mut self) {
+        let g = &self.scenario.geometry;
+        let max_radius = g.radius_max.max(self.particles.max_radius());
+        self.face_grid = face_grid(&self.mesh.faces, max_radius, self.neighbours.skin);
+    }
+
+    /// After a rebuild: loads for the particles, pieces of the face list, and the mesh pose
+    /// the lists were built with.
+    fn built(&mut self) {
+        self.loads.clear();
+        self.loads.resize(self.particles.len(), Load::default());
+        self.face_pieces = owner_pieces(&self.neighbours.faces.start);
+        self.built_at = self.steps;
         self.mark_mesh_built();
     }
 
-    /// Stage 3 (Section 2.2): the force of every touching particle pair, once per pair.
-    /// Returns the overlaps deeper than the smaller radius (a sign of instability).
+    /// Stage 3 (Section 2.2): the force of every touching particle pair, once per pair,
+    /// added to the loads of both particles (with the reactions of Eqs. 56-60). Returns the
+    /// overlaps deeper than the smaller radius.
     ///
-    /// Each piece of the list first sorts its pairs into touching and apart (a pair that
-    /// has just parted forgets its springs and force), then evaluates the touching ones
-    /// `WIDTH` at a time in SIMD lanes; a lane gives the bits the pair would give alone, so
-    /// neither the pieces nor the grouping change a result.
+    /// The owners are cut into slabs whose partners lie at most in the next slab
+    /// (`Neighbours::slabs`): the even slabs run at the same time, then the odd ones, so a
+    /// load is added to by one slab at a time, in an order that does not depend on the
+    /// number of threads. Each slab first sorts out its touching pairs (a pair that has just
+    /// parted forgets its springs), then evaluates them `WIDTH` at a time in SIMD lanes; a
+    /// lane gives the bits the pair would give alone. Body i of a pair is the particle of
+    /// the lower id, so a pair's force and springs do not depend on the storage order.
+    #[inline(never)] // a stage of its own in profiles
     fn particle_contacts(&mut self) -> Vec<Deep> {
         let deep = Mutex::new(Vec::new());
         let p = &self.particles;
         let law = &self.law;
         let density = self.scenario.material.density;
-        let list = &mut self.neighbours.pairs;
-        pieces(&mut self.pair_forces, list).for_each(
-            |(forces, springs, touched, owner, partner)| {
-                let mut touching = [0u16; PIECE];
-                let mut count = 0;
-                for (k, (&i, &j)) in owner.iter().zip(partner).enumerate() {
-                    let (i, j) = (i as usize, j as usize);
-                    let reach = p.radius[i] + p.radius[j];
-                    if (p.x[i] - p.x[j]).length_squared() < reach * reach {
-                        touching[count] = k as u16;
-                        count += 1;
-                        touched[k] = true;
-                    } else if touched[k] {
-                        // The contact ended: forget its history and its force.
-                        springs[k] = Springs::default();
-                        forces[k] = ContactForce::default();
-                        touched[k] = false;
-                    }
-                }
-                for group in touching[..count].chunks(WIDTH) {
-                    // A short last group repeats its last pair in the spare lanes.
-                    let k: [usize; WIDTH] =
-                        std::array::from_fn(|l| group[l.min(group.len() - 1)] as usize);
-                    let i = k.map(|k| owner[k] as usize);
-                    let j = k.map(|k| partner[k] as usize);
-                    let body = |idx: [usize; WIDTH]| Body::<Group> {
-                        x: Group::gather_vec(idx.map(|i| p.x[i])),
-                        radius: Group::gather(idx.map(|i| p.radius[i])),
-                        v: Group::gather_vec(idx.map(|i| p.v[i])),
-                        w: Group::gather_vec(idx.map(|i| p.w[i])),
-                    };
-                    let (body_i, body_j) = (body(i), body(j));
-                    let d = body_i.x - body_j.x; // Eq. (8)
-                    let kin =
-                        Kinematics::of_touching_particles(&body_i, &body_j, d, Group::dot(d, d));
-                    let mass = |idx: [usize; WIDTH]| {
-                        Group::gather(idx.map(|i| Inertia::mass(p.radius[i], density)))
-                    };
-                    let mut lanes = gather_springs(springs, k);
-                    let other = Other::Particle {
-                        r: body_j.radius,
-                        m: mass(j),
-                    };
-                    let force = law.evaluate(body_i.radius, mass(i), other, &kin, &mut lanes);
-                    scatter_springs(lanes, springs, &k[..group.len()]);
-                    scatter_forces(force, forces, &k[..group.len()]);
-                    let delta = kin.delta.scatter();
-                    for l in 0..group.len() {
-                        let limit = p.radius[i[l]].min(p.radius[j[l]]);
-                        if delta[l] > limit {
-                            deep.lock().expect("not poisoned").push(Deep {
-                                i: i[l],
-                                other: Partner::Particle(j[l]),
-                                delta: delta[l],
-                                limit,
-                            });
+        let slabs: Vec<usize> = self.neighbours.slabs.iter().map(|&o| o as usize).collect();
+        let ContactList {
+            start,
+            partner,
+            springs,
+            touched,
+        } = &mut self.neighbours.pairs;
+        let (start, partner) = (&*start, &*partner);
+        thread_local! {
+            static TOUCHING: std::cell::RefCell<Vec<[u32; 3]>> = Default::default();
+        }
+        for phase in 0..2 {
+            let mut all: Vec<Option<Piece>> =
+                pieces(&slabs, &mut self.loads, start, springs, touched)
+                    .into_iter()
+                    .map(Some)
+                    .collect();
+            // A slab, with the loads of the next one.
+            let tasks: Vec<(Piece, Option<Piece>)> = (phase..all.len())
+                .step_by(2)
+                .map(|s| {
+                    let own = all[s].take().expect("each slab once");
+                    (own, all.get_mut(s + 1).and_then(Option::take))
+                })
+                .collect();
+            tasks.into_par_iter().for_each(|(slab, next)| {
+                TOUCHING.with_borrow_mut(|touching| {
+                    let Piece {
+                        owners,
+                        first,
+                        loads,
+                        springs,
+                        touched,
+                    } = slab;
+                    let mut next_loads = next.map(|n| (n.owners.start, n.loads));
+                    // The touching pairs: the particle of the lower id (body i of the law,
+                    // whatever the storage order), the other, and the slot (in the slab).
+                    touching.clear();
+                    for i in owners.clone() {
+                        let (xi, ri) = (p.x[i], p.radius[i]);
+                        let run = start[i] as usize - first..start[i + 1] as usize - first;
+                        for kl in run {
+                            let j = partner[first + kl] as usize;
+                            let reach = ri + p.radius[j];
+                            if (xi - p.x[j]).length_squared() < reach * reach {
+                                let (a, b) = if p.id[i] < p.id[j] { (i, j) } else { (j, i) };
+                                touching.push([a as u32, b as u32, kl as u32]);
+                                touched[kl] = true;
+                            } else if touched[kl] {
+                                // The contact ended: forget its history.
+                                springs[kl] = Springs::default();
+                                touched[kl] = false;
+                            }
                         }
                     }
-                }
-            },
-        );
+                    let mut add = |idx: usize, f: DVec3, tau: DVec3| {
+                        if idx < owners.end {
+                            loads[idx - owners.start].add(f, tau);
+                        } else {
+                            let (base, next) = next_loads
+                                .as_mut()
+                                .expect("partners reach the next slab only");
+                            next[idx - *base].add(f, tau);
+                        }
+                    };
+                    for group in touching.chunks(WIDTH) {
+                        // A short last group repeats its last pair in the spare lanes.
+                        let (mut i, mut j, mut k) = ([0; WIDTH], [0; WIDTH], [0; WIDTH]);
+                        for l in 0..WIDTH {
+                            let [a, b, kl] = group[l.min(group.len() - 1)];
+                            (i[l], j[l], k[l]) = (a as usize, b as usize, kl as usize);
+                        }
+                        let body = |idx: [usize; WIDTH]| Body::<Group> {
+                            x: Group::gather_vec_at(&p.x, &idx),
+                            radius: Group::gather_at(&p.radius, &idx),
+                            v: Group::gather_vec_at(&p.v, &idx),
+                            w: Group::gather_vec_at(&p.w, &idx),
+                        };
+                        let (body_i, body_j) = (body(i), body(j));
+                        let d = body_i.x - body_j.x; // Eq. (8)
+                        let kin = Kinematics::of_touching_particles(
+                            &body_i,
+                            &body_j,
+                            d,
+                            Group::dot(d, d),
+                        );
+                        let mass = |idx: [usize; WIDTH]| {
+                            let mut m = [0.0; WIDTH];
+                            for l in 0..WIDTH {
+                                m[l] = Inertia::mass(p.radius[idx[l]], density);
+                            }
+                            Group::gather(m)
+                        };
+                        let mut lanes = gather_springs(springs, k);
+                        let other = Other::Particle {
+                            r: body_j.radius,
+                            m: mass(j),
+                        };
+                        let force = law.evaluate(body_i.radius, mass(i), other, &kin, &mut lanes);
+                        scatter_springs(lanes, springs, &k[..group.len()]);
+                        let (f, tau_i, tau_j) = (
+                            Group::scatter_vec(force.f),
+                            Group::scatter_vec(force.tau_i),
+                            Group::scatter_vec(force.tau_j),
+                        );
+                        let delta = kin.delta.scatter();
+                        for l in 0..group.len() {
+                            add(i[l], f[l], tau_i[l]);
+                            add(j[l], -f[l], tau_j[l]); // Eqs. (56)-(60)
+                            let limit = p.radius[i[l]].min(p.radius[j[l]]);
+                            if delta[l] > limit {
+                                deep.lock().expect("not poisoned").push(Deep {
+                                    i: i[l],
+                                    other: Partner::Particle(j[l]),
+                                    delta: delta[l],
+                                    limit,
+                                });
+                            }
+                        }
+                    }
+                });
+            });
+        }
         deep.into_inner().expect("not poisoned")
     }
 
@@ -854,6 +976,7 @@ impl Simulation {
     /// every face is a surface of its own), hands the springs of the others to the contact
     /// that absorbs them, then evaluates the law for `WIDTH` contacts at a time in SIMD
     /// lanes (bit for bit as alone).
+    #[inline(never)] // a stage of its own in profiles
     fn mesh_contacts(&mut self) -> Vec<Deep> {
         let deep = Mutex::new(Vec::new());
         let p = &self.particles;
@@ -861,13 +984,28 @@ impl Simulation {
         let faces = &self.mesh.faces;
         let (face_part, moving) = (&self.face_part, &self.moving);
         let density = self.scenario.material.density;
-        let list = &mut self.neighbours.faces;
+        let ContactList {
+            start,
+            partner,
+            springs,
+            touched,
+        } = &mut self.neighbours.faces;
+        let (start, partner) = (&*start, &*partner);
         thread_local! {
             static SCRATCH: std::cell::RefCell<MeshScratch> = Default::default();
         }
-        owner_pieces(&mut self.face_forces, list, &self.face_pieces).for_each(
-            |(forces, springs, touched, owner, partner)| {
+        let all = pieces(&self.face_pieces, &mut self.loads, start, springs, touched);
+        all.into_par_iter()
+            .with_min_len(MIN_PARALLEL_LEN.div_ceil(PIECE))
+            .for_each(|piece| {
                 SCRATCH.with_borrow_mut(|scratch| {
+                    let Piece {
+                        owners,
+                        first,
+                        loads,
+                        springs,
+                        touched,
+                    } = piece;
                     let MeshScratch {
                         near,
                         candidates,
@@ -878,60 +1016,64 @@ impl Simulation {
                     // The faces within reach, each with its closest point and kinematics; the
                     // slots of a particle are consecutive, so are its candidates.
                     near.clear();
-                    for (k, (&i, &f)) in owner.iter().zip(partner).enumerate() {
-                        let (i, face) = (i as usize, &faces[f as usize]);
+                    for i in owners.clone() {
                         let body = Body {
                             x: p.x[i],
                             radius: p.radius[i],
                             v: p.v[i],
                             w: p.w[i],
                         };
-                        let contact = if face.certainly_beyond(body.x, body.radius + face.radius) {
-                            None
-                        } else {
-                            let wall = match face_part[f as usize] {
-                                STATIC => RigidVelocity::default(),
-                                part => moving[part as usize].velocity,
-                            };
-                            let (d, feature) = face.separation_and_feature(body.x);
-                            let (d, interior) =
-                                surface::snap(face, body.x, body.radius, d, feature);
-                            Kinematics::with_wall(&body, d, face.radius, &wall)
-                                .map(|kin| (kin, d, interior))
-                        };
-                        match contact {
-                            Some((kin, d, interior)) => near.push(Near {
-                                slot: k,
-                                kin,
-                                d,
-                                interior,
-                            }),
-                            None if touched[k] => {
-                                // The contact ended: forget its history and its force.
-                                springs[k] = Springs::default();
-                                forces[k] = ContactForce::default();
-                                touched[k] = false;
+                        let run = start[i] as usize..start[i + 1] as usize;
+                        for (k, &f) in run.clone().zip(&partner[run]) {
+                            let kl = k - first;
+                            let face = &faces[f as usize];
+                            let contact =
+                                if face.certainly_beyond(body.x, body.radius + face.radius) {
+                                    None
+                                } else {
+                                    let wall = match face_part[f as usize] {
+                                        STATIC => RigidVelocity::default(),
+                                        part => moving[part as usize].velocity,
+                                    };
+                                    let (d, feature) = face.separation_and_feature(body.x);
+                                    let (d, interior) =
+                                        surface::snap(face, body.x, body.radius, d, feature);
+                                    Kinematics::with_wall(&body, d, face.radius, &wall)
+                                        .map(|kin| (kin, d, interior))
+                                };
+                            match contact {
+                                Some((kin, d, interior)) => near.push(Near {
+                                    owner: i as u32,
+                                    slot: kl,
+                                    kin,
+                                    d,
+                                    interior,
+                                }),
+                                None if touched[kl] => {
+                                    // The contact ended: forget its history.
+                                    springs[kl] = Springs::default();
+                                    touched[kl] = false;
+                                }
+                                None => {}
                             }
-                            None => {}
                         }
                     }
-                    // One contact per touch, particle by particle (its slots, so its faces
-                    // within reach, are consecutive); the absorbed hand over their springs
-                    // and are treated as apart.
+                    // One contact per touch, particle by particle; the absorbed hand over
+                    // their springs and are treated as apart.
                     contacts.clear();
                     let mut a = 0;
                     while a < near.len() {
-                        let i = owner[near[a].slot];
+                        let i = near[a].owner as usize;
                         let mut b = a + 1;
-                        while b < near.len() && owner[near[b].slot] == i {
+                        while b < near.len() && near[b].owner as usize == i {
                             b += 1;
                         }
-                        let (x, radius) = (p.x[i as usize], p.radius[i as usize]);
+                        let (x, radius) = (p.x[i], p.radius[i]);
                         let several = b - a > 1;
                         if several {
                             candidates.clear();
                             candidates.extend(near[a..b].iter().map(|c| Candidate {
-                                face: partner[c.slot],
+                                face: partner[first + c.slot],
                                 point: x - c.d,
                                 dist2: c.d.length_squared(),
                                 interior: c.interior,
@@ -952,8 +1094,8 @@ impl Simulation {
                             if !several || fates[c] == Fate::Contact {
                                 if near.kin.delta > radius {
                                     deep.lock().expect("not poisoned").push(Deep {
-                                        i: i as usize,
-                                        other: Partner::Face(partner[k] as usize),
+                                        i,
+                                        other: Partner::Face(partner[first + k] as usize),
                                         delta: near.kin.delta,
                                         limit: radius,
                                     });
@@ -962,18 +1104,18 @@ impl Simulation {
                                 touched[k] = true;
                             } else if touched[k] {
                                 springs[k] = Springs::default();
-                                forces[k] = ContactForce::default();
                                 touched[k] = false;
                             }
                         }
                         a = b;
                     }
-                    // The law, `WIDTH` contacts at a time (as for particle pairs).
+                    // The law, `WIDTH` contacts at a time (as for particle pairs), added to
+                    // the particles' loads in slot order.
                     for group in contacts.chunks(WIDTH) {
                         let c: [&Near; WIDTH] =
                             std::array::from_fn(|l| &near[group[l.min(group.len() - 1)] as usize]);
                         let k = c.map(|c| c.slot);
-                        let i = k.map(|k| owner[k] as usize);
+                        let i = c.map(|c| c.owner as usize);
                         let scalar =
                             |get: fn(&Kinematics) -> f64| Group::gather(c.map(|c| get(&c.kin)));
                         let vector = |get: fn(&Kinematics) -> DVec3| {
@@ -992,46 +1134,26 @@ impl Simulation {
                         let mut lanes = gather_springs(springs, k);
                         let force = law.evaluate(radius, mass, Other::Wall, &kin, &mut lanes);
                         scatter_springs(lanes, springs, &k[..group.len()]);
-                        scatter_forces(force, forces, &k[..group.len()]);
+                        let (f, tau) =
+                            (Group::scatter_vec(force.f), Group::scatter_vec(force.tau_i));
+                        for l in 0..group.len() {
+                            loads[i[l] - owners.start].add(f[l], tau[l]);
+                        }
                     }
                 });
-            },
-        );
+            });
         deep.into_inner().expect("not poisoned")
     }
 
-    /// Stage 5 (Section 2.3): sum each particle's contact forces and torques (Eqs. 1-2,
-    /// with the reactions of Eqs. 56-60) and advance it by Δt.
+    /// Stage 5 (Section 2.3): advance each particle by Δt under the force and torque its
+    /// contacts added to its load (Eqs. 1-2).
     /// Returns whether some particle's new state is not finite (for stage 6, so that it
     /// needs no pass of its own).
+    #[inline(never)] // a stage of its own in profiles
     fn integrate(&mut self) -> bool {
         let s = &self.scenario;
         let (dt, g) = (s.simulation.timestep, s.kinetics.gravity);
         let (density, viscosity) = (s.material.density, s.material.viscosity);
-        let nb = &self.neighbours;
-        let (pair_forces, face_forces) = (&self.pair_forces, &self.face_forces);
-        // Force and torque on particle i.
-        let load = |i: usize| {
-            let mut f = DVec3::ZERO;
-            let mut tau = DVec3::ZERO;
-            let own = nb.pairs.start[i] as usize..nb.pairs.start[i + 1] as usize;
-            for c in &pair_forces[own] {
-                f += c.f;
-                tau += c.tau_i;
-            }
-            let reverse = nb.reverse_start[i] as usize..nb.reverse_start[i + 1] as usize;
-            for &slot in &nb.reverse_slot[reverse] {
-                let c = &pair_forces[slot as usize];
-                f -= c.f; // Eqs. (56), (57)
-                tau += c.tau_j; // Eqs. (58)-(60)
-            }
-            let faces = nb.faces.start[i] as usize..nb.faces.start[i + 1] as usize;
-            for c in &face_forces[faces] {
-                f += c.f;
-                tau += c.tau_i;
-            }
-            (f, tau)
-        };
         let p = &mut self.particles;
         (
             p.x.par_chunks_mut(WIDTH),
@@ -1039,25 +1161,28 @@ impl Simulation {
             p.q.par_chunks_mut(WIDTH),
             p.w.par_chunks_mut(WIDTH),
             p.radius.par_chunks(WIDTH),
+            self.loads.par_chunks_mut(WIDTH),
         )
             .into_par_iter()
             .with_min_len(MIN_PARALLEL_LEN.div_ceil(WIDTH))
-            .enumerate()
-            .map(|(group, (x, v, q, w, radius))| {
+            .map(|(x, v, q, w, radius, load)| {
                 // `WIDTH` particles at a time in lanes; a short last group repeats its last
-                // particle in the spare lanes.
+                // particle in the spare lanes. The loads are used up (zeroed for the next
+                // step).
                 let n = x.len();
                 let lane: [usize; WIDTH] = std::array::from_fn(|l| l.min(n - 1));
-                let loads = lane.map(|l| load(group * WIDTH + l));
+                let (mut f, mut tau) = ([DVec3::ZERO; WIDTH], [DVec3::ZERO; WIDTH]);
+                for l in 0..WIDTH {
+                    (f[l], tau[l]) = (load[lane[l]].f, load[lane[l]].tau);
+                }
+                load.fill(Load::default());
                 let state = State::<Group> {
-                    x: Group::gather_vec(lane.map(|l| x[l])),
-                    v: Group::gather_vec(lane.map(|l| v[l])),
-                    q: Group::gather_quat(lane.map(|l| q[l])),
-                    w: Group::gather_vec(lane.map(|l| w[l])),
+                    x: Group::gather_vec_at(x, &lane),
+                    v: Group::gather_vec_at(v, &lane),
+                    q: Group::gather_quat_at(q, &lane),
+                    w: Group::gather_vec_at(w, &lane),
                 };
-                let body =
-                    Response::new(Group::gather(lane.map(|l| radius[l])), density, viscosity);
-                let (f, tau) = (loads.map(|l| l.0), loads.map(|l| l.1));
+                let body = Response::new(Group::gather_at(radius, &lane), density, viscosity);
                 let new = advance(
                     state,
                     &body,

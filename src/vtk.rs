@@ -129,16 +129,15 @@ impl Vtu {
         atomic_write(path, &[text.as_bytes(), &self.appended, tail.as_bytes()])
     }
 
-    /// A named array of 3-vectors.
-    fn vectors(&mut self, section: Section, name: &str, values: &[glam::DVec3]) {
-        let count = 3 * values.len();
-        self.array(
-            section,
-            name,
-            3,
-            count,
-            values.iter().flat_map(|a| a.to_array()),
-        );
+    /// A named array of `n` 3-vectors.
+    fn vectors(
+        &mut self,
+        section: Section,
+        name: &str,
+        n: usize,
+        values: impl Iterator<Item = glam::DVec3>,
+    ) {
+        self.array(section, name, 3, 3 * n, values.flat_map(|a| a.to_array()));
     }
 }
 
@@ -159,23 +158,26 @@ fn atomic_write(path: &Path, parts: &[&[u8]]) -> Result<()> {
     write().with_context(|| format!("cannot write {}", path.display()))
 }
 
-/// Writes the particles as a `.vtu` file.
+/// Writes the particles as a `.vtu` file, in id order.
 pub fn write_particles(path: &Path, p: &Particles) -> Result<()> {
     use Section::*;
     let n = p.len();
+    let order = p.id_order();
+    let by_id = || order.iter().copied();
     let mut v = Vtu::new();
-    v.array(PointData, "radius", 1, n, p.radius.iter().copied());
-    v.vectors(PointData, "velocity", &p.v);
-    v.vectors(PointData, "angular_velocity", &p.w);
+    v.array(PointData, "id", 1, n, by_id().map(|i| p.id[i]));
+    v.array(PointData, "radius", 1, n, by_id().map(|i| p.radius[i]));
+    v.vectors(PointData, "velocity", n, by_id().map(|i| p.v[i]));
+    v.vectors(PointData, "angular_velocity", n, by_id().map(|i| p.w[i]));
     v.array(
         PointData,
         "orientation",
         4,
         4 * n,
-        p.q.iter().flat_map(|q| [q.w, q.x, q.y, q.z]),
+        by_id().flat_map(|i| [p.q[i].w, p.q[i].x, p.q[i].y, p.q[i].z]),
     );
-    v.array(PointData, "tag", 1, n, p.tag.iter().copied());
-    v.vectors(Points, "points", &p.x);
+    v.array(PointData, "tag", 1, n, by_id().map(|i| p.tag[i]));
+    v.vectors(Points, "points", n, by_id().map(|i| p.x[i]));
     v.array(Cells, "connectivity", 1, n, 0..n as i64);
     v.array(Cells, "offsets", 1, n, 1..=n as i64);
     v.array(Cells, "types", 1, n, std::iter::repeat_n(1u8, n)); // VTK_VERTEX
@@ -212,7 +214,7 @@ pub fn write_mesh(path: &Path, mesh: &Mesh) -> Result<()> {
         nc,
         mesh.faces.iter().map(|f| f.radius),
     );
-    v.vectors(Points, "points", &points);
+    v.vectors(Points, "points", points.len(), points.iter().copied());
     v.array(
         Cells,
         "connectivity",

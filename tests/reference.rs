@@ -60,7 +60,7 @@ fn check_case(case: &str) -> f64 {
             sim.particles.len(),
             "{case} frame {f}: particle count"
         );
-        for (i, (e, a)) in expected.iter().zip(sim.particles.iter()).enumerate() {
+        for (i, (e, (_, a))) in expected.iter().zip(sim.particles.iter_by_id()).enumerate() {
             for c in &columns {
                 let (e, a) = (column(&e, c), column(&a, c));
                 let err = (a - e).abs() / (1.0 + e.abs()) / tol;
