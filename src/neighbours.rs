@@ -45,6 +45,36 @@ pub fn key(c: IVec3) -> u64 {
     (b(c.x) << 42) | (b(c.y) << 21) | b(c.z)
 }
 
+/// The cell of a key (the inverse of [`key`]).
+fn unkey(k: u64) -> IVec3 {
+    let c = |shift: u32| ((k >> shift) & ((1 << 21) - 1)) as i32 - CELL_BIAS;
+    IVec3::new(c(42), c(21), c(0))
+}
+
+/// The 13 neighbours of a cell whose keys come after its own, in key order (x, then y, then
+/// z): with the cell itself, every pair of neighbouring cells once.
+const FORWARD: [IVec3; 13] = {
+    let mut d = [IVec3::ZERO; 13];
+    let mut k = 0;
+    let mut dx = 0;
+    while dx <= 1 {
+        let mut dy = -1;
+        while dy <= 1 {
+            let mut dz = -1;
+            while dz <= 1 {
+                if dx > 0 || (dx == 0 && (dy > 0 || (dy == 0 && dz > 0))) {
+                    d[k] = IVec3::new(dx, dy, dz);
+                    k += 1;
+                }
+                dz += 1;
+            }
+            dy += 1;
+        }
+        dx += 1;
+    }
+    d
+};
+
 /// A hashed grid of cubic cells: for each occupied cell, the items in it.
 #[derive(Clone, Debug, Default)]
 pub struct CellGrid {
@@ -102,6 +132,26 @@ impl CellGrid {
         }
         keyed.sort_unstable();
         CellGrid::from_sorted(keyed, inv_h)
+    }
+
+    /// The occupied cells with the range of items in each, in key order.
+    fn occupied(&self) -> Vec<(IVec3, u32, u32)> {
+        let mut cells: Vec<(u64, u32, u32)> =
+            self.cells.iter().map(|(&k, &(a, b))| (k, a, b)).collect();
+        cells.sort_unstable();
+        cells
+            .into_iter()
+            .map(|(k, a, b)| (unkey(k), a, b))
+            .collect()
+    }
+
+    /// The range of items in cell `c` (empty if none).
+    #[inline]
+    fn range(&self, c: IVec3) -> std::ops::Range<u32> {
+        match self.cells.get(&key(c)) {
+            Some(&(a, b)) => a..b,
+            None => 0..0,
+        }
     }
 
     /// Items in the cell containing `x`.
@@ -186,50 +236,52 @@ impl ContactList {
     }
 }
 
-/// A contact history by particle id: the springs of particle pairs keyed by (lower id,
-/// higher id), or of particle-face contacts by (id, face). It carries the springs across
-/// rebuilds, which re-sort the particles, and into checkpoints.
+/// A contact history: the springs of particle pairs keyed by (lower, higher) and of
+/// particle-face contacts by (particle, face), where particles are named by id (in
+/// checkpoints) or by their storage index after a rebuild's re-sort (to carry the springs
+/// into the new lists). Compressed by the first key, each run ordered by the second.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct History {
-    /// The entries of id `a` are `start[a]..start[a+1]`, ordered by the other key.
+    /// The entries of `a` are `start[a]..start[a+1]`, ordered by the other key.
     start: Vec<u32>,
     other: Vec<u32>,
     springs: Vec<Springs>,
 }
 
 impl History {
-    /// The history of `(id, other, springs)` entries, ids below `ids`: a counting sort by id
-    /// (`first` yields the same ids in the same order), then each id's run by `other`.
+    /// The history of `(a, other, springs)` entries, `a` below `keys`: a counting sort by
+    /// `a` (`first` yields the same keys in the same order), then each run by `other`.
     fn from_entries(
-        ids: usize,
+        keys: usize,
         first: impl Iterator<Item = u32>,
         entries: impl Iterator<Item = (u32, u32, Springs)>,
     ) -> History {
-        let mut start = vec![0u32; ids + 1];
-        for id in first {
-            start[id as usize + 1] += 1;
+        let mut start = vec![0u32; keys + 1];
+        for a in first {
+            start[a as usize + 1] += 1;
         }
-        for k in 0..ids {
+        for k in 0..keys {
             start[k + 1] += start[k];
         }
-        let total = start[ids] as usize;
+        let total = start[keys] as usize;
         let mut fill = start.clone();
         let mut other = vec![0u32; total];
         let mut springs = vec![Springs::default(); total];
-        for (id, o, s) in entries {
-            let k = fill[id as usize] as usize;
+        for (a, o, s) in entries {
+            let k = fill[a as usize] as usize;
             (other[k], springs[k]) = (o, s);
-            fill[id as usize] += 1;
+            fill[a as usize] += 1;
         }
         drop(fill);
-        for a in 0..ids {
+        // Runs are short: insertion sort, in place.
+        for a in 0..keys {
             let run = start[a] as usize..start[a + 1] as usize;
-            if run.len() > 1 {
-                let mut pairs: Vec<(u32, Springs)> =
-                    run.clone().map(|k| (other[k], springs[k])).collect();
-                pairs.sort_by_key(|p| p.0);
-                for (k, (o, s)) in run.zip(pairs) {
-                    (other[k], springs[k]) = (o, s);
+            for k in run.start + 1..run.end {
+                let mut m = k;
+                while m > run.start && other[m - 1] > other[m] {
+                    other.swap(m - 1, m);
+                    springs.swap(m - 1, m);
+                    m -= 1;
                 }
             }
         }
@@ -240,19 +292,44 @@ impl History {
         }
     }
 
-    /// The history of saved `(id, other, springs)` entries (a checkpoint's).
-    pub fn new(ids: usize, entries: &[(u32, u32, Springs)]) -> Result<History, String> {
-        if let Some(&(id, ..)) = entries.iter().find(|e| e.0 as usize >= ids) {
-            return Err(format!("contact of particle id {id}, of {ids} ids"));
+    /// The history of saved `(id, other, springs)` entries (a checkpoint's) for `particles`
+    /// (in storage order): keyed by storage index, `pairs` or not.
+    pub fn in_storage(
+        particles: &Particles,
+        entries: &[(u32, u32, Springs)],
+        pairs: bool,
+    ) -> Result<History, String> {
+        let n = particles.len();
+        let mut index = vec![u32::MAX; particles.next_id as usize];
+        for (k, &id) in particles.id.iter().enumerate() {
+            index[id as usize] = k as u32;
         }
+        let at = |id: u32| match index.get(id as usize) {
+            Some(&k) if k != u32::MAX => Ok(k),
+            _ => Err(format!(
+                "contact of particle id {id}, which the checkpoint lacks"
+            )),
+        };
+        let keyed = entries
+            .iter()
+            .map(|&(a, b, s)| {
+                let a = at(a)?;
+                if pairs {
+                    let b = at(b)?;
+                    Ok((a.min(b), a.max(b), s))
+                } else {
+                    Ok((a, b, s))
+                }
+            })
+            .collect::<Result<Vec<_>, String>>()?;
         Ok(History::from_entries(
-            ids,
-            entries.iter().map(|e| e.0),
-            entries.iter().copied(),
+            n,
+            keyed.iter().map(|e| e.0),
+            keyed.iter().copied(),
         ))
     }
 
-    /// Every entry, ordered by id and then by the other key.
+    /// Every entry, ordered by the first key and then by the other.
     pub fn entries(&self) -> Vec<(u32, u32, Springs)> {
         (0..self.start.len().saturating_sub(1))
             .flat_map(|a| {
@@ -270,18 +347,14 @@ impl History {
         self.other.is_empty()
     }
 
-    /// The springs of `(id, other)`, or zero.
+    /// The entries of `a`: the other keys (ascending) and their springs.
     #[inline]
-    fn get(&self, id: u32, other: u32) -> Springs {
-        let id = id as usize;
-        if id + 1 >= self.start.len() {
-            return Springs::default();
+    fn run(&self, a: usize) -> (&[u32], &[Springs]) {
+        if a + 1 >= self.start.len() {
+            return (&[], &[]);
         }
-        let run = self.start[id] as usize..self.start[id + 1] as usize;
-        match self.other[run.clone()].binary_search(&other) {
-            Ok(k) => self.springs[run.start + k],
-            Err(_) => Springs::default(),
-        }
+        let run = self.start[a] as usize..self.start[a + 1] as usize;
+        (&self.other[run.clone()], &self.springs[run])
     }
 }
 
@@ -542,14 +615,13 @@ impl Neighbours {
 
     /// Rebuilds both lists for `particles`, re-sorting them into spatial order first.
     ///
-    /// The springs of touching pairs are carried by particle id. Particles are stored in the
-    /// order of their cells (cell key, then id), so that neighbours in space are neighbours
-    /// in memory, and the lists are built from their positions (see [`Neighbours::build`]).
+    /// Particles are stored in the order of their cells (cell key, then id), so that
+    /// neighbours in space are neighbours in memory; the springs of touching pairs are
+    /// carried to their slots in the new lists (keyed by the particles' new storage
+    /// indices, so that carrying them runs in spatial order too), and the lists are built
+    /// from the positions (see [`Neighbours::build`]).
     pub fn rebuild(&mut self, particles: &mut Particles, faces: &[Face], face_grid: &CellGrid) {
-        let history = self.history(&particles.id, particles.next_id as usize);
-        // The old lists go before the new ones are made.
-        self.pairs = ContactList::default();
-        self.faces = ContactList::default();
+        let n = particles.len();
         let layout = Layout::of(&particles.radius, self.skin);
         let inv_h = 1.0 / layout.h;
         let keys: Vec<(u64, u32)> = particles
@@ -559,10 +631,36 @@ impl Neighbours {
             .with_min_len(MIN_PARALLEL_LEN)
             .map(|(&x, &id)| (key(cell_of(x, inv_h)), id))
             .collect();
-        if !keys.is_sorted() {
-            let mut order: Vec<u32> = (0..keys.len() as u32).collect();
+        let order: Option<Vec<u32>> = (!keys.is_sorted()).then(|| {
+            let mut order: Vec<u32> = (0..n as u32).collect();
             order.par_sort_unstable_by_key(|&i| keys[i as usize]);
-            drop(keys);
+            order
+        });
+        drop(keys);
+        // Where each particle goes, and the springs by the new places.
+        let mut new = vec![0u32; self.pairs.owners()];
+        match &order {
+            Some(order) => {
+                for (k, &old) in order.iter().enumerate() {
+                    if (old as usize) < new.len() {
+                        new[old as usize] = k as u32;
+                    }
+                }
+            }
+            None => new.iter_mut().enumerate().for_each(|(k, v)| *v = k as u32),
+        }
+        let history = Histories {
+            pairs: self.pairs.history(n, |i, j| {
+                let (a, b) = (new[i], new[j as usize]);
+                (a.min(b), a.max(b))
+            }),
+            faces: self.faces.history(n, |i, f| (new[i], f)),
+        };
+        drop(new);
+        // The old lists go before the new ones are made.
+        self.pairs = ContactList::default();
+        self.faces = ContactList::default();
+        if let Some(order) = order {
             particles.permute(&order);
         }
         let x = particles.x.clone();
@@ -574,7 +672,8 @@ impl Neighbours {
 
     /// Builds again the lists of a checkpoint: the particles in their saved storage order,
     /// the positions of the last rebuild (`anchors`) and its lonely particles, and the
-    /// contact histories. The lists are those the run had, slot for slot.
+    /// contact histories (keyed by storage index, [`History::in_storage`]). The lists are
+    /// those the run had, slot for slot.
     pub fn restore(
         &mut self,
         particles: &Particles,
@@ -608,7 +707,7 @@ impl Neighbours {
         layout: Layout,
         history: &Histories,
     ) {
-        let (radius, ids) = (&particles.radius, &particles.id);
+        let radius = &particles.radius;
         let n = x.len();
         let skin = self.skin;
         let grid = CellGrid::of_points(x, layout.h);
@@ -616,10 +715,39 @@ impl Neighbours {
             let reach = radius[i as usize] + radius[j as usize] + skin;
             (x[i as usize] - x[j as usize]).length_squared() < reach * reach
         };
-        let (start, partner) = if layout.uniform {
-            // Per owner, its partners of higher index from the 27 cells around its cell;
-            // a run is sorted (cells in key order hold ascending indices when the storage
-            // is in cell order, and the run is sorted in any case).
+        let in_cell_order = layout.uniform && {
+            let inv_h = 1.0 / layout.h;
+            x.windows(2)
+                .all(|w| key(cell_of(w[0], inv_h)) <= key(cell_of(w[1], inv_h)))
+        };
+        let (start, partner) = if in_cell_order {
+            // Storage in cell order: per cell, each particle's partners are the later ones
+            // of its cell and those of the 13 cells after it in key order, whose indices
+            // all come after its own; so each run comes out sorted.
+            let cells = grid.occupied();
+            let runs: Vec<Vec<u32>> = cells
+                .par_iter()
+                .with_min_len(MIN_PARALLEL_LEN / 4)
+                .fold(Vec::new, |mut out: Vec<u32>, &(c, a, b)| {
+                    let forward = FORWARD.map(|d| grid.range(c + d));
+                    for i in a..b {
+                        let at = out.len();
+                        out.push(0); // the run's length, filled below
+                        for j in (i + 1..b).chain(forward.iter().flat_map(|r| r.clone())) {
+                            if close(i, j) {
+                                out.push(j);
+                            }
+                        }
+                        out[at] = (out.len() - at - 1) as u32;
+                    }
+                    out
+                })
+                .collect();
+            runs_to_csr(n, runs)
+        } else if layout.uniform {
+            // Any storage order (a restored checkpoint may hold a re-anchored particle out
+            // of its cell): per owner, its partners of higher index from the 27 cells
+            // around its cell, sorted.
             let runs: Vec<Vec<u32>> = (0..n as u32)
                 .into_par_iter()
                 .with_min_len(4 * MIN_PARALLEL_LEN)
@@ -672,11 +800,7 @@ impl Neighbours {
             compress(n, pairs.iter().map(|&k| ((k >> 32) as u32, k as u32)))
         };
         drop(grid);
-        let pair_of = pair_key(ids);
-        self.pairs = ContactList::with_springs(start, partner, |i, j| {
-            let (a, b) = pair_of(i, j);
-            history.pairs.get(a, b)
-        });
+        self.pairs = ContactList::with_springs(start, partner, &history.pairs);
 
         // The items of a grid cell come in ascending order, so each particle's run of faces
         // is sorted.
@@ -695,34 +819,47 @@ impl Neighbours {
             .collect();
         let (start, partner) = compress(n, face_pairs.iter().copied());
         drop(face_pairs);
-        self.faces = ContactList::with_springs(start, partner, |i, f| history.faces.get(ids[i], f));
+        self.faces = ContactList::with_springs(start, partner, &history.faces);
         self.slabs = slabs_of(&self.pairs);
     }
 }
 
 impl ContactList {
-    /// A list from runs in compressed form, each slot with the springs `springs(owner,
-    /// partner)` gives it.
-    fn with_springs(
-        start: Vec<u32>,
-        partner: Vec<u32>,
-        springs: impl Fn(usize, u32) -> Springs + Sync,
-    ) -> ContactList {
+    /// A list from runs in compressed form, each slot with the springs `history` holds for
+    /// (owner, partner), found by merging each run with the owner's history run (both
+    /// ascending).
+    fn with_springs(start: Vec<u32>, partner: Vec<u32>, history: &History) -> ContactList {
         let owners = start.len().saturating_sub(1);
-        let springs: Vec<Springs> = (0..owners)
-            .into_par_iter()
-            .with_min_len(MIN_PARALLEL_LEN)
-            .flat_map_iter(|i| {
+        let mut springs = vec![Springs::default(); partner.len()];
+        let mut touched = vec![false; partner.len()];
+        // Pieces of 1024 owners, each filling its own slots.
+        let bounds: Vec<usize> = (0..owners)
+            .step_by(1024)
+            .chain(std::iter::once(owners))
+            .collect();
+        let slots: Vec<usize> = bounds.iter().map(|&o| start[o] as usize).collect();
+        let pieces: Vec<_> = (0..bounds.len() - 1)
+            .zip(cut(&mut springs, &slots))
+            .zip(cut(&mut touched, &slots))
+            .collect();
+        pieces.into_par_iter().for_each(|((p, springs), touched)| {
+            let first = slots[p];
+            for i in bounds[p]..bounds[p + 1] {
                 let run = start[i] as usize..start[i + 1] as usize;
-                let springs = &springs;
-                partner[run].iter().map(move |&j| springs(i, j))
-            })
-            .collect();
-        let touched = springs
-            .par_iter()
-            .with_min_len(MIN_PARALLEL_LEN)
-            .map(|s| *s != Springs::default())
-            .collect();
+                let (other, carried) = history.run(i);
+                let mut h = 0;
+                for k in run {
+                    let j = partner[k];
+                    while h < other.len() && other[h] < j {
+                        h += 1;
+                    }
+                    if other.get(h) == Some(&j) && carried[h] != Springs::default() {
+                        springs[k - first] = carried[h];
+                        touched[k - first] = true;
+                    }
+                }
+            }
+        });
         ContactList {
             start,
             partner,
@@ -730,6 +867,18 @@ impl ContactList {
             touched,
         }
     }
+}
+
+/// `slice` cut at `bounds` (ascending, from 0 to its length).
+pub(crate) fn cut<'a, T>(mut slice: &'a mut [T], bounds: &[usize]) -> Vec<&'a mut [T]> {
+    bounds
+        .windows(2)
+        .map(|w| {
+            let (piece, rest) = std::mem::take(&mut slice).split_at_mut(w[1] - w[0]);
+            slice = rest;
+            piece
+        })
+        .collect()
 }
 
 /// Runs collected as `[length, partners...]` blocks, `n` of them in owner order, in

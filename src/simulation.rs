@@ -18,7 +18,7 @@ use crate::lanes::{Gather, Lanes};
 use crate::mesh::{Contacts, Face, Mesh};
 use crate::motion::{Motion, Pose, RigidVelocity};
 use crate::neighbours::{
-    CellGrid, ContactList, Histories, History, MIN_PARALLEL_LEN, Neighbours, face_grid,
+    CellGrid, ContactList, Histories, History, MIN_PARALLEL_LEN, Neighbours, cut, face_grid,
 };
 use crate::particles::Particles;
 use crate::scenario::{MeshSource, Scenario, default_timestep};
@@ -61,18 +61,6 @@ fn owner_pieces(start: &[u32]) -> Vec<usize> {
         bounds.push(owners);
     }
     bounds
-}
-
-/// `slice` cut at `bounds` (ascending, from 0 to its length).
-fn cut<'a, T>(mut slice: &'a mut [T], bounds: &[usize]) -> Vec<&'a mut [T]> {
-    bounds
-        .windows(2)
-        .map(|w| {
-            let (piece, rest) = std::mem::take(&mut slice).split_at_mut(w[1] - w[0]);
-            slice = rest;
-            piece
-        })
-        .collect()
 }
 
 /// A piece of owners `owners` of a contact list: their loads, and the springs and touched
@@ -485,10 +473,11 @@ impl Simulation {
         }
         sim.particles = snapshot.particles;
         sim.spawner = Spawner::resume(sim.scenario.simulation.seed, snapshot.spawner);
-        let ids = sim.particles.next_id as usize;
         let history = Histories {
-            pairs: History::new(ids, &snapshot.pair_history).map_err(misfit)?,
-            faces: History::new(ids, &snapshot.face_history).map_err(misfit)?,
+            pairs: History::in_storage(&sim.particles, &snapshot.pair_history, true)
+                .map_err(misfit)?,
+            faces: History::in_storage(&sim.particles, &snapshot.face_history, false)
+                .map_err(misfit)?,
         };
         if let Some(&(_, f, _)) = snapshot
             .face_history
