@@ -42,10 +42,11 @@ impl Inertia {
         }
     }
 
-    /// Mass alone (for contact partners).
-    #[inline]
-    pub fn mass(radius: f64, density: f64) -> f64 {
-        4.0 / 3.0 * std::f64::consts::PI * density * radius.powi(3)
+    /// Mass alone (for contact partners), of one particle or of lanes: (4/3 π ρ) R³, with
+    /// R³ = (R R) R, the bits of `radius.powi(3)`.
+    #[inline(always)]
+    pub fn mass<T: Lanes>(radius: T, density: f64) -> T {
+        T::splat(4.0 / 3.0 * std::f64::consts::PI * density) * (radius * radius * radius)
     }
 }
 
@@ -244,6 +245,21 @@ mod tests {
         }
 
         proptest! {
+            /// The mass in lanes (and alone) has the bits of (4/3 π ρ) R.powi(3), the
+            /// formula of the original program.
+            #[test]
+            fn masses_in_lanes_are_those_of_the_formula(
+                radii in proptest::array::uniform8(1e-6..1.0f64),
+                density in 1.0..1e5f64,
+            ) {
+                let lanes = Inertia::mass(f64x8::gather(radii), density).scatter();
+                for (r, m) in radii.iter().zip(lanes) {
+                    let formula = 4.0 / 3.0 * std::f64::consts::PI * density * r.powi(3);
+                    prop_assert_eq!(m.to_bits(), formula.to_bits());
+                    prop_assert_eq!(Inertia::mass(*r, density).to_bits(), formula.to_bits());
+                }
+            }
+
             /// The integration advances eight particles at once; each lane must give the
             /// bits of the particle advanced alone, on every branch of the rotation series.
             #[test]

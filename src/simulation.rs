@@ -916,37 +916,35 @@ impl Simulation {
                             d,
                             Group::dot(d, d),
                         );
-                        let mass = |idx: [usize; WIDTH]| {
-                            let mut m = [0.0; WIDTH];
-                            for l in 0..WIDTH {
-                                m[l] = Inertia::mass(p.radius[idx[l]], density);
-                            }
-                            Group::gather(m)
-                        };
                         let mut lanes = gather_springs(springs, k);
                         let other = Other::Particle {
                             r: body_j.radius,
-                            m: mass(j),
+                            m: Inertia::mass(body_j.radius, density),
                         };
-                        let force = law.evaluate(body_i.radius, mass(i), other, &kin, &mut lanes);
+                        let m_i = Inertia::mass(body_i.radius, density);
+                        let force = law.evaluate(body_i.radius, m_i, other, &kin, &mut lanes);
                         scatter_springs(lanes, springs, &k[..group.len()]);
                         let (f, tau_i, tau_j) = (
                             Group::scatter_vec(force.f),
                             Group::scatter_vec(force.tau_i),
                             Group::scatter_vec(force.tau_j),
                         );
-                        let delta = kin.delta.scatter();
                         for l in 0..group.len() {
                             add(i[l], f[l], tau_i[l]);
                             add(j[l], -f[l], tau_j[l]); // Eqs. (56)-(60)
-                            let limit = p.radius[i[l]].min(p.radius[j[l]]);
-                            if delta[l] > limit {
-                                deep.lock().expect("not poisoned").push(Deep {
-                                    i: i[l],
-                                    other: Partner::Particle(j[l]),
-                                    delta: delta[l],
-                                    limit,
-                                });
+                        }
+                        if kin.delta.simd_gt(body_i.radius.min(body_j.radius)).any() {
+                            let delta = kin.delta.scatter();
+                            for l in 0..group.len() {
+                                let limit = p.radius[i[l]].min(p.radius[j[l]]);
+                                if delta[l] > limit {
+                                    deep.lock().expect("not poisoned").push(Deep {
+                                        i: i[l],
+                                        other: Partner::Particle(j[l]),
+                                        delta: delta[l],
+                                        limit,
+                                    });
+                                }
                             }
                         }
                     }
@@ -1006,13 +1004,16 @@ impl Simulation {
                     // slots of a particle are consecutive, so are its candidates.
                     near.clear();
                     for i in owners.clone() {
+                        let run = start[i] as usize..start[i + 1] as usize;
+                        if run.is_empty() {
+                            continue;
+                        }
                         let body = Body {
                             x: p.x[i],
                             radius: p.radius[i],
                             v: p.v[i],
                             w: p.w[i],
                         };
-                        let run = start[i] as usize..start[i + 1] as usize;
                         for (k, &f) in run.clone().zip(&partner[run]) {
                             let kl = k - first;
                             let face = &faces[f as usize];
@@ -1119,7 +1120,7 @@ impl Simulation {
                             omega: vector(|k| k.omega),
                         };
                         let radius = Group::gather(i.map(|i| p.radius[i]));
-                        let mass = Group::gather(i.map(|i| Inertia::mass(p.radius[i], density)));
+                        let mass = Inertia::mass(radius, density);
                         let mut lanes = gather_springs(springs, k);
                         let force = law.evaluate(radius, mass, Other::Wall, &kin, &mut lanes);
                         scatter_springs(lanes, springs, &k[..group.len()]);
