@@ -184,21 +184,72 @@ impl CellGrid {
     }
 }
 
-/// A compressed list: for each owner `i` (a storage index), a run of partners, each slot
-/// with the friction springs of its contact.
+/// A slot without a contact.
+pub const NONE: u32 = u32::MAX;
+
+/// The friction springs of the touching contacts of one piece of a list, and its free
+/// entries. A contact stage runs a piece in one task, which opens and closes entries in the
+/// piece's own store.
+#[derive(Clone, Debug, Default)]
+pub struct Store {
+    pub springs: Vec<Springs>,
+    free: Vec<u32>,
+}
+
+impl Store {
+    /// A new entry, with zero springs.
+    #[inline]
+    pub fn open(&mut self) -> u32 {
+        match self.free.pop() {
+            Some(k) => {
+                self.springs[k as usize] = Springs::default();
+                k
+            }
+            None => {
+                if self.springs.len() == self.springs.capacity() {
+                    // A little room at a time: contacts come and go, the count changes slowly.
+                    self.springs.reserve_exact(self.springs.len() / 8 + 8);
+                }
+                self.springs.push(Springs::default());
+                (self.springs.len() - 1) as u32
+            }
+        }
+    }
+
+    /// Frees entry `k` (its springs are forgotten).
+    #[inline]
+    pub fn close(&mut self, k: u32) {
+        self.free.push(k);
+    }
+
+    /// Entries in use.
+    pub fn len(&self) -> usize {
+        self.springs.len() - self.free.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// A compressed list: for each owner `i` (a storage index), a run of partners; each slot
+/// whose pair touches holds its contact, an entry of the store of the slot's piece (the
+/// pieces are runs of owners). Springs are kept only for touching pairs, those of a
+/// particle pair as seen from the particle of the lower id (body i of the contact law),
+/// whatever the storage order.
 #[derive(Clone, Debug, Default)]
 pub struct ContactList {
     /// Run of owner `i` is `start[i]..start[i+1]`.
     pub start: Vec<u32>,
     /// Partner of each slot: a particle `j > i` (storage index), or a face index.
     pub partner: Vec<u32>,
-    /// Friction springs of each slot; those of a particle pair as seen from the particle of
-    /// the lower id (body i of the contact law), whatever the storage order.
-    pub springs: Vec<Springs>,
-    /// Whether the slot's springs may be non-zero: its pair touched at the last force
-    /// evaluation, or had springs when listed. A pair apart has them zeroed once, and is not
-    /// looked at again while it stays apart.
-    pub touched: Vec<bool>,
+    /// The contact of each slot: its entry in its piece's store, or [`NONE`]. A pair that
+    /// parts closes its contact and is not looked at again while it stays apart.
+    pub contact: Vec<u32>,
+    /// Owner bounds of the pieces: piece `p` is owners `pieces[p]..pieces[p+1]`.
+    pub pieces: Vec<u32>,
+    /// One store per piece.
+    pub stores: Vec<Store>,
 }
 
 impl ContactList {
@@ -217,24 +268,105 @@ impl ContactList {
         self.start.len().saturating_sub(1)
     }
 
-    /// The contact history of the list by id: for each slot with springs, the key that
-    /// `key(owner, partner)` gives it and its springs.
-    fn history(&self, ids: usize, key: impl Fn(usize, u32) -> (u32, u32) + Sync) -> History {
-        let live = |k: usize| self.touched[k] && self.springs[k] != Springs::default();
-        let entries = || {
-            (0..self.owners())
-                .flat_map(move |i| self.run(i).filter(move |&k| live(k)).map(move |k| (i, k)))
-        };
+    /// Number of contacts (touching pairs).
+    pub fn contacts(&self) -> usize {
+        self.stores.iter().map(Store::len).sum()
+    }
+
+    /// Every slot with non-zero springs: owner, slot and springs, in slot order.
+    fn live(&self) -> impl Iterator<Item = (usize, usize, Springs)> + '_ {
+        (0..self.pieces.len().saturating_sub(1)).flat_map(move |p| {
+            let store = &self.stores[p];
+            (self.pieces[p] as usize..self.pieces[p + 1] as usize).flat_map(move |i| {
+                self.run(i).filter_map(move |k| match self.contact[k] {
+                    NONE => None,
+                    c => {
+                        let s = store.springs[c as usize];
+                        (s != Springs::default()).then_some((i, k, s))
+                    }
+                })
+            })
+        })
+    }
+
+    /// The contact history of the list: for each slot with springs, the key that
+    /// `key(owner, partner)` gives it (first keys below `keys`) and its springs.
+    fn history(&self, keys: usize, key: impl Fn(usize, u32) -> (u32, u32) + Sync) -> History {
         History::from_entries(
-            ids,
-            entries().map(|(i, k)| key(i, self.partner[k]).0),
-            entries().map(|(i, k)| {
-                let (id, other) = key(i, self.partner[k]);
-                (id, other, self.springs[k])
+            keys,
+            self.live().map(|(i, k, _)| key(i, self.partner[k]).0),
+            self.live().map(|(i, k, s)| {
+                let (a, other) = key(i, self.partner[k]);
+                (a, other, s)
             }),
         )
     }
+
+    /// A list from runs in compressed form cut into pieces at `pieces` (owner bounds), each
+    /// slot with the springs `history` holds for (owner, partner), found by merging each
+    /// run with the owner's history run (both ascending).
+    fn with_springs(
+        start: Vec<u32>,
+        partner: Vec<u32>,
+        pieces: Vec<u32>,
+        history: &History,
+    ) -> ContactList {
+        let mut contact = vec![NONE; partner.len()];
+        let slots: Vec<usize> = pieces.iter().map(|&o| start[o as usize] as usize).collect();
+        let stores: Vec<Store> = (0..pieces.len().saturating_sub(1))
+            .zip(cut(&mut contact, &slots))
+            .collect::<Vec<_>>()
+            .into_par_iter()
+            .map(|(p, contact)| {
+                let first = slots[p];
+                let mut store = Store::default();
+                for i in pieces[p] as usize..pieces[p + 1] as usize {
+                    let run = start[i] as usize..start[i + 1] as usize;
+                    let (other, carried) = history.run(i);
+                    let mut h = 0;
+                    for k in run {
+                        let j = partner[k];
+                        while h < other.len() && other[h] < j {
+                            h += 1;
+                        }
+                        if other.get(h) == Some(&j) && carried[h] != Springs::default() {
+                            contact[k - first] = store.springs.len() as u32;
+                            store.springs.push(carried[h]);
+                        }
+                    }
+                }
+                store.springs.shrink_to_fit();
+                store
+            })
+            .collect();
+        ContactList {
+            start,
+            partner,
+            contact,
+            pieces,
+            stores,
+        }
+    }
 }
+
+/// Owner bounds of pieces of at least `size` slots of a list with run starts `start` (the
+/// last piece may be shorter).
+fn pieces_of(start: &[u32], size: usize) -> Vec<u32> {
+    let mut bounds = vec![0u32];
+    let owners = start.len().saturating_sub(1);
+    for i in 1..owners {
+        if (start[i] - start[bounds[bounds.len() - 1] as usize]) as usize >= size {
+            bounds.push(i as u32);
+        }
+    }
+    if owners > 0 {
+        bounds.push(owners as u32);
+    }
+    bounds
+}
+
+/// Slots per piece of the particle-face list (a task of the mesh stage).
+pub const FACE_PIECE: usize = 256;
 
 /// A contact history: the springs of particle pairs keyed by (lower, higher) and of
 /// particle-face contacts by (particle, face), where particles are named by id (in
@@ -417,10 +549,6 @@ pub struct Neighbours {
     pub pairs: ContactList,
     /// Particle-face pairs.
     pub faces: ContactList,
-    /// Slabs of owners for the pair-force stage: slab `s` is owners `slabs[s]..slabs[s+1]`,
-    /// and every partner of an owner in slab `s` lies in slab `s` or `s + 1`. So the even
-    /// slabs can add their forces to their particles at the same time, then the odd ones.
-    pub slabs: Vec<u32>,
     /// Positions at the last rebuild (the anchors of the Verlet criterion).
     x_at_build: Vec<DVec3>,
     /// Particles with nothing within reach at the last rebuild, each with how far it may
@@ -433,17 +561,15 @@ pub struct Neighbours {
 /// The fewest owners in a slab (a task of the pair stage).
 const MIN_SLAB: usize = 64;
 
-/// Slab bounds over owners such that the partners of slab `s` lie in slabs `s` and `s + 1`:
-/// slab `s + 2` starts beyond the last partner of slab `s`.
-fn slabs_of(pairs: &ContactList) -> Vec<u32> {
-    let n = pairs.owners();
+/// The pieces of the pair list, slabs: owner bounds such that the partners of slab `s` lie
+/// in slabs `s` and `s + 1` (slab `s + 2` starts beyond the last partner of slab `s`). So
+/// the pair stage can run the even slabs at the same time, each adding forces to its own
+/// particles and the next slab's, then the odd ones.
+fn slabs_of(start: &[u32], partner: &[u32]) -> Vec<u32> {
+    let n = start.len().saturating_sub(1);
     let reach = |i: usize| {
-        let run = pairs.run(i);
-        if run.is_empty() {
-            i
-        } else {
-            pairs.partner[run.end - 1] as usize
-        }
+        let (a, b) = (start[i] as usize, start[i + 1] as usize);
+        if a == b { i } else { partner[b - 1] as usize }
     };
     let mut bounds = vec![0u32];
     if n == 0 {
@@ -657,9 +783,10 @@ impl Neighbours {
             faces: self.faces.history(n, |i, f| (new[i], f)),
         };
         drop(new);
-        // The old lists go before the new ones are made.
+        // The old lists and anchors go before the new ones are made.
         self.pairs = ContactList::default();
         self.faces = ContactList::default();
+        self.x_at_build = Vec::new();
         if let Some(order) = order {
             particles.permute(&order);
         }
@@ -800,7 +927,8 @@ impl Neighbours {
             compress(n, pairs.iter().map(|&k| ((k >> 32) as u32, k as u32)))
         };
         drop(grid);
-        self.pairs = ContactList::with_springs(start, partner, &history.pairs);
+        let slabs = slabs_of(&start, &partner);
+        self.pairs = ContactList::with_springs(start, partner, slabs, &history.pairs);
 
         // The items of a grid cell come in ascending order, so each particle's run of faces
         // is sorted.
@@ -819,53 +947,8 @@ impl Neighbours {
             .collect();
         let (start, partner) = compress(n, face_pairs.iter().copied());
         drop(face_pairs);
-        self.faces = ContactList::with_springs(start, partner, &history.faces);
-        self.slabs = slabs_of(&self.pairs);
-    }
-}
-
-impl ContactList {
-    /// A list from runs in compressed form, each slot with the springs `history` holds for
-    /// (owner, partner), found by merging each run with the owner's history run (both
-    /// ascending).
-    fn with_springs(start: Vec<u32>, partner: Vec<u32>, history: &History) -> ContactList {
-        let owners = start.len().saturating_sub(1);
-        let mut springs = vec![Springs::default(); partner.len()];
-        let mut touched = vec![false; partner.len()];
-        // Pieces of 1024 owners, each filling its own slots.
-        let bounds: Vec<usize> = (0..owners)
-            .step_by(1024)
-            .chain(std::iter::once(owners))
-            .collect();
-        let slots: Vec<usize> = bounds.iter().map(|&o| start[o] as usize).collect();
-        let pieces: Vec<_> = (0..bounds.len() - 1)
-            .zip(cut(&mut springs, &slots))
-            .zip(cut(&mut touched, &slots))
-            .collect();
-        pieces.into_par_iter().for_each(|((p, springs), touched)| {
-            let first = slots[p];
-            for i in bounds[p]..bounds[p + 1] {
-                let run = start[i] as usize..start[i + 1] as usize;
-                let (other, carried) = history.run(i);
-                let mut h = 0;
-                for k in run {
-                    let j = partner[k];
-                    while h < other.len() && other[h] < j {
-                        h += 1;
-                    }
-                    if other.get(h) == Some(&j) && carried[h] != Springs::default() {
-                        springs[k - first] = carried[h];
-                        touched[k - first] = true;
-                    }
-                }
-            }
-        });
-        ContactList {
-            start,
-            partner,
-            springs,
-            touched,
-        }
+        let pieces = pieces_of(&start, FACE_PIECE);
+        self.faces = ContactList::with_springs(start, partner, pieces, &history.faces);
     }
 }
 
@@ -995,7 +1078,7 @@ mod tests {
     fn listed(nb: &Neighbours, p: &Particles) -> Vec<(u32, u32)> {
         let list = &nb.pairs;
         let mut pairs = Vec::new();
-        let slabs = &nb.slabs;
+        let slabs = &nb.pairs.pieces;
         for s in 0..slabs.len() - 1 {
             let limit = slabs.get(s + 2).copied().unwrap_or(slabs[slabs.len() - 1]);
             for i in slabs[s] as usize..slabs[s + 1] as usize {
@@ -1071,7 +1154,7 @@ mod tests {
         for k in 0..p.len() {
             assert_eq!(p.x[k], x[p.id[k] as usize]);
         }
-        assert!(nb.slabs.len() > 3, "{:?}", nb.slabs);
+        assert!(nb.pairs.pieces.len() > 3, "{:?}", nb.pairs.pieces);
     }
 
     #[test]
@@ -1088,11 +1171,14 @@ mod tests {
         nb.rebuild(&mut p, &[], &CellGrid::default());
         assert_eq!(listed(&nb, &p), vec![(0, 3), (1, 2)]);
         // Give each pair springs that name it, then move the pairs past each other.
+        let list = &mut nb.pairs;
         for i in 0..p.len() {
-            for k in nb.pairs.run(i) {
-                let id = p.id[i].min(p.id[nb.pairs.partner[k] as usize]);
-                nb.pairs.springs[k].u_t = id as f64 + 1.0;
-                nb.pairs.touched[k] = true;
+            let piece = list.pieces.partition_point(|&b| b as usize <= i) - 1;
+            for k in list.start[i] as usize..list.start[i + 1] as usize {
+                let id = p.id[i].min(p.id[list.partner[k] as usize]);
+                let e = list.stores[piece].open();
+                list.stores[piece].springs[e as usize].u_t = id as f64 + 1.0;
+                list.contact[k] = e;
             }
         }
         for x in &mut p.x {

@@ -18,16 +18,14 @@ use crate::lanes::{Gather, Lanes};
 use crate::mesh::{Contacts, Face, Mesh};
 use crate::motion::{Motion, Pose, RigidVelocity};
 use crate::neighbours::{
-    CellGrid, ContactList, Histories, History, MIN_PARALLEL_LEN, Neighbours, cut, face_grid,
+    CellGrid, ContactList, FACE_PIECE, Histories, History, MIN_PARALLEL_LEN, NONE, Neighbours,
+    Store, cut, face_grid,
 };
 use crate::particles::Particles;
 use crate::scenario::{MeshSource, Scenario, default_timestep};
 use crate::spawn::{Spawner, SpawnerState};
 use crate::surface::{self, Candidate, Fate};
 
-/// List slots per piece of the contact stages: small enough for stack buffers, large
-/// enough to fill lanes.
-const PIECE: usize = 256;
 /// Contacts per group evaluated together: 8 doubles fill an AVX-512 register, two AVX ones.
 const WIDTH: usize = 8;
 type Group = wide::f64x8;
@@ -47,63 +45,48 @@ impl Load {
     }
 }
 
-/// Owner bounds of pieces of at least `PIECE` slots of a list with run starts `start` (the
-/// last piece may be shorter): every owner's slots lie in one piece.
-fn owner_pieces(start: &[u32]) -> Vec<usize> {
-    let mut bounds = vec![0];
-    let owners = start.len().saturating_sub(1);
-    for i in 1..owners {
-        if (start[i] - start[bounds[bounds.len() - 1]]) as usize >= PIECE {
-            bounds.push(i);
-        }
-    }
-    if owners > 0 {
-        bounds.push(owners);
-    }
-    bounds
-}
-
-/// A piece of owners `owners` of a contact list: their loads, and the springs and touched
-/// flags of their slots (which start at slot `first`).
+/// A piece of owners `owners` of a contact list: their loads, and the contacts of their
+/// slots (which start at slot `first`) with the piece's store.
 struct Piece<'a> {
     owners: std::ops::Range<usize>,
     first: usize,
     loads: &'a mut [Load],
-    springs: &'a mut [Springs],
-    touched: &'a mut [bool],
+    contact: &'a mut [u32],
+    store: &'a mut Store,
 }
 
-/// The pieces of owners cut at `bounds`, with their `loads` and the `springs` and `touched`
-/// flags of their slots in a list with run starts `start`.
+/// The pieces of a contact list (its run starts `start`, owner bounds `bounds` of its pieces,
+/// its slots' `contact` and its `stores`), each with the `loads` of its owners.
 fn pieces<'a>(
-    bounds: &[usize],
+    bounds: &[u32],
     loads: &'a mut [Load],
     start: &[u32],
-    springs: &'a mut [Springs],
-    touched: &'a mut [bool],
+    contact: &'a mut [u32],
+    stores: &'a mut [Store],
 ) -> Vec<Piece<'a>> {
-    let slots: Vec<usize> = bounds.iter().map(|&o| start[o] as usize).collect();
-    cut(loads, bounds)
+    let owners: Vec<usize> = bounds.iter().map(|&o| o as usize).collect();
+    let slots: Vec<usize> = owners.iter().map(|&o| start[o] as usize).collect();
+    cut(loads, &owners)
         .into_iter()
-        .zip(cut(springs, &slots))
-        .zip(cut(touched, &slots))
+        .zip(cut(contact, &slots))
+        .zip(stores.iter_mut())
         .enumerate()
-        .map(|(k, ((loads, springs), touched))| Piece {
-            owners: bounds[k]..bounds[k + 1],
+        .map(|(k, ((loads, contact), store))| Piece {
+            owners: owners[k]..owners[k + 1],
             first: slots[k],
             loads,
-            springs,
-            touched,
+            contact,
+            store,
         })
         .collect()
 }
 
-/// The springs of slots `k` in the lanes of a group.
+/// The springs of store entries `c` in the lanes of a group.
 #[inline(always)]
-fn gather_springs(springs: &[Springs], k: [usize; WIDTH]) -> Springs<Group> {
+fn gather_springs(store: &Store, c: [u32; WIDTH]) -> Springs<Group> {
     let (mut u_s, mut u_r, mut u_t) = ([DVec3::ZERO; WIDTH], [DVec3::ZERO; WIDTH], [0.0; WIDTH]);
     for l in 0..WIDTH {
-        let s = &springs[k[l]];
+        let s = &store.springs[c[l] as usize];
         (u_s[l], u_r[l], u_t[l]) = (s.u_s, s.u_r, s.u_t);
     }
     Springs {
@@ -113,16 +96,17 @@ fn gather_springs(springs: &[Springs], k: [usize; WIDTH]) -> Springs<Group> {
     }
 }
 
-/// Puts the springs of a group's lanes back into slots `k` (the first `k.len()` lanes).
+/// Puts the springs of a group's lanes back into store entries `c` (the first `c.len()`
+/// lanes).
 #[inline(always)]
-fn scatter_springs(lanes: Springs<Group>, springs: &mut [Springs], k: &[usize]) {
+fn scatter_springs(lanes: Springs<Group>, store: &mut Store, c: &[u32]) {
     let (u_s, u_r, u_t) = (
         Group::scatter_vec(lanes.u_s),
         Group::scatter_vec(lanes.u_r),
         lanes.u_t.scatter(),
     );
-    for (l, &k) in k.iter().enumerate() {
-        springs[k] = Springs {
+    for (l, &c) in c.iter().enumerate() {
+        store.springs[c as usize] = Springs {
             u_s: u_s[l],
             u_r: u_r[l],
             u_t: u_t[l],
@@ -378,8 +362,6 @@ pub struct Simulation {
     /// Force and torque on each particle (storage order), summed by stages 3 and 4 and used
     /// up by stage 5.
     loads: Vec<Load>,
-    /// Owner bounds of the pieces of the particle-face list for stage 4.
-    face_pieces: Vec<usize>,
     /// The mesh as read (at t = 0).
     rest_faces: Vec<Face>,
     /// Parts of the mesh that follow a prescribed motion.
@@ -549,7 +531,6 @@ impl Simulation {
             face_grid,
             spawner: Spawner::new(scenario.simulation.seed),
             loads: Vec::new(),
-            face_pieces: vec![0],
             rest_faces: mesh.faces.clone(),
             moving: Vec::new(),
             face_part: vec![STATIC; mesh.faces.len()],
@@ -585,9 +566,7 @@ impl Simulation {
 
     /// Number of particle-particle and particle-face contacts in the last step.
     pub fn contact_count(&self) -> usize {
-        let nb = &self.neighbours;
-        let touching = |t: &[bool]| t.iter().filter(|&&t| t).count();
-        touching(&nb.pairs.touched) + touching(&nb.faces.touched)
+        self.neighbours.pairs.contacts() + self.neighbours.faces.contacts()
     }
 
     /// Advances the simulation by one time step Δt.
@@ -808,7 +787,6 @@ impl Simulation {
     fn built(&mut self) {
         self.loads.clear();
         self.loads.resize(self.particles.len(), Load::default());
-        self.face_pieces = owner_pieces(&self.neighbours.faces.start);
         self.built_at = self.steps;
         self.mark_mesh_built();
     }
@@ -830,20 +808,20 @@ impl Simulation {
         let p = &self.particles;
         let law = &self.law;
         let density = self.scenario.material.density;
-        let slabs: Vec<usize> = self.neighbours.slabs.iter().map(|&o| o as usize).collect();
         let ContactList {
             start,
             partner,
-            springs,
-            touched,
+            contact,
+            pieces: slabs,
+            stores,
         } = &mut self.neighbours.pairs;
-        let (start, partner) = (&*start, &*partner);
+        let (start, partner, slabs) = (&*start, &*partner, &*slabs);
         thread_local! {
             static TOUCHING: std::cell::RefCell<Vec<[u32; 3]>> = Default::default();
         }
         for phase in 0..2 {
             let mut all: Vec<Option<Piece>> =
-                pieces(&slabs, &mut self.loads, start, springs, touched)
+                pieces(slabs, &mut self.loads, start, contact, stores)
                     .into_iter()
                     .map(Some)
                     .collect();
@@ -861,12 +839,13 @@ impl Simulation {
                         owners,
                         first,
                         loads,
-                        springs,
-                        touched,
+                        contact,
+                        store,
                     } = slab;
                     let mut next_loads = next.map(|n| (n.owners.start, n.loads));
                     // The touching pairs: the particle of the lower id (body i of the law,
-                    // whatever the storage order), the other, and the slot (in the slab).
+                    // whatever the storage order), the other, and the contact's entry in the
+                    // slab's store (opened at first touch, closed when the pair parts).
                     touching.clear();
                     for i in owners.clone() {
                         let (xi, ri) = (p.x[i], p.radius[i]);
@@ -876,12 +855,14 @@ impl Simulation {
                             let reach = ri + p.radius[j];
                             if (xi - p.x[j]).length_squared() < reach * reach {
                                 let (a, b) = if p.id[i] < p.id[j] { (i, j) } else { (j, i) };
-                                touching.push([a as u32, b as u32, kl as u32]);
-                                touched[kl] = true;
-                            } else if touched[kl] {
+                                if contact[kl] == NONE {
+                                    contact[kl] = store.open();
+                                }
+                                touching.push([a as u32, b as u32, contact[kl]]);
+                            } else if contact[kl] != NONE {
                                 // The contact ended: forget its history.
-                                springs[kl] = Springs::default();
-                                touched[kl] = false;
+                                store.close(contact[kl]);
+                                contact[kl] = NONE;
                             }
                         }
                     }
@@ -897,10 +878,10 @@ impl Simulation {
                     };
                     for group in touching.chunks(WIDTH) {
                         // A short last group repeats its last pair in the spare lanes.
-                        let (mut i, mut j, mut k) = ([0; WIDTH], [0; WIDTH], [0; WIDTH]);
+                        let (mut i, mut j, mut c) = ([0; WIDTH], [0; WIDTH], [0; WIDTH]);
                         for l in 0..WIDTH {
-                            let [a, b, kl] = group[l.min(group.len() - 1)];
-                            (i[l], j[l], k[l]) = (a as usize, b as usize, kl as usize);
+                            let [a, b, e] = group[l.min(group.len() - 1)];
+                            (i[l], j[l], c[l]) = (a as usize, b as usize, e);
                         }
                         let body = |idx: [usize; WIDTH]| Body::<Group> {
                             x: Group::gather_vec_at(&p.x, &idx),
@@ -916,14 +897,14 @@ impl Simulation {
                             d,
                             Group::dot(d, d),
                         );
-                        let mut lanes = gather_springs(springs, k);
+                        let mut lanes = gather_springs(store, c);
                         let other = Other::Particle {
                             r: body_j.radius,
                             m: Inertia::mass(body_j.radius, density),
                         };
                         let m_i = Inertia::mass(body_i.radius, density);
                         let force = law.evaluate(body_i.radius, m_i, other, &kin, &mut lanes);
-                        scatter_springs(lanes, springs, &k[..group.len()]);
+                        scatter_springs(lanes, store, &c[..group.len()]);
                         let (f, tau_i, tau_j) = (
                             Group::scatter_vec(force.f),
                             Group::scatter_vec(force.tau_i),
@@ -974,24 +955,25 @@ impl Simulation {
         let ContactList {
             start,
             partner,
-            springs,
-            touched,
+            contact,
+            pieces: bounds,
+            stores,
         } = &mut self.neighbours.faces;
         let (start, partner) = (&*start, &*partner);
         thread_local! {
             static SCRATCH: std::cell::RefCell<MeshScratch> = Default::default();
         }
-        let all = pieces(&self.face_pieces, &mut self.loads, start, springs, touched);
+        let all = pieces(bounds, &mut self.loads, start, contact, stores);
         all.into_par_iter()
-            .with_min_len(MIN_PARALLEL_LEN.div_ceil(PIECE))
+            .with_min_len(MIN_PARALLEL_LEN.div_ceil(FACE_PIECE))
             .for_each(|piece| {
                 SCRATCH.with_borrow_mut(|scratch| {
                     let Piece {
                         owners,
                         first,
                         loads,
-                        springs,
-                        touched,
+                        contact,
+                        store,
                     } = piece;
                     let MeshScratch {
                         near,
@@ -1017,21 +999,21 @@ impl Simulation {
                         for (k, &f) in run.clone().zip(&partner[run]) {
                             let kl = k - first;
                             let face = &faces[f as usize];
-                            let contact =
-                                if face.certainly_beyond(body.x, body.radius + face.radius) {
-                                    None
-                                } else {
-                                    let wall = match face_part[f as usize] {
-                                        STATIC => RigidVelocity::default(),
-                                        part => moving[part as usize].velocity,
-                                    };
-                                    let (d, feature) = face.separation_and_feature(body.x);
-                                    let (d, interior) =
-                                        surface::snap(face, body.x, body.radius, d, feature);
-                                    Kinematics::with_wall(&body, d, face.radius, &wall)
-                                        .map(|kin| (kin, d, interior))
+                            let touch = if face.certainly_beyond(body.x, body.radius + face.radius)
+                            {
+                                None
+                            } else {
+                                let wall = match face_part[f as usize] {
+                                    STATIC => RigidVelocity::default(),
+                                    part => moving[part as usize].velocity,
                                 };
-                            match contact {
+                                let (d, feature) = face.separation_and_feature(body.x);
+                                let (d, interior) =
+                                    surface::snap(face, body.x, body.radius, d, feature);
+                                Kinematics::with_wall(&body, d, face.radius, &wall)
+                                    .map(|kin| (kin, d, interior))
+                            };
+                            match touch {
                                 Some((kin, d, interior)) => near.push(Near {
                                     owner: i as u32,
                                     slot: kl,
@@ -1039,10 +1021,10 @@ impl Simulation {
                                     d,
                                     interior,
                                 }),
-                                None if touched[kl] => {
+                                None if contact[kl] != NONE => {
                                     // The contact ended: forget its history.
-                                    springs[kl] = Springs::default();
-                                    touched[kl] = false;
+                                    store.close(contact[kl]);
+                                    contact[kl] = NONE;
                                 }
                                 None => {}
                             }
@@ -1071,10 +1053,18 @@ impl Simulation {
                             let tol = surface::tolerance(x, radius);
                             surface::resolve(candidates, faces, tol, order, fates);
                             for (c, fate) in near[a..b].iter().zip(fates.iter()) {
-                                if let Fate::Absorbed(s) = *fate {
-                                    let s = near[a + s].slot;
-                                    if springs[s] == Springs::default() {
-                                        springs[s] = springs[c.slot];
+                                let Fate::Absorbed(s) = *fate else { continue };
+                                let (k, s) = (c.slot, near[a + s].slot);
+                                let none = |e: u32| {
+                                    e == NONE || store.springs[e as usize] == Springs::default()
+                                };
+                                if none(contact[s]) && contact[k] != NONE {
+                                    if contact[s] == NONE {
+                                        // The absorbing contact takes over the entry.
+                                        (contact[s], contact[k]) = (contact[k], NONE);
+                                    } else {
+                                        let e = contact[k] as usize;
+                                        store.springs[contact[s] as usize] = store.springs[e];
                                     }
                                 }
                             }
@@ -1090,11 +1080,13 @@ impl Simulation {
                                         limit: radius,
                                     });
                                 }
+                                if contact[k] == NONE {
+                                    contact[k] = store.open();
+                                }
                                 contacts.push((a + c) as u32);
-                                touched[k] = true;
-                            } else if touched[k] {
-                                springs[k] = Springs::default();
-                                touched[k] = false;
+                            } else if contact[k] != NONE {
+                                store.close(contact[k]);
+                                contact[k] = NONE;
                             }
                         }
                         a = b;
@@ -1104,7 +1096,7 @@ impl Simulation {
                     for group in contacts.chunks(WIDTH) {
                         let c: [&Near; WIDTH] =
                             std::array::from_fn(|l| &near[group[l.min(group.len() - 1)] as usize]);
-                        let k = c.map(|c| c.slot);
+                        let e = c.map(|c| contact[c.slot]);
                         let i = c.map(|c| c.owner as usize);
                         let scalar =
                             |get: fn(&Kinematics) -> f64| Group::gather(c.map(|c| get(&c.kin)));
@@ -1121,9 +1113,9 @@ impl Simulation {
                         };
                         let radius = Group::gather(i.map(|i| p.radius[i]));
                         let mass = Inertia::mass(radius, density);
-                        let mut lanes = gather_springs(springs, k);
+                        let mut lanes = gather_springs(store, e);
                         let force = law.evaluate(radius, mass, Other::Wall, &kin, &mut lanes);
-                        scatter_springs(lanes, springs, &k[..group.len()]);
+                        scatter_springs(lanes, store, &e[..group.len()]);
                         let (f, tau) =
                             (Group::scatter_vec(force.f), Group::scatter_vec(force.tau_i));
                         for l in 0..group.len() {
