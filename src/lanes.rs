@@ -332,15 +332,7 @@ pub trait Gather<const N: usize>: Lanes<Vec = V3<Self>, Quat = Q4<Self>> {
 
     #[inline(always)]
     fn gather_vec(v: [DVec3; N]) -> V3<Self> {
-        let (mut x, mut y, mut z) = ([0.0; N], [0.0; N], [0.0; N]);
-        for l in 0..N {
-            (x[l], y[l], z[l]) = (v[l].x, v[l].y, v[l].z);
-        }
-        V3 {
-            x: Self::gather(x),
-            y: Self::gather(y),
-            z: Self::gather(z),
-        }
+        Self::gather_vec_at(&v, &std::array::from_fn(|l| l))
     }
 
     /// `values[idx[l]]` in lane `l`.
@@ -380,16 +372,7 @@ pub trait Gather<const N: usize>: Lanes<Vec = V3<Self>, Quat = Q4<Self>> {
 
     #[inline(always)]
     fn gather_quat(q: [DQuat; N]) -> Q4<Self> {
-        let (mut x, mut y, mut z, mut w) = ([0.0; N], [0.0; N], [0.0; N], [0.0; N]);
-        for l in 0..N {
-            (x[l], y[l], z[l], w[l]) = (q[l].x, q[l].y, q[l].z, q[l].w);
-        }
-        Q4 {
-            x: Self::gather(x),
-            y: Self::gather(y),
-            z: Self::gather(z),
-            w: Self::gather(w),
-        }
+        Self::gather_quat_at(&q, &std::array::from_fn(|l| l))
     }
 
     /// `values[idx[l]]` in lane `l`.
