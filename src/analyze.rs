@@ -130,6 +130,7 @@ mod tests {
             q: DQuat::IDENTITY,
             w: DVec3::ZERO,
             tag: 0,
+            material: 0,
         }
     }
 

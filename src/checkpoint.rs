@@ -5,7 +5,7 @@
 //! (u64), step (u64), step of the last neighbour-list rebuild (u64), spawner word position
 //! (u128), pending radius flag (u8) and value (f64), the next particle id (u32), particle
 //! count (u64) and per particle, in storage order: its id (u32), 14 f64 (x, y, z, R, vx, vy,
-//! vz, q0..q3, wx, wy, wz) and its tag (u32); whether the lists were built (u8) and if so
+//! vz, q0..q3, wx, wy, wz), its tag (u32) and material (u16); whether the lists were built (u8) and if so
 //! each particle's position at the last rebuild (3 f64); the lonely particles of the last
 //! rebuild: count (u64) and per entry storage index (u32) and allowance (f64); then the particle-pair and particle-face histories: count (u64) and per
 //! entry the ids (lower, higher) or the id and face (u32, u32) and the springs u_s, u_r (3 f64
@@ -24,11 +24,13 @@ use crate::contact::Springs;
 use crate::mesh::Mesh;
 use crate::particles::{Particle, Particles};
 use crate::scenario::Scenario;
-use crate::simulation::Snapshot;
+use crate::simulation::{Outflow, Removed, Snapshot, Wrench};
 use crate::spawn::SpawnerState;
 
 const MAGIC: &[u8; 12] = b"TINYDEM CKPT";
-const VERSION: u32 = 2;
+const VERSION: u32 = 3;
+/// The oldest version this program reads.
+const OLDEST: u32 = 2;
 
 /// A fingerprint of everything a checkpoint's state depends on: the physics, time step,
 /// spawning and mesh. The number of frames and the output may change on resume.
@@ -98,6 +100,7 @@ pub fn encode(snapshot: &Snapshot, fingerprint: u64) -> Vec<u8> {
             ],
         );
         out.extend_from_slice(&q.tag.to_le_bytes());
+        out.extend_from_slice(&q.material.to_le_bytes());
     }
     let built = snapshot.anchors.len() == p.len() && !p.is_empty();
     out.push(built as u8);
@@ -113,6 +116,20 @@ pub fn encode(snapshot: &Snapshot, fingerprint: u64) -> Vec<u8> {
     }
     put_history(&mut out, &snapshot.pair_history);
     put_history(&mut out, &snapshot.face_history);
+    let removed = &snapshot.removed;
+    let put_outflow = |out: &mut Vec<u8>, o: &Outflow| {
+        out.extend_from_slice(&o.count.to_le_bytes());
+        put_f64s(out, &[o.mass]);
+    };
+    put_outflow(&mut out, &removed.domain);
+    out.extend_from_slice(&(removed.outlets.len() as u64).to_le_bytes());
+    for o in &removed.outlets {
+        put_outflow(&mut out, o);
+    }
+    out.extend_from_slice(&(snapshot.wall_sums.len() as u64).to_le_bytes());
+    for w in &snapshot.wall_sums {
+        put_f64s(&mut out, &[w.f.x, w.f.y, w.f.z, w.tau.x, w.tau.y, w.tau.z]);
+    }
     let crc = crc32fast::hash(&out);
     out.extend_from_slice(&crc.to_le_bytes());
     out
@@ -137,6 +154,9 @@ impl Reader<'_> {
     }
     fn u8(&mut self) -> Result<u8> {
         Ok(self.take(1)?[0])
+    }
+    fn u16(&mut self) -> Result<u16> {
+        Ok(u16::from_le_bytes(self.take(2)?.try_into()?))
     }
     fn u32(&mut self) -> Result<u32> {
         Ok(u32::from_le_bytes(self.take(4)?.try_into()?))
@@ -186,8 +206,10 @@ pub fn decode(bytes: &[u8], expected_fingerprint: u64) -> Result<Snapshot> {
     }
     let (body, crc) = bytes.split_at(bytes.len() - 4);
     let version = u32::from_le_bytes(bytes[12..16].try_into()?);
-    if version != VERSION {
-        bail!("checkpoint format version {version}; this tinydem reads version {VERSION}");
+    if !(OLDEST..=VERSION).contains(&version) {
+        bail!(
+            "checkpoint format version {version}; this tinydem reads versions {OLDEST} to {VERSION}"
+        );
     }
     if crc32fast::hash(body).to_le_bytes() != crc {
         bail!("corrupt checkpoint: the checksum does not match (truncated or damaged file)");
@@ -211,7 +233,8 @@ pub fn decode(bytes: &[u8], expected_fingerprint: u64) -> Result<Snapshot> {
     let has_pending = r.u8()? != 0;
     let pending = r.f64()?;
     let next_id = r.u32()?;
-    let n = r.count(4 + 14 * 8 + 4)?;
+    let v3 = version >= 3;
+    let n = r.count(4 + 14 * 8 + 4 + if v3 { 2 } else { 0 })?;
     let mut particles = Particles::default();
     let mut ids = Vec::with_capacity(n);
     for _ in 0..n {
@@ -222,6 +245,7 @@ pub fn decode(bytes: &[u8], expected_fingerprint: u64) -> Result<Snapshot> {
         let (w0, q1, q2, q3) = (r.f64()?, r.f64()?, r.f64()?, r.f64()?);
         let w = r.vec3()?;
         let tag = r.u32()?;
+        let material = if v3 { r.u16()? } else { 0 };
         particles.push(Particle {
             x,
             radius,
@@ -229,6 +253,7 @@ pub fn decode(bytes: &[u8], expected_fingerprint: u64) -> Result<Snapshot> {
             q: DQuat::from_xyzw(q1, q2, q3, w0),
             w,
             tag,
+            material,
         });
     }
     let anchors = match r.u8()? {
@@ -250,6 +275,30 @@ pub fn decode(bytes: &[u8], expected_fingerprint: u64) -> Result<Snapshot> {
     }
     let pair_history = r.history()?;
     let face_history = r.history()?;
+    let mut removed = Removed::default();
+    let mut wall_sums = Vec::new();
+    if v3 {
+        let outflow = |r: &mut Reader| -> Result<Outflow> {
+            Ok(Outflow {
+                count: r.u64()?,
+                mass: r.f64()?,
+            })
+        };
+        removed.domain = outflow(&mut r)?;
+        let outlets = r.count(16)?;
+        removed.outlets = (0..outlets)
+            .map(|_| outflow(&mut r))
+            .collect::<Result<_>>()?;
+        let files = r.count(48)?;
+        wall_sums = (0..files)
+            .map(|_| {
+                Ok(Wrench {
+                    f: r.vec3()?,
+                    tau: r.vec3()?,
+                })
+            })
+            .collect::<Result<_>>()?;
+    }
     if r.at != body.len() {
         bail!(
             "corrupt checkpoint: {} unexpected bytes at the end",
@@ -268,6 +317,8 @@ pub fn decode(bytes: &[u8], expected_fingerprint: u64) -> Result<Snapshot> {
         lonely,
         pair_history,
         face_history,
+        removed,
+        wall_sums,
     })
 }
 
@@ -307,6 +358,7 @@ mod tests {
             q: DQuat::from_rotation_y(0.7),
             w: DVec3::new(1.0, 2.0, 3.0),
             tag: 7,
+            material: 0,
         });
         let s = Springs {
             u_s: DVec3::new(1e-5, 2e-6, 0.0),
@@ -327,6 +379,20 @@ mod tests {
             lonely: vec![(0, 0.25)],
             pair_history: vec![(3, 4, s)],
             face_history: vec![(3, 3, s)],
+            removed: Removed {
+                outlets: vec![Outflow {
+                    count: 3,
+                    mass: 1.5e-4,
+                }],
+                domain: Outflow {
+                    count: 1,
+                    mass: 2e-5,
+                },
+            },
+            wall_sums: vec![Wrench {
+                f: DVec3::new(1.0, -2.0, 3.0),
+                tau: DVec3::new(0.5, 0.25, -1e-9),
+            }],
         }
     }
 
@@ -334,6 +400,22 @@ mod tests {
     fn round_trip_is_exact() {
         let s = snapshot();
         assert_eq!(decode(&encode(&s, 7), 7).unwrap(), s);
+    }
+
+    #[test]
+    fn version_2_is_read() {
+        // A version 2 file: no material per particle, nothing removed, no wall loads.
+        let mut s = snapshot();
+        (s.removed, s.wall_sums) = (Removed::default(), Vec::new());
+        let v3 = encode(&s, 7);
+        let body = &v3[..v3.len() - 4];
+        // The one particle's record starts at byte 77 (after the header and the count); its
+        // material is the last 2 of its 122 bytes; the removal and load counts end the body.
+        let mut v2 = [&body[..77 + 120], &body[77 + 122..body.len() - 32]].concat();
+        v2[12..16].copy_from_slice(&2u32.to_le_bytes());
+        let crc = crc32fast::hash(&v2);
+        v2.extend_from_slice(&crc.to_le_bytes());
+        assert_eq!(decode(&v2, 7).unwrap(), s);
     }
 
     #[test]
@@ -348,6 +430,8 @@ mod tests {
         let mut version = bytes.clone();
         version[12] = 9;
         assert!(msg(&version, 7).contains("version 9"));
+        version[12] = 1;
+        assert!(msg(&version, 7).contains("version 1"));
         assert!(msg(b"hello world, not a checkpoint", 7).contains("not a tinydem checkpoint"));
         assert!(msg(b"", 7).contains("not a tinydem checkpoint"));
     }

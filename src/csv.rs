@@ -1,6 +1,7 @@
 //! Particle frames in the original program's CSV format:
 //! header `x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz`, one particle per line, full round-trip
-//! precision, files `particlesNNNNNN.csv`. Runs that tag particles add a last column `tag`.
+//! precision, files `particlesNNNNNN.csv`. Runs that tag particles add a column `tag`; runs
+//! that can remove particles (or have several materials) add `id` and `material` after it.
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::path::{Path, PathBuf};
@@ -14,18 +15,36 @@ pub const COLUMNS: [&str; 14] = [
     "x", "y", "z", "R", "vx", "vy", "vz", "q0", "q1", "q2", "q3", "wx", "wy", "wz",
 ];
 
+/// Whole-number columns a frame may carry beyond the fourteen.
+pub const INT_COLUMNS: [&str; 3] = ["tag", "id", "material"];
+
 /// The file name of frame `k`.
 pub fn frame_name(k: u64) -> String {
     format!("particles{k:06}.csv")
 }
 
-/// Writes all particles as CSV text in id order, with the `tag` column if `tags`.
-pub fn write_particles(out: &mut impl Write, p: &Particles, tags: bool) -> std::io::Result<()> {
+/// The columns of a frame beyond the original fourteen.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Extra {
+    /// `tag`
+    pub tag: bool,
+    /// `id` and `material`
+    pub ids: bool,
+}
+
+/// Writes all particles as CSV text in id order, with the `extra` columns.
+pub fn write_particles(out: &mut impl Write, p: &Particles, extra: Extra) -> std::io::Result<()> {
     let mut line = String::with_capacity(512);
     out.write_all(COLUMNS.join(",").as_bytes())?;
-    out.write_all(if tags { b",tag\n" } else { b"\n" })?;
+    if extra.tag {
+        out.write_all(b",tag")?;
+    }
+    if extra.ids {
+        out.write_all(b",id,material")?;
+    }
+    out.write_all(b"\n")?;
     let mut buf = ryu::Buffer::new();
-    for (_, q) in p.iter_by_id() {
+    for (id, q) in p.iter_by_id() {
         line.clear();
         let values = [
             q.x.x, q.x.y, q.x.z, q.radius, q.v.x, q.v.y, q.v.z, q.q.w, q.q.x, q.q.y, q.q.z, q.w.x,
@@ -37,9 +56,15 @@ pub fn write_particles(out: &mut impl Write, p: &Particles, tags: bool) -> std::
             }
             line.push_str(buf.format(*value));
         }
-        if tags {
+        if extra.tag {
             line.push(',');
             line.push_str(itoa::Buffer::new().format(q.tag));
+        }
+        if extra.ids {
+            line.push(',');
+            line.push_str(itoa::Buffer::new().format(id));
+            line.push(',');
+            line.push_str(itoa::Buffer::new().format(q.material));
         }
         line.push('\n');
         out.write_all(line.as_bytes())?;
@@ -49,17 +74,17 @@ pub fn write_particles(out: &mut impl Write, p: &Particles, tags: bool) -> std::
 
 /// Writes a frame file atomically: to a temporary name first, then renamed, so a crash
 /// never leaves a half-written frame behind.
-pub fn write_frame(dir: &Path, k: u64, p: &Particles, tags: bool) -> Result<PathBuf> {
-    write_frame_as(dir, &frame_name(k), p, tags)
+pub fn write_frame(dir: &Path, k: u64, p: &Particles, extra: Extra) -> Result<PathBuf> {
+    write_frame_as(dir, &frame_name(k), p, extra)
 }
 
 /// Writes particles atomically to `dir/name`.
-pub fn write_frame_as(dir: &Path, name: &str, p: &Particles, tags: bool) -> Result<PathBuf> {
+pub fn write_frame_as(dir: &Path, name: &str, p: &Particles, extra: Extra) -> Result<PathBuf> {
     let path = dir.join(name);
     let tmp = dir.join(format!(".{name}.tmp"));
     let write = || -> std::io::Result<()> {
         let mut w = std::io::BufWriter::with_capacity(1 << 20, std::fs::File::create(&tmp)?);
-        write_particles(&mut w, p, tags)?;
+        write_particles(&mut w, p, extra)?;
         w.into_inner().map_err(|e| e.into_error())?.sync_data()?;
         std::fs::rename(&tmp, &path)
     };
@@ -85,16 +110,21 @@ pub fn read_particles(input: impl Read, file: &str) -> Result<Particles> {
     }
     let names: Vec<&str> = header.trim().split(',').map(str::trim).collect();
     let mut slot = [usize::MAX; 14];
-    let mut tag_column = None;
+    // The optional whole-number columns: tag, id, material.
+    let mut int_column = [None; 3];
     for (col, name) in names.iter().enumerate() {
-        if *name == "tag" && tag_column.is_none() {
-            tag_column = Some(col);
+        if let Some(k) = INT_COLUMNS.iter().position(|c| c == name) {
+            if int_column[k].is_some() {
+                bail!("{file}:1: column '{name}' appears twice");
+            }
+            int_column[k] = Some(col);
             continue;
         }
         let Some(k) = COLUMNS.iter().position(|c| c == name) else {
             bail!(
-                "{file}:1: unknown column '{name}': expected the header '{}'",
-                COLUMNS.join(",")
+                "{file}:1: unknown column '{name}': expected the header '{}' (and optionally {})",
+                COLUMNS.join(","),
+                INT_COLUMNS.join(", ")
             );
         };
         if slot[k] != usize::MAX {
@@ -116,6 +146,7 @@ pub fn read_particles(input: impl Read, file: &str) -> Result<Particles> {
         quantity_of_column[col] = k;
     }
     let mut particles = Particles::default();
+    let mut ids = Vec::new();
     let mut values = [0.0f64; 14];
     let mut reader = lines;
     let mut buf = String::new();
@@ -133,16 +164,20 @@ pub fn read_particles(input: impl Read, file: &str) -> Result<Particles> {
             continue;
         }
         let mut count = 0;
-        let mut tag = 0u32;
+        let mut ints = [0u32; 3];
         for (col, text) in line.split(',').enumerate() {
             count += 1;
             if col >= names.len() {
                 continue;
             }
             let text = text.trim();
-            if Some(col) == tag_column {
-                tag = text.parse().map_err(|_| {
-                    anyhow::anyhow!("{file}:{n}: column {} ('tag'): expected a whole number >= 0, found '{text}'", col + 1)
+            if let Some(k) = int_column.iter().position(|&c| c == Some(col)) {
+                ints[k] = text.parse().map_err(|_| {
+                    anyhow::anyhow!(
+                        "{file}:{n}: column {} ('{}'): expected a whole number >= 0, found '{text}'",
+                        col + 1,
+                        INT_COLUMNS[k]
+                    )
                 })?;
                 continue;
             }
@@ -187,8 +222,26 @@ pub fn read_particles(input: impl Read, file: &str) -> Result<Particles> {
                 q / norm
             },
             w: DVec3::new(v[11], v[12], v[13]),
-            tag,
+            tag: ints[0],
+            material: u16::try_from(ints[2])
+                .map_err(|_| anyhow::anyhow!("{file}:{n}: material {} is out of range", ints[2]))?,
         });
+        if int_column[1].is_some() {
+            ids.push(ints[1]);
+        }
+    }
+    if int_column[1].is_some() {
+        // The particles keep the ids of the file (a frame of a run that removed some).
+        let mut sorted = ids.clone();
+        sorted.sort_unstable();
+        if let Some(w) = sorted.windows(2).find(|w| w[0] == w[1]) {
+            bail!("{file}: particle id {} appears twice", w[0]);
+        }
+        if sorted.last().is_some_and(|&m| m >= u32::MAX / 2) {
+            bail!("{file}: particle ids must be below {}", u32::MAX / 2);
+        }
+        particles.next_id = sorted.last().map_or(0, |&m| m + 1);
+        particles.id = ids;
     }
     Ok(particles)
 }
@@ -213,13 +266,54 @@ mod tests {
             q: DQuat::from_rotation_x(0.3),
             w: DVec3::new(1.0, 2.0, 3.0),
             tag: 42,
+            material: 0,
         }]
         .into_iter()
         .collect();
         let mut text = Vec::new();
-        write_particles(&mut text, &p, true).unwrap();
+        write_particles(
+            &mut text,
+            &p,
+            Extra {
+                tag: true,
+                ids: false,
+            },
+        )
+        .unwrap();
         let back = read_particles(&text[..], "t").unwrap();
         assert_eq!(back, p);
+    }
+
+    #[test]
+    fn ids_and_materials_round_trip() {
+        let mut p: Particles = (0..3)
+            .map(|k| Particle {
+                x: DVec3::new(k as f64, 0.0, 0.0),
+                radius: 0.004,
+                v: DVec3::ZERO,
+                q: DQuat::IDENTITY,
+                w: DVec3::ZERO,
+                tag: 0,
+                material: k as u16,
+            })
+            .collect();
+        // Ids with gaps (particles 1, 4 and 6 removed), stored out of id order.
+        p.id = vec![7, 2, 5];
+        p.next_id = 8;
+        let mut text = Vec::new();
+        let extra = Extra {
+            tag: false,
+            ids: true,
+        };
+        write_particles(&mut text, &p, extra).unwrap();
+        let text = String::from_utf8(text).unwrap();
+        assert!(text.starts_with("x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz,id,material\n1.0,"));
+        let back = read_particles(text.as_bytes(), "t").unwrap();
+        assert_eq!(back.id, vec![2, 5, 7]);
+        assert_eq!(back.material, vec![1, 2, 0]);
+        assert_eq!(back.next_id, 8);
+        let twice = text.replace(",7,0\n", ",2,0\n");
+        assert!(err(&twice).contains("particle id 2 appears twice"));
     }
 
     fn err(text: &str) -> String {

@@ -308,6 +308,20 @@ fn report(summary: &Summary, out: &std::path::Path) {
         out.display(),
         summary.wall_seconds
     );
+    let r = &summary.removed;
+    if r.count() > 0 {
+        let mut by = Vec::new();
+        for (k, o) in r.outlets.iter().enumerate() {
+            by.push(format!("outlet {k}: {} ({:.6e} kg)", o.count, o.mass));
+        }
+        if r.domain.count > 0 {
+            by.push(format!(
+                "left the domain: {} ({:.6e} kg)",
+                r.domain.count, r.domain.mass
+            ));
+        }
+        eprintln!("removed {} particles: {}", r.count(), by.join(", "));
+    }
     let times = &summary.stage_times;
     let mut parts: Vec<(&str, f64)> = Stage::ALL
         .iter()

@@ -290,15 +290,19 @@ impl ContactList {
     }
 
     /// The contact history of the list: for each slot with springs, the key that
-    /// `key(owner, partner)` gives it (first keys below `keys`) and its springs.
-    fn history(&self, keys: usize, key: impl Fn(usize, u32) -> (u32, u32) + Sync) -> History {
+    /// `key(owner, partner)` gives it (first keys below `keys`; none: the contact is
+    /// dropped) and its springs.
+    fn history(
+        &self,
+        keys: usize,
+        key: impl Fn(usize, u32) -> Option<(u32, u32)> + Sync,
+    ) -> History {
         History::from_entries(
             keys,
-            self.live().map(|(i, k, _)| key(i, self.partner[k]).0),
-            self.live().map(|(i, k, s)| {
-                let (a, other) = key(i, self.partner[k]);
-                (a, other, s)
-            }),
+            self.live()
+                .filter_map(|(i, k, _)| key(i, self.partner[k]).map(|k| k.0)),
+            self.live()
+                .filter_map(|(i, k, s)| key(i, self.partner[k]).map(|(a, other)| (a, other, s))),
         )
     }
 
@@ -498,10 +502,10 @@ pub struct Histories {
 }
 
 /// The history of particle pairs of a list, by (lower id, higher id).
-fn pair_key(ids: &[u32]) -> impl Fn(usize, u32) -> (u32, u32) + Sync + '_ {
+fn pair_key(ids: &[u32]) -> impl Fn(usize, u32) -> Option<(u32, u32)> + Sync + '_ {
     move |i, j| {
         let (a, b) = (ids[i], ids[j as usize]);
-        (a.min(b), a.max(b))
+        Some((a.min(b), a.max(b)))
     }
 }
 
@@ -729,7 +733,7 @@ impl Neighbours {
     pub fn history(&self, ids: &[u32], id_count: usize) -> Histories {
         Histories {
             pairs: self.pairs.history(id_count, pair_key(ids)),
-            faces: self.faces.history(id_count, |i, f| (ids[i], f)),
+            faces: self.faces.history(id_count, |i, f| Some((ids[i], f))),
         }
     }
 
@@ -747,7 +751,18 @@ impl Neighbours {
     /// indices, so that carrying them runs in spatial order too), and the lists are built
     /// from the positions (see [`Neighbours::build`]).
     pub fn rebuild(&mut self, particles: &mut Particles, faces: &[Face], face_grid: &CellGrid) {
-        let n = particles.len();
+        self.rebuild_without(particles, &[], faces, face_grid);
+    }
+
+    /// Rebuilds the lists as [`Neighbours::rebuild`] does, removing first the particles
+    /// (storage indices, ascending) in `gone` and the history of their contacts.
+    pub fn rebuild_without(
+        &mut self,
+        particles: &mut Particles,
+        gone: &[u32],
+        faces: &[Face],
+        face_grid: &CellGrid,
+    ) {
         let layout = Layout::of(&particles.radius, self.skin);
         let inv_h = 1.0 / layout.h;
         let keys: Vec<(u64, u32)> = particles
@@ -757,14 +772,18 @@ impl Neighbours {
             .with_min_len(MIN_PARALLEL_LEN)
             .map(|(&x, &id)| (key(cell_of(x, inv_h)), id))
             .collect();
-        let order: Option<Vec<u32>> = (!keys.is_sorted()).then(|| {
-            let mut order: Vec<u32> = (0..n as u32).collect();
+        let order: Option<Vec<u32>> = (!gone.is_empty() || !keys.is_sorted()).then(|| {
+            let mut gone = gone.iter().peekable();
+            let mut order: Vec<u32> = (0..particles.len() as u32)
+                .filter(|&i| gone.next_if_eq(&&i).is_none())
+                .collect();
             order.par_sort_unstable_by_key(|&i| keys[i as usize]);
             order
         });
         drop(keys);
-        // Where each particle goes, and the springs by the new places.
-        let mut new = vec![0u32; self.pairs.owners()];
+        let n = order.as_ref().map_or(particles.len(), Vec::len);
+        // Where each particle goes (NONE: removed), and the springs by the new places.
+        let mut new = vec![NONE; self.pairs.owners()];
         match &order {
             Some(order) => {
                 for (k, &old) in order.iter().enumerate() {
@@ -775,12 +794,13 @@ impl Neighbours {
             }
             None => new.iter_mut().enumerate().for_each(|(k, v)| *v = k as u32),
         }
+        let kept = |a: u32| (a != NONE).then_some(a);
         let history = Histories {
             pairs: self.pairs.history(n, |i, j| {
-                let (a, b) = (new[i], new[j as usize]);
-                (a.min(b), a.max(b))
+                let (a, b) = (kept(new[i])?, kept(new[j as usize])?);
+                Some((a.min(b), a.max(b)))
             }),
-            faces: self.faces.history(n, |i, f| (new[i], f)),
+            faces: self.faces.history(n, |i, f| kept(new[i]).map(|a| (a, f))),
         };
         drop(new);
         // The old lists and anchors go before the new ones are made.
@@ -1069,6 +1089,7 @@ mod tests {
                 q: glam::DQuat::IDENTITY,
                 w: DVec3::ZERO,
                 tag: 0,
+                material: 0,
             })
             .collect()
     }

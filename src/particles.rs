@@ -27,6 +27,9 @@ pub struct Particles {
     /// A label per particle (0 by default), set by `[[tags]]` regions, e.g. to dye grains by
     /// the path they took.
     pub tag: Vec<u32>,
+    /// The index of each particle's material in `[[materials]]` (0: the first, or the one
+    /// `[material]`).
+    pub material: Vec<u16>,
 }
 
 /// One particle's state, as read from and written to CSV.
@@ -38,6 +41,7 @@ pub struct Particle {
     pub q: DQuat,
     pub w: DVec3,
     pub tag: u32,
+    pub material: u16,
 }
 
 impl Particles {
@@ -59,6 +63,7 @@ impl Particles {
         self.q.push(p.q);
         self.w.push(p.w);
         self.tag.push(p.tag);
+        self.material.push(p.material);
     }
 
     pub fn get(&self, i: usize) -> Particle {
@@ -69,6 +74,7 @@ impl Particles {
             q: self.q[i],
             w: self.w[i],
             tag: self.tag[i],
+            material: self.material[i],
         }
     }
 
@@ -94,6 +100,7 @@ impl Particles {
         gather(&mut self.q, order);
         gather(&mut self.w, order);
         gather(&mut self.tag, order);
+        gather(&mut self.material, order);
     }
 
     /// The storage indices in id order.

@@ -10,7 +10,7 @@ use anyhow::{Context, Result};
 
 use crate::checkpoint;
 use crate::contact::ContactLaw;
-use crate::csv::{frame_name, write_frame};
+use crate::csv::{Extra, frame_name, write_frame};
 use crate::integrate::Inertia;
 use crate::mesh::Contacts;
 use crate::scenario::{Formats, Scenario};
@@ -22,6 +22,10 @@ pub const CHECKPOINT: &str = "checkpoint.bin";
 pub const INTERRUPTED: &str = "interrupted.csv";
 /// Name of the frame written when a run becomes unstable.
 pub const UNSTABLE: &str = "unstable.csv";
+/// Name of the log of particles removed by each outlet (`frame,time,outlet,count,mass`).
+pub const OUTLETS: &str = "outlets.csv";
+/// Name of the log of the loads on each mesh file (`frame,time,mesh,fx,fy,fz,tx,ty,tz`).
+pub const WALLS: &str = "walls.csv";
 
 /// How much to tell the user while running.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -57,6 +61,8 @@ pub struct Summary {
     /// the likely cause.
     pub warnings: usize,
     pub advice: String,
+    /// Particles removed by the outlets and the domain bounds.
+    pub removed: crate::simulation::Removed,
 }
 
 /// Per-pair warning lines shown during a run; further pairs are only counted.
@@ -89,8 +95,8 @@ impl std::error::Error for Interrupted {}
 struct Frames<'a> {
     dir: &'a Path,
     formats: Formats,
-    /// Whether the CSV frames have a tag column.
-    tags: bool,
+    /// The CSV frames' columns beyond the fourteen.
+    extra: Extra,
     /// Simulated time between frames.
     frame_time: f64,
 }
@@ -106,7 +112,7 @@ impl Frames<'_> {
 
     fn write(&self, k: u64, sim: &Simulation) -> Result<()> {
         if self.formats.csv {
-            write_frame(self.dir, k, &sim.particles, self.tags)?;
+            write_frame(self.dir, k, &sim.particles, self.extra)?;
         }
         if self.formats.vtk {
             let name = format!("particles{k:06}.vtu");
@@ -169,15 +175,59 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
     let out = Frames {
         dir: output_dir,
         formats: sim.scenario.formats,
-        tags: sim.has_tags(),
+        extra: Extra {
+            tag: sim.has_tags(),
+            ids: sim.frames_carry_ids(),
+        },
         frame_time: steps_per_frame as f64 * sim.scenario.simulation.timestep,
     };
     out.start(&sim)?;
     let mut frames_written = 0;
     let mut output_seconds = 0.0;
+    // The logs, continued after the checkpoint's last complete frame when resuming.
+    let resumed_at = options.resume.map(|_| sim.steps / steps_per_frame);
+    let mut outlets = (!sim.scenario.outlets.is_empty())
+        .then(|| {
+            Log::open(
+                output_dir,
+                OUTLETS,
+                "frame,time,outlet,count,mass",
+                resumed_at,
+            )
+        })
+        .transpose()?;
+    let mut walls = sim
+        .scenario
+        .wall_forces
+        .then(|| {
+            Log::open(
+                output_dir,
+                WALLS,
+                "frame,time,mesh,fx,fy,fz,tx,ty,tz",
+                resumed_at,
+            )
+        })
+        .transpose()?;
+    let mut log = |sim: &mut Simulation, frame: u64| -> Result<()> {
+        if let Some(log) = &mut outlets {
+            for (k, o) in sim.removed.outlets.iter().enumerate() {
+                log.row(&[&frame, &sim.time, &k, &o.count, &o.mass])?;
+            }
+        }
+        if let Some(log) = walls.as_mut().filter(|_| frame > 0) {
+            // The mean over the steps since the last frame.
+            let steps = steps_per_frame as f64;
+            for (k, w) in sim.take_wall_loads().iter().enumerate() {
+                let (f, t) = (w.f / steps, w.tau / steps);
+                log.row(&[&frame, &sim.time, &k, &f.x, &f.y, &f.z, &t.x, &t.y, &t.z])?;
+            }
+        }
+        Ok(())
+    };
     if options.resume.is_none() {
         out.write(0, &sim)?;
         frames_written += 1;
+        log(&mut sim, 0)?;
     }
 
     let total_steps = frames * steps_per_frame;
@@ -198,6 +248,10 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
         let fresh = sim.take_new_warnings();
         if options.verbosity == Verbosity::Normal {
             let mut lines = Vec::new();
+            let removed = match sim.removed.count() {
+                0 => String::new(),
+                n => format!("  removed {n}"),
+            };
             for w in fresh {
                 warned += 1;
                 if warned <= WARNING_LINES {
@@ -212,7 +266,7 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
                 n => format!("  deep overlaps {n}"),
             };
             lines.push(format!(
-                "frame {frame:>6}  t = {:.6e} s  particles {}{deep}",
+                "frame {frame:>6}  t = {:.6e} s  particles {}{removed}{deep}",
                 sim.time,
                 sim.particles.len()
             ));
@@ -232,7 +286,7 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
         if let Err(unstable) = sim.step() {
             let last = sim.steps.saturating_sub(1) / steps_per_frame.max(1);
             let written =
-                crate::csv::write_frame_as(output_dir, UNSTABLE, &sim.particles, out.tags).is_ok();
+                crate::csv::write_frame_as(output_dir, UNSTABLE, &sim.particles, out.extra).is_ok();
             anyhow::bail!(
                 "{unstable}.\nThe last complete frame is {}{}.",
                 output_dir.join(frame_name(last)).display(),
@@ -250,6 +304,7 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
             let t = Instant::now();
             let frame = sim.steps / steps_per_frame;
             out.write(frame, &sim)?;
+            log(&mut sim, frame)?;
             frames_written += 1;
             status(&mut sim, frame);
             if checkpoint_every > 0 && frame.is_multiple_of(checkpoint_every) {
@@ -267,7 +322,7 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
         if options.stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
             let path = output_dir.join(CHECKPOINT);
             checkpoint::save(&path, &sim.snapshot(), fingerprint(&sim))?;
-            crate::csv::write_frame_as(output_dir, INTERRUPTED, &sim.particles, out.tags)?;
+            crate::csv::write_frame_as(output_dir, INTERRUPTED, &sim.particles, out.extra)?;
             if let Some(bar) = &bar {
                 bar.abandon();
             }
@@ -282,6 +337,14 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }
+    // Every run ends with a checkpoint, so that it can be extended or staged.
+    let t = Instant::now();
+    checkpoint::save(
+        &output_dir.join(CHECKPOINT),
+        &sim.snapshot(),
+        fingerprint(&sim),
+    )?;
+    output_seconds += t.elapsed().as_secs_f64();
     let _ = std::fs::remove_file(output_dir.join(INTERRUPTED));
     Ok(Summary {
         frames_written,
@@ -293,8 +356,88 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
         output_seconds,
         warnings: sim.warnings().count(),
         advice: sim.advice(),
+        removed: sim.removed.clone(),
     })
 }
+
+/// A CSV log in the output directory with a row per frame (or several).
+struct Log {
+    out: std::io::BufWriter<std::fs::File>,
+    path: PathBuf,
+    line: String,
+}
+
+impl Log {
+    /// Creates `dir/name` with `header`, or, when resuming after frame `resumed_at`, keeps
+    /// the rows of frames up to it (a later checkpoint's rows, or a half-written last line,
+    /// are dropped) and continues it.
+    fn open(dir: &Path, name: &str, header: &str, resumed_at: Option<u64>) -> Result<Log> {
+        let path = dir.join(name);
+        let mut text = format!("{header}\n");
+        if let Some(last) = resumed_at
+            && let Ok(old) = std::fs::read_to_string(&path)
+        {
+            for line in old.lines().skip(1) {
+                let frame = line.split(',').next().and_then(|f| f.parse::<u64>().ok());
+                if frame.is_some_and(|f| f <= last)
+                    && line.split(',').count() == header.split(',').count()
+                {
+                    text += line;
+                    text.push('\n');
+                }
+            }
+        }
+        std::fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))?;
+        let file = std::fs::OpenOptions::new()
+            .append(true)
+            .open(&path)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        Ok(Log {
+            out: std::io::BufWriter::new(file),
+            path,
+            line: String::new(),
+        })
+    }
+
+    /// Appends a row (numbers in full precision) and flushes it.
+    fn row(&mut self, values: &[&dyn LogValue]) -> Result<()> {
+        use std::io::Write;
+        self.line.clear();
+        for (k, v) in values.iter().enumerate() {
+            if k > 0 {
+                self.line.push(',');
+            }
+            v.put(&mut self.line);
+        }
+        self.line.push('\n');
+        self.out
+            .write_all(self.line.as_bytes())
+            .and_then(|()| self.out.flush())
+            .with_context(|| format!("cannot write {}", self.path.display()))
+    }
+}
+
+/// A value of a log row.
+trait LogValue {
+    fn put(&self, line: &mut String);
+}
+
+impl LogValue for f64 {
+    fn put(&self, line: &mut String) {
+        line.push_str(ryu::Buffer::new().format(*self));
+    }
+}
+
+macro_rules! whole_log_values {
+    ($($t:ty),*) => {$(
+        impl LogValue for $t {
+            fn put(&self, line: &mut String) {
+                line.push_str(itoa::Buffer::new().format(*self));
+            }
+        }
+    )*};
+}
+whole_log_values!(u64, usize, i32);
 
 /// The fingerprint of a simulation's scenario and mesh, for checkpoints.
 fn fingerprint(sim: &Simulation) -> u64 {
@@ -347,10 +490,35 @@ pub fn describe(s: &Scenario) -> Result<String> {
             faces.len()
         );
     }
+    let mut bounds = String::new();
+    if let Some(d) = s.domain {
+        bounds += &format!(
+            "domain                 {} .. {} (particles leaving it are removed)\n",
+            d.min, d.max
+        );
+        let outside = sim.particles.x.iter().filter(|&&x| !d.contains(x)).count();
+        if outside > 0 {
+            bounds += &format!(
+                "                       warning: {outside} initial particles lie outside it and are removed at the first step\n"
+            );
+        }
+    }
+    for (k, o) in s.outlets.iter().enumerate() {
+        bounds += &format!(
+            "outlet {k:<16}{} .. {} (removes particles entering it; {OUTLETS})\n",
+            o.min, o.max
+        );
+    }
+    if s.wall_forces {
+        bounds += &format!(
+            "wall loads             force and torque on each mesh file, mean per frame ({WALLS})\n"
+        );
+    }
     let default_dt = crate::scenario::default_timestep(g.radius_min, m);
     Ok(format!(
         "scenario is valid\n\
          {meshes}\
+         {bounds}\
          initial particles      {}\n\
          time step              {dt:.6e} s ({:.3} x Eq. 50)\n\
          particle mass          {m_min:.6e} .. {m_max:.6e} kg\n\

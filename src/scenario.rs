@@ -12,8 +12,10 @@
 //!              phase } | { type = "velocity", velocity } | { type = "rotation", center, axis,
 //!              angular_velocity }   (any number of these)
 //! [[tags]]     min, max, tag   (a box that labels particles entering it; any number)
+//! [domain]     min, max   (particles whose centre leaves it are removed)
+//! [[outlets]]  min, max   (particles whose centre enters one are removed; any number)
 //! [input]      particles
-//! [output]     dir, checkpoint_every, formats
+//! [output]     dir, checkpoint_every, formats, wall_forces
 //! ```
 //! Paths are relative to the scenario file. Unknown keys and values outside Table 2's
 //! "Requirements" column are errors naming the key and the allowed range.
@@ -121,6 +123,21 @@ pub struct TagRegion {
     pub tag: u32,
 }
 
+/// An axis-aligned box of space, `min` to `max` (inclusive).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Region {
+    pub min: DVec3,
+    pub max: DVec3,
+}
+
+impl Region {
+    /// Whether `x` lies in the box (its faces included).
+    #[inline]
+    pub fn contains(&self, x: DVec3) -> bool {
+        x.cmpge(self.min).all() && x.cmple(self.max).all()
+    }
+}
+
 /// A complete, validated scenario.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scenario {
@@ -132,6 +149,11 @@ pub struct Scenario {
     pub meshes: Vec<MeshSpec>,
     /// Regions that tag particles passing through them (`[[tags]]`), later ones winning.
     pub tags: Vec<TagRegion>,
+    /// The bounds of the simulated space (`[domain]`): particles whose centre leaves it are
+    /// removed. None: unbounded.
+    pub domain: Option<Region>,
+    /// Boxes that remove the particles whose centre enters them (`[[outlets]]`).
+    pub outlets: Vec<Region>,
     /// Initial particles (CSV), if any.
     pub particles: Option<PathBuf>,
     /// Output directory.
@@ -140,6 +162,8 @@ pub struct Scenario {
     pub checkpoint_every: u64,
     /// Frame formats to write.
     pub formats: Formats,
+    /// Write `walls.csv`: the force and torque the particles exert on each mesh file.
+    pub wall_forces: bool,
 }
 
 /// The frame formats of `[output] formats`.
@@ -223,6 +247,13 @@ struct RawTag {
     tag: u32,
 }
 
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawBox {
+    min: [f64; 3],
+    max: [f64; 3],
+}
+
 #[derive(Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 struct RawScenario {
@@ -230,6 +261,9 @@ struct RawScenario {
     meshes: Vec<RawMesh>,
     #[serde(default)]
     tags: Vec<RawTag>,
+    domain: Option<RawBox>,
+    #[serde(default)]
+    outlets: Vec<RawBox>,
     #[serde(default)]
     geometry: RawGeometry,
     #[serde(default)]
@@ -300,6 +334,7 @@ struct RawOutput {
     dir: Option<PathBuf>,
     checkpoint_every: Option<u64>,
     formats: Option<Vec<String>>,
+    wall_forces: Option<bool>,
 }
 
 /// A range check of Table 2's "Requirements" column.
@@ -353,6 +388,22 @@ fn check_vec(key: &str, v: [f64; 3]) -> Result<DVec3> {
         check(&format!("{key}.{c}"), x, Range::Finite)?;
     }
     Ok(DVec3::from_array(v))
+}
+
+/// A box from `min` and `max` under `key`: `max >= min` in every component, or `max > min`
+/// if `strict` (a box of space that must hold particles).
+fn region(key: &str, b: RawBox, strict: bool) -> Result<Region> {
+    let (min, max) = (
+        check_vec(&format!("{key} min"), b.min)?,
+        check_vec(&format!("{key} max"), b.max)?,
+    );
+    if strict && max.cmple(min).any() {
+        bail!("{key} max = {max} must be > min = {min} in every component");
+    }
+    if max.cmplt(min).any() {
+        bail!("{key} max = {max} must be >= min = {min} in every component");
+    }
+    Ok(Region { min, max })
 }
 
 /// The value of a `mesh_contacts` or `contacts` key (default "merged").
@@ -613,17 +664,11 @@ impl Scenario {
             .into_iter()
             .enumerate()
             .map(|(k, t)| {
-                let key = |name: &str| format!("[[tags]] #{} {name}", k + 1);
-                let (min, max) = (
-                    check_vec(&key("min"), t.min)?,
-                    check_vec(&key("max"), t.max)?,
-                );
-                if max.cmplt(min).any() {
-                    bail!(
-                        "{} = {max} must be >= min = {min} in every component",
-                        key("max")
-                    );
-                }
+                let b = RawBox {
+                    min: t.min,
+                    max: t.max,
+                };
+                let Region { min, max } = region(&format!("[[tags]] #{}", k + 1), b, false)?;
                 Ok(TagRegion {
                     min,
                     max,
@@ -631,6 +676,28 @@ impl Scenario {
                 })
             })
             .collect::<Result<Vec<_>>>()?;
+        let domain = raw
+            .domain
+            .map(|b| region("[domain]", b, true))
+            .transpose()?;
+        let outlets = raw
+            .outlets
+            .into_iter()
+            .enumerate()
+            .map(|(k, b)| region(&format!("[[outlets]] #{}", k + 1), b, false))
+            .collect::<Result<Vec<_>>>()?;
+        if let Some(d) = domain
+            && simulation.max_particles > 0
+            && simulation.spawn_attempts > 0
+            && !(d.contains(spawn_min) && d.contains(spawn_max))
+        {
+            bail!(
+                "[geometry] spawn box {spawn_min} .. {spawn_max} must lie inside [domain] {} .. {} \
+                 (particles spawned outside it would be removed at once)",
+                d.min,
+                d.max
+            );
+        }
 
         Ok(Scenario {
             geometry,
@@ -639,6 +706,8 @@ impl Scenario {
             simulation,
             meshes,
             tags,
+            domain,
+            outlets,
             particles: raw.input.particles.map(|p| base.join(p)),
             output_dir: raw
                 .output
@@ -646,7 +715,13 @@ impl Scenario {
                 .map_or_else(|| PathBuf::from("output"), |d| base.join(d)),
             checkpoint_every: raw.output.checkpoint_every.unwrap_or(0),
             formats: Formats::parse(raw.output.formats)?,
+            wall_forces: raw.output.wall_forces.unwrap_or(false),
         })
+    }
+
+    /// Whether particles can be removed during the run (a domain or outlets).
+    pub fn removes(&self) -> bool {
+        self.domain.is_some() || !self.outlets.is_empty()
     }
 
     /// Total simulated time N_frames N_steps Δt.

@@ -149,10 +149,11 @@ pub enum Stage {
     Integrate,
     Tag,
     Stability,
+    Remove,
 }
 
 impl Stage {
-    pub const ALL: [Stage; 8] = [
+    pub const ALL: [Stage; 9] = [
         Stage::MoveMeshes,
         Stage::Spawn,
         Stage::Neighbours,
@@ -161,6 +162,7 @@ impl Stage {
         Stage::Integrate,
         Stage::Tag,
         Stage::Stability,
+        Stage::Remove,
     ];
 
     pub fn name(self) -> &'static str {
@@ -173,6 +175,7 @@ impl Stage {
             Stage::Integrate => "integrate",
             Stage::Tag => "tag",
             Stage::Stability => "stability check",
+            Stage::Remove => "remove",
         }
     }
 }
@@ -220,6 +223,10 @@ pub struct Snapshot {
     /// Particle pairs by (lower id, higher id) and particle-face contacts by (id, face).
     pub pair_history: Vec<(u32, u32, Springs)>,
     pub face_history: Vec<(u32, u32, Springs)>,
+    /// The particles removed so far.
+    pub removed: Removed,
+    /// The loads on the mesh files summed since the last frame (`[output] wall_forces`).
+    pub wall_sums: Vec<Wrench>,
 }
 
 /// The partner of a particle in a contact.
@@ -323,6 +330,44 @@ impl std::fmt::Display for Unstable {
 
 impl std::error::Error for Unstable {}
 
+/// Particles removed, and their mass.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Outflow {
+    pub count: u64,
+    /// [M]
+    pub mass: f64,
+}
+
+/// The particles removed so far: by each `[[outlets]]` box, and for leaving the `[domain]`.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Removed {
+    pub outlets: Vec<Outflow>,
+    pub domain: Outflow,
+}
+
+impl Removed {
+    /// All particles removed so far.
+    pub fn count(&self) -> u64 {
+        self.domain.count + self.outlets.iter().map(|o| o.count).sum::<u64>()
+    }
+}
+
+/// The force and torque that particles exert on a body (a mesh file).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Wrench {
+    /// [ML/T²]
+    pub f: DVec3,
+    /// [ML²/T²], about the body's reference point.
+    pub tau: DVec3,
+}
+
+impl std::ops::AddAssign for Wrench {
+    fn add_assign(&mut self, o: Wrench) {
+        self.f += o.f;
+        self.tau += o.tau;
+    }
+}
+
 /// `face_part` of a face that does not move.
 const STATIC: u32 = u32::MAX;
 
@@ -346,6 +391,8 @@ pub struct MeshFile {
     pub name: String,
     pub faces: std::ops::Range<usize>,
     pub contacts: Contacts,
+    /// The point torques on it are taken about: the origin, or the centre of its rotation.
+    pub torque_about: DVec3,
 }
 
 /// A running simulation.
@@ -379,6 +426,13 @@ pub struct Simulation {
     pub stage_times: StageTimes,
     /// Overlaps past the smaller radius that did not stop the run.
     warnings: Warnings,
+    /// Particles removed so far by the outlets and the domain bounds.
+    pub removed: Removed,
+    /// For each face, its mesh file (an index of `mesh_files`), if wall loads are summed.
+    face_file: Vec<u32>,
+    /// The loads on each mesh file summed over the steps since the last call of
+    /// [`Simulation::take_wall_loads`] (`[output] wall_forces`).
+    wall_sums: Vec<Wrench>,
 }
 
 impl Simulation {
@@ -400,6 +454,7 @@ impl Simulation {
             name,
             faces: 0..mesh.faces.len(),
             contacts: g.mesh_contacts,
+            torque_about: DVec3::ZERO,
         }];
         let mut moving = Vec::new();
         for spec in &scenario.meshes {
@@ -412,6 +467,10 @@ impl Simulation {
                 name: spec.file.display().to_string(),
                 faces,
                 contacts: spec.contacts,
+                torque_about: match spec.motion {
+                    Some(Motion::Rotation { center, .. }) => center,
+                    _ => DVec3::ZERO,
+                },
             });
             mesh.append(part);
         }
@@ -421,6 +480,7 @@ impl Simulation {
         };
         let mut sim = Simulation::from_parts(scenario, mesh, particles)?;
         sim.mesh_files = files;
+        sim.sum_wall_loads();
         for (faces, motion) in moving {
             for f in faces.clone() {
                 sim.face_part[f] = sim.moving.len() as u32;
@@ -455,6 +515,19 @@ impl Simulation {
         }
         sim.particles = snapshot.particles;
         sim.spawner = Spawner::resume(sim.scenario.simulation.seed, snapshot.spawner);
+        if snapshot.removed.outlets.len() > sim.removed.outlets.len() {
+            return Err(misfit(format!(
+                "it counts {} outlets, the scenario has {}",
+                snapshot.removed.outlets.len(),
+                sim.removed.outlets.len()
+            )));
+        }
+        sim.removed.domain = snapshot.removed.domain;
+        sim.removed.outlets[..snapshot.removed.outlets.len()]
+            .copy_from_slice(&snapshot.removed.outlets);
+        if !sim.wall_sums.is_empty() && snapshot.wall_sums.len() == sim.wall_sums.len() {
+            sim.wall_sums = snapshot.wall_sums;
+        }
         let history = Histories {
             pairs: History::in_storage(&sim.particles, &snapshot.pair_history, true)
                 .map_err(misfit)?,
@@ -513,6 +586,8 @@ impl Simulation {
             lonely: lonely.to_vec(),
             pair_history: history.pairs.entries(),
             face_history: history.faces.entries(),
+            removed: self.removed.clone(),
+            wall_sums: self.wall_sums.clone(),
         }
     }
 
@@ -525,7 +600,7 @@ impl Simulation {
         }
         let skin = SKIN_PER_RADIUS * g.radius_max;
         let face_grid = face_grid(&mesh.faces, max_radius, skin);
-        Ok(Simulation {
+        let mut sim = Simulation {
             law: ContactLaw::new(&scenario.material, scenario.simulation.timestep),
             neighbours: Neighbours::new(skin),
             face_grid,
@@ -547,11 +622,20 @@ impl Simulation {
                     .faces
                     .first()
                     .map_or_else(Contacts::default, |f| f.contacts),
+                torque_about: DVec3::ZERO,
             }],
+            removed: Removed {
+                outlets: vec![Outflow::default(); scenario.outlets.len()],
+                domain: Outflow::default(),
+            },
+            face_file: Vec::new(),
+            wall_sums: Vec::new(),
             scenario,
             particles,
             mesh,
-        })
+        };
+        sim.sum_wall_loads();
+        Ok(sim)
     }
 
     /// Number of neighbour-list rebuilds so far.
@@ -591,9 +675,91 @@ impl Simulation {
         let t = self.stage_times.add(Stage::Tag, t);
         self.steps += 1;
         self.time = self.steps as f64 * self.scenario.simulation.timestep;
-        let result = self.check_stability(deep, non_finite);
-        self.stage_times.add(Stage::Stability, t);
-        result
+        self.check_stability(deep, non_finite)?;
+        let t = self.stage_times.add(Stage::Stability, t);
+        self.remove();
+        self.stage_times.add(Stage::Remove, t);
+        Ok(())
+    }
+
+    /// Stage 7: particles whose centre has entered an outlet or left the domain are
+    /// removed (counted, with their mass, by the outlet or the domain: the first outlet
+    /// that holds a particle takes it). The lists are rebuilt without them; the ids of the
+    /// others stay.
+    #[inline(never)] // a stage of its own in profiles
+    fn remove(&mut self) {
+        let s = &self.scenario;
+        if !s.removes() {
+            return;
+        }
+        let (domain, outlets) = (s.domain, &s.outlets);
+        // Where each removed particle goes: an outlet, or `outlets.len()` for the domain.
+        let fate = |x: &DVec3| -> Option<u32> {
+            if let Some(k) = outlets.iter().position(|o| o.contains(*x)) {
+                return Some(k as u32);
+            }
+            domain
+                .is_some_and(|d| !d.contains(*x))
+                .then_some(outlets.len() as u32)
+        };
+        let p = &self.particles;
+        let gone: Vec<(u32, u32)> =
+            p.x.par_iter()
+                .enumerate()
+                .with_min_len(4 * MIN_PARALLEL_LEN)
+                .filter_map(|(i, x)| fate(x).map(|f| (i as u32, f)))
+                .collect();
+        if gone.is_empty() {
+            return;
+        }
+        // Counted in id order, so the masses sum in an order of their own.
+        let mut by_id: Vec<(u32, u32, u32)> = gone
+            .iter()
+            .map(|&(i, f)| (p.id[i as usize], i, f))
+            .collect();
+        by_id.sort_unstable();
+        let density = s.material.density;
+        for &(_, i, f) in &by_id {
+            let out = match self.removed.outlets.get_mut(f as usize) {
+                Some(o) => o,
+                None => &mut self.removed.domain,
+            };
+            out.count += 1;
+            out.mass += Inertia::mass(p.radius[i as usize], density);
+        }
+        let gone: Vec<u32> = gone.into_iter().map(|(i, _)| i).collect();
+        self.neighbours.rebuild_without(
+            &mut self.particles,
+            &gone,
+            &self.mesh.faces,
+            &self.face_grid,
+        );
+        self.built();
+    }
+
+    /// Whether frames name each particle's id and material (particles can be removed, so
+    /// the line of a particle is not its id).
+    pub fn frames_carry_ids(&self) -> bool {
+        self.scenario.removes()
+    }
+
+    /// Starts summing the loads on each mesh file (`take_wall_loads`).
+    fn sum_wall_loads(&mut self) {
+        if !self.scenario.wall_forces {
+            return;
+        }
+        self.face_file = vec![0; self.mesh.faces.len()];
+        for (k, file) in self.mesh_files.iter().enumerate() {
+            self.face_file[file.faces.clone()].fill(k as u32);
+        }
+        self.wall_sums = vec![Wrench::default(); self.mesh_files.len()];
+    }
+
+    /// The loads on each mesh file summed over the steps since the last call, and the
+    /// sums set back to zero (empty unless `[output] wall_forces`).
+    pub fn take_wall_loads(&mut self) -> Vec<Wrench> {
+        let zero = vec![Wrench::default(); self.wall_sums.len()];
+        std::mem::replace(&mut self.wall_sums, zero)
     }
 
     /// Stage 5b: particles whose centre is inside a `[[tags]]` box take its tag.
@@ -746,7 +912,7 @@ impl Simulation {
     #[inline(never)] // a stage of its own in profiles
     fn spawn(&mut self) {
         let s = &self.scenario;
-        if self.particles.len() < s.simulation.max_particles as usize {
+        if (self.particles.next_id as u64) < s.simulation.max_particles {
             self.spawner
                 .spawn(s, &mut self.particles, &self.mesh.faces, &self.face_grid);
         }
@@ -963,10 +1129,12 @@ impl Simulation {
         thread_local! {
             static SCRATCH: std::cell::RefCell<MeshScratch> = Default::default();
         }
+        let (face_file, files, about) = (&self.face_file, self.wall_sums.len(), &self.mesh_files);
         let all = pieces(bounds, &mut self.loads, start, contact, stores);
-        all.into_par_iter()
+        let walls: Vec<Vec<Wrench>> = all
+            .into_par_iter()
             .with_min_len(MIN_PARALLEL_LEN.div_ceil(FACE_PIECE))
-            .for_each(|piece| {
+            .map(|piece| {
                 SCRATCH.with_borrow_mut(|scratch| {
                     let Piece {
                         owners,
@@ -1092,7 +1260,9 @@ impl Simulation {
                         a = b;
                     }
                     // The law, `WIDTH` contacts at a time (as for particle pairs), added to
-                    // the particles' loads in slot order.
+                    // the particles' loads in slot order, and their reactions to the piece's
+                    // sum for each mesh file.
+                    let mut wall = vec![Wrench::default(); files];
                     for group in contacts.chunks(WIDTH) {
                         let c: [&Near; WIDTH] =
                             std::array::from_fn(|l| &near[group[l.min(group.len() - 1)] as usize]);
@@ -1121,9 +1291,28 @@ impl Simulation {
                         for l in 0..group.len() {
                             loads[i[l] - owners.start].add(f[l], tau[l]);
                         }
+                        if files > 0 {
+                            // The reaction on the mesh file (Newton's third law for the
+                            // force and for the torque about the file's reference point).
+                            for l in 0..group.len() {
+                                let k = face_file[partner[first + c[l].slot] as usize] as usize;
+                                let arm = p.x[i[l]] - about[k].torque_about;
+                                wall[k] += Wrench {
+                                    f: -f[l],
+                                    tau: -(arm.cross(f[l]) + tau[l]),
+                                };
+                            }
+                        }
                     }
-                });
-            });
+                    wall
+                })
+            })
+            .collect();
+        for piece in walls {
+            for (sum, w) in self.wall_sums.iter_mut().zip(piece) {
+                *sum += w;
+            }
+        }
         deep.into_inner().expect("not poisoned")
     }
 

@@ -58,7 +58,8 @@ impl Spawner {
         }
     }
 
-    /// Makes up to `N_spawn` attempts (until `N_max` particles exist): a uniform centre in
+    /// Makes up to `N_spawn` attempts (until `N_max` particles have been created, those
+    /// removed since included): a uniform centre in
     /// the spawn box and a uniform radius in [R_min, R_max], rejected if the sphere would
     /// overlap a particle or a mesh face. Returns the number of particles added.
     pub fn spawn(
@@ -70,7 +71,7 @@ impl Spawner {
     ) -> usize {
         let g = &s.geometry;
         let max = s.simulation.max_particles as usize;
-        if s.simulation.spawn_attempts == 0 || particles.len() >= max {
+        if s.simulation.spawn_attempts == 0 || particles.next_id as usize >= max {
             return 0;
         }
         // A grid of the current particles, grown as particles are added.
@@ -86,7 +87,7 @@ impl Spawner {
 
         let before = particles.len();
         for _ in 0..s.simulation.spawn_attempts {
-            if particles.len() >= max {
+            if particles.next_id as usize >= max {
                 break;
             }
             let radius = match self.pending_radius {
@@ -139,6 +140,7 @@ impl Spawner {
                 q: DQuat::IDENTITY,
                 w: s.kinetics.initial_angular_velocity,
                 tag: 0,
+                material: 0,
             });
         }
         particles.len() - before

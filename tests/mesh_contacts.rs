@@ -40,6 +40,7 @@ fn sphere(x: DVec3, v: DVec3, w: DVec3) -> Particle {
         q: DQuat::IDENTITY,
         w,
         tag: 0,
+        material: 0,
     }
 }
 

@@ -24,6 +24,7 @@ fn particle(x: DVec3, v: DVec3, w: DVec3) -> Particle {
         q: DQuat::IDENTITY,
         w,
         tag: 0,
+        material: 0,
     }
 }
 
