@@ -52,7 +52,11 @@ pub fn fingerprint(s: &Scenario, mesh: &Mesh) -> u64 {
         s.simulation.spawn_attempts,
         (s.simulation.seed, &mesh.faces),
     );
-    // FNV-1a, 64 bit.
+    hash(&text)
+}
+
+/// FNV-1a, 64 bit, of `text`.
+pub fn hash(text: &str) -> u64 {
     text.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
         (h ^ b as u64).wrapping_mul(0x100_0000_01b3)
     })
@@ -130,6 +134,13 @@ pub fn encode(snapshot: &Snapshot, fingerprint: u64) -> Vec<u8> {
     for w in &snapshot.wall_sums {
         put_f64s(&mut out, &[w.f.x, w.f.y, w.f.z, w.tau.x, w.tau.y, w.tau.z]);
     }
+    out.extend_from_slice(&(snapshot.scenario.len() as u64).to_le_bytes());
+    out.extend_from_slice(snapshot.scenario.as_bytes());
+    out.extend_from_slice(&(snapshot.mesh_files.len() as u64).to_le_bytes());
+    for &(faces, hash) in &snapshot.mesh_files {
+        out.extend_from_slice(&faces.to_le_bytes());
+        out.extend_from_slice(&hash.to_le_bytes());
+    }
     let crc = crc32fast::hash(&out);
     out.extend_from_slice(&crc.to_le_bytes());
     out
@@ -199,8 +210,9 @@ impl Reader<'_> {
     }
 }
 
-/// Decodes a checkpoint, checking magic, version, checksum and fingerprint.
-pub fn decode(bytes: &[u8], expected_fingerprint: u64) -> Result<Snapshot> {
+/// Decodes a checkpoint, checking magic, version, checksum and, if given, the fingerprint
+/// (a resume needs the scenario it was written with; a staged run does not).
+pub fn decode(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<Snapshot> {
     if bytes.len() < MAGIC.len() + 4 || &bytes[..MAGIC.len()] != MAGIC {
         bail!("not a tinydem checkpoint (no 'TINYDEM CKPT' header)");
     }
@@ -218,7 +230,8 @@ pub fn decode(bytes: &[u8], expected_fingerprint: u64) -> Result<Snapshot> {
         bytes: body,
         at: 16,
     };
-    if r.u64()? != expected_fingerprint {
+    let fingerprint = r.u64()?;
+    if expected_fingerprint.is_some_and(|f| f != fingerprint) {
         bail!(
             "the checkpoint was written for a different scenario or mesh (material, time step, \
              spawning, geometry): resume it with the scenario it was written with"
@@ -277,6 +290,8 @@ pub fn decode(bytes: &[u8], expected_fingerprint: u64) -> Result<Snapshot> {
     let face_history = r.history()?;
     let mut removed = Removed::default();
     let mut wall_sums = Vec::new();
+    let mut scenario = String::new();
+    let mut mesh_files = Vec::new();
     if v3 {
         let outflow = |r: &mut Reader| -> Result<Outflow> {
             Ok(Outflow {
@@ -297,6 +312,13 @@ pub fn decode(bytes: &[u8], expected_fingerprint: u64) -> Result<Snapshot> {
                     tau: r.vec3()?,
                 })
             })
+            .collect::<Result<_>>()?;
+        let len = r.count(1)?;
+        scenario = String::from_utf8(r.take(len)?.to_vec())
+            .map_err(|_| anyhow::anyhow!("corrupt checkpoint: its scenario is not UTF-8"))?;
+        let files = r.count(16)?;
+        mesh_files = (0..files)
+            .map(|_| Ok((r.u64()?, r.u64()?)))
             .collect::<Result<_>>()?;
     }
     if r.at != body.len() {
@@ -319,6 +341,8 @@ pub fn decode(bytes: &[u8], expected_fingerprint: u64) -> Result<Snapshot> {
         face_history,
         removed,
         wall_sums,
+        scenario,
+        mesh_files,
     })
 }
 
@@ -338,8 +362,8 @@ pub fn save(path: &Path, snapshot: &Snapshot, fingerprint: u64) -> Result<()> {
     write().with_context(|| format!("cannot write checkpoint {}", path.display()))
 }
 
-/// Reads a checkpoint for `scenario` with its `mesh`.
-pub fn load(path: &Path, fingerprint: u64) -> Result<Snapshot> {
+/// Reads a checkpoint, for the scenario and mesh of `fingerprint` if given.
+pub fn load(path: &Path, fingerprint: Option<u64>) -> Result<Snapshot> {
     let bytes = std::fs::read(path)
         .with_context(|| format!("cannot read checkpoint {}", path.display()))?;
     decode(&bytes, fingerprint).with_context(|| format!("cannot resume from {}", path.display()))
@@ -393,13 +417,15 @@ mod tests {
                 f: DVec3::new(1.0, -2.0, 3.0),
                 tau: DVec3::new(0.5, 0.25, -1e-9),
             }],
+            scenario: "[simulation]\nframes = 3\n".into(),
+            mesh_files: vec![(0, 1), (12, 0xdead_beef)],
         }
     }
 
     #[test]
     fn round_trip_is_exact() {
         let s = snapshot();
-        assert_eq!(decode(&encode(&s, 7), 7).unwrap(), s);
+        assert_eq!(decode(&encode(&s, 7), Some(7)).unwrap(), s);
     }
 
     #[test]
@@ -407,21 +433,23 @@ mod tests {
         // A version 2 file: no material per particle, nothing removed, no wall loads.
         let mut s = snapshot();
         (s.removed, s.wall_sums) = (Removed::default(), Vec::new());
+        (s.scenario, s.mesh_files) = (String::new(), Vec::new());
         let v3 = encode(&s, 7);
         let body = &v3[..v3.len() - 4];
         // The one particle's record starts at byte 77 (after the header and the count); its
-        // material is the last 2 of its 122 bytes; the removal and load counts end the body.
-        let mut v2 = [&body[..77 + 120], &body[77 + 122..body.len() - 32]].concat();
+        // material is the last 2 of its 122 bytes; the counts of removals, loads, scenario
+        // and mesh files end the body.
+        let mut v2 = [&body[..77 + 120], &body[77 + 122..body.len() - 48]].concat();
         v2[12..16].copy_from_slice(&2u32.to_le_bytes());
         let crc = crc32fast::hash(&v2);
         v2.extend_from_slice(&crc.to_le_bytes());
-        assert_eq!(decode(&v2, 7).unwrap(), s);
+        assert_eq!(decode(&v2, Some(7)).unwrap(), s);
     }
 
     #[test]
     fn damage_is_refused() {
         let bytes = encode(&snapshot(), 7);
-        let msg = |b: &[u8], f| format!("{:#}", decode(b, f).unwrap_err());
+        let msg = |b: &[u8], f| format!("{:#}", decode(b, Some(f)).unwrap_err());
         assert!(msg(&bytes, 8).contains("different scenario"));
         assert!(msg(&bytes[..bytes.len() - 9], 7).contains("checksum"));
         let mut flipped = bytes.clone();

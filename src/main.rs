@@ -9,7 +9,7 @@ use clap::{Parser, Subcommand};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use tinydem::render::{ColorBy, Style, View};
-use tinydem::run::{Interrupted, Options, Summary, Verbosity, describe, run};
+use tinydem::run::{Interrupted, Options, Summary, Verbosity, describe, describe_stage, run};
 use tinydem::scenario::Scenario;
 use tinydem::simulation::Stage;
 
@@ -41,11 +41,20 @@ enum Command {
         quiet: bool,
         /// Continue an interrupted run from its checkpoint (written to the output
         /// directory on Ctrl-C/SIGTERM and every `[output] checkpoint_every` frames).
-        #[arg(long)]
+        #[arg(long, conflicts_with = "from")]
         resume: Option<PathBuf>,
+        /// Start a new stage of a study from the checkpoint of another run (its particles
+        /// and contact history; the rest from SCENARIO, whose clock starts at 0).
+        #[arg(long)]
+        from: Option<PathBuf>,
     },
     /// Validate a scenario and print derived quantities.
-    Check { scenario: PathBuf },
+    Check {
+        scenario: PathBuf,
+        /// Also say what the scenario changes as a stage after this checkpoint.
+        #[arg(long)]
+        from: Option<PathBuf>,
+    },
     /// Measure every frame of an output directory: kinetic energy, coordination number,
     /// packing fraction; optionally the angle of repose and the height of large particles.
     Analyze {
@@ -183,6 +192,7 @@ fn execute(command: Option<Command>, resume_default: Option<PathBuf>) -> Result<
             let options = Options {
                 verbosity: Verbosity::Normal,
                 resume: resume_default.as_deref(),
+                from: None,
                 stop: Some(&STOP),
             };
             let summary = run(s, &out, options)?;
@@ -193,6 +203,7 @@ fn execute(command: Option<Command>, resume_default: Option<PathBuf>) -> Result<
             output,
             quiet,
             resume,
+            from,
         }) => {
             let s = Scenario::load(&scenario)?;
             let out = output.unwrap_or_else(|| s.output_dir.clone());
@@ -205,6 +216,7 @@ fn execute(command: Option<Command>, resume_default: Option<PathBuf>) -> Result<
             let options = Options {
                 verbosity,
                 resume: resume.as_deref(),
+                from: from.as_deref(),
                 stop: Some(&STOP),
             };
             let summary = run(s, &out, options)?;
@@ -275,9 +287,12 @@ fn execute(command: Option<Command>, resume_default: Option<PathBuf>) -> Result<
             csv,
             plot.map(|p| (p, column)),
         )?,
-        Some(Command::Check { scenario }) => {
+        Some(Command::Check { scenario, from }) => {
             let s = Scenario::load(&scenario)?;
-            print!("{}", describe(&s)?);
+            match from {
+                None => print!("{}", describe(&s)?),
+                Some(from) => print!("{}", describe_stage(&s, &from)?),
+            }
         }
     }
     Ok(())

@@ -41,6 +41,8 @@ pub struct Options<'a> {
     pub verbosity: Verbosity,
     /// Continue from this checkpoint instead of starting afresh.
     pub resume: Option<&'a Path>,
+    /// Start from the particles and contacts of this checkpoint of another run (a stage).
+    pub from: Option<&'a Path>,
     /// Set (by a signal handler) to stop after the current step with a checkpoint.
     pub stop: Option<&'a AtomicBool>,
 }
@@ -161,13 +163,24 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
     let steps_per_frame = scenario.simulation.steps_per_frame;
     let checkpoint_every = scenario.checkpoint_every;
     let mut sim = match options.resume {
-        None => Simulation::new(scenario)?,
+        None => match options.from {
+            None => Simulation::new(scenario)?,
+            Some(path) => {
+                let snapshot = checkpoint::load(path, None)?;
+                let (sim, notes) = Simulation::stage(scenario, snapshot)
+                    .with_context(|| format!("cannot start a stage from {}", path.display()))?;
+                if options.verbosity == Verbosity::Normal {
+                    eprintln!("stage from {}: {}", path.display(), notes.join("; "));
+                }
+                sim
+            }
+        },
         Some(path) => {
             let fresh = Simulation::new(Scenario {
                 particles: None,
                 ..scenario.clone()
             })?;
-            let snapshot = checkpoint::load(path, fingerprint(&fresh))?;
+            let snapshot = checkpoint::load(path, Some(fingerprint(&fresh)))?;
             Simulation::restore(scenario, snapshot)?
         }
     };
@@ -536,6 +549,37 @@ pub fn describe(s: &Scenario) -> Result<String> {
         human_bytes(frame_bytes as f64),
         human_bytes(frame_bytes as f64 * (s.simulation.frames + 1) as f64),
     ))
+}
+
+/// What `tinydem check SCENARIO --from CHECKPOINT` prints: the scenario's derived
+/// quantities, then what it changes as a stage after the checkpoint's run and what it
+/// carries over.
+pub fn describe_stage(s: &Scenario, from: &Path) -> Result<String> {
+    let mut out = describe(s)?;
+    let snapshot = checkpoint::load(from, None)?;
+    let old = snapshot.scenario.clone();
+    let steps = snapshot.steps;
+    let (_, notes) = Simulation::stage(s.clone(), snapshot)
+        .with_context(|| format!("cannot start a stage from {}", from.display()))?;
+    out += &format!(
+        "stage from             {} (step {steps} of its run); the clock starts at 0\n",
+        from.display()
+    );
+    if old.is_empty() {
+        out += "changes                unknown (the checkpoint predates format 3)\n";
+    } else {
+        let changes = crate::scenario::changes(&old, &s.to_toml());
+        if changes.is_empty() {
+            out += "changes                none\n";
+        }
+        for (k, c) in changes.iter().enumerate() {
+            out += &format!("{:<23}{c}\n", if k == 0 { "changes" } else { "" });
+        }
+    }
+    for (k, note) in notes.iter().enumerate() {
+        out += &format!("{:<23}{note}\n", if k == 0 { "carries" } else { "" });
+    }
+    Ok(out)
 }
 
 /// A byte count in kB, MB or GB.

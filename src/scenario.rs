@@ -203,6 +203,50 @@ impl Formats {
     }
 }
 
+/// What `new` changes with respect to `old` (both resolved scenarios, `Scenario::to_toml`),
+/// one line per key: `[material] friction_sliding: 0.3 -> 0.5`, `[[meshes]] #2 file: added
+/// "plug.off"`.
+pub fn changes(old: &str, new: &str) -> Vec<String> {
+    // `section key` -> value, in the order of the text.
+    fn flat(text: &str) -> Vec<(String, String)> {
+        let mut out = Vec::new();
+        let mut section = String::new();
+        let mut counts: std::collections::HashMap<String, usize> = Default::default();
+        for line in text.lines().map(str::trim) {
+            if line.starts_with("[[") {
+                let n = counts.entry(line.to_string()).or_default();
+                *n += 1;
+                section = format!("{line} #{n}");
+            } else if line.starts_with('[') {
+                section = line.to_string();
+            } else if let Some(mesh) = line.strip_prefix("# mesh: ") {
+                out.push((format!("{section} mesh"), format!("{mesh:?}")));
+            } else if let Some((k, v)) = line.split_once(" = ") {
+                out.push((format!("{section} {k}"), v.to_string()));
+            }
+        }
+        out
+    }
+    let (old, new) = (flat(old), flat(new));
+    let find = |list: &[(String, String)], key: &str| {
+        list.iter().find(|(k, _)| k == key).map(|(_, v)| v.clone())
+    };
+    let mut lines = Vec::new();
+    for (key, value) in &new {
+        match find(&old, key) {
+            Some(was) if was != *value => lines.push(format!("{key}: {was} -> {value}")),
+            Some(_) => {}
+            None => lines.push(format!("{key}: added {value}")),
+        }
+    }
+    for (key, value) in &old {
+        if find(&new, key).is_none() {
+            lines.push(format!("{key}: removed (was {value})"));
+        }
+    }
+    lines
+}
+
 /// Default time step, Eq. (50): Δt = R_min sqrt(ρ (1 - ν²) / E).
 pub fn default_timestep(radius_min: f64, material: &Material) -> f64 {
     let nu = material.poisson_ratio;
@@ -719,6 +763,147 @@ impl Scenario {
         })
     }
 
+    /// The scenario as TOML with every default filled in: parsed again (from a file in the
+    /// current directory) it gives the same scenario. A built-in mesh is named in a comment.
+    pub fn to_toml(&self) -> String {
+        use std::fmt::Write;
+        let f = |x: f64| format!("{x:?}");
+        let v = |x: DVec3| format!("[{:?}, {:?}, {:?}]", x.x, x.y, x.z);
+        let list = |xs: &[f64]| {
+            let items: Vec<String> = xs.iter().map(|&x| f(x)).collect();
+            format!("[{}]", items.join(", "))
+        };
+        let text = |t: &str| toml::Value::String(t.to_string()).to_string();
+        let path = |p: &Path| text(&p.display().to_string());
+        let contacts = |c: Contacts| match c {
+            Contacts::Merged => "\"merged\"",
+            Contacts::PerFace => "\"per_face\"",
+        };
+        let mut o = String::new();
+        let g = &self.geometry;
+        o += "[geometry]\n";
+        let _ = writeln!(o, "radius_min = {}", f(g.radius_min));
+        let _ = writeln!(o, "radius_max = {}", f(g.radius_max));
+        match &g.mesh {
+            MeshSource::None => {}
+            MeshSource::File(p) => {
+                let _ = writeln!(o, "mesh = {}", path(p));
+            }
+            MeshSource::Embedded { name, .. } => {
+                let _ = writeln!(o, "# mesh: {name}");
+            }
+        }
+        let _ = writeln!(o, "mesh_radii = {}", list(&g.mesh_radii));
+        let _ = writeln!(o, "mesh_contacts = {}", contacts(g.mesh_contacts));
+        let _ = writeln!(o, "spawn_min = {}", v(g.spawn_min));
+        let _ = writeln!(o, "spawn_max = {}", v(g.spawn_max));
+        let m = &self.material;
+        o += "\n[material]\n";
+        for (key, x) in [
+            ("density", m.density),
+            ("youngs_modulus", m.youngs_modulus),
+            ("poisson_ratio", m.poisson_ratio),
+            ("restitution", m.restitution),
+            ("friction_sliding", m.friction_sliding),
+            ("friction_rolling", m.friction_rolling),
+            ("friction_twisting", m.friction_twisting),
+            ("viscosity", m.viscosity),
+        ] {
+            let _ = writeln!(o, "{key} = {}", f(x));
+        }
+        let k = &self.kinetics;
+        o += "\n[kinetics]\n";
+        let _ = writeln!(o, "initial_velocity = {}", v(k.initial_velocity));
+        let _ = writeln!(
+            o,
+            "initial_angular_velocity = {}",
+            v(k.initial_angular_velocity)
+        );
+        let _ = writeln!(o, "gravity = {}", v(k.gravity));
+        let s = &self.simulation;
+        o += "\n[simulation]\n";
+        let _ = writeln!(o, "timestep = {}", f(s.timestep));
+        for (key, n) in [
+            ("max_particles", s.max_particles),
+            ("frames", s.frames),
+            ("steps_per_frame", s.steps_per_frame),
+            ("spawn_attempts", s.spawn_attempts),
+            ("seed", s.seed),
+        ] {
+            let _ = writeln!(o, "{key} = {n}");
+        }
+        for mesh in &self.meshes {
+            o += "\n[[meshes]]\n";
+            let _ = writeln!(o, "file = {}", path(&mesh.file));
+            let _ = writeln!(o, "radii = {}", list(&mesh.radii));
+            let _ = writeln!(o, "contacts = {}", contacts(mesh.contacts));
+            match mesh.motion {
+                None => {}
+                Some(Motion::Harmonic {
+                    amplitude,
+                    frequency,
+                    direction,
+                    phase,
+                }) => {
+                    let _ = writeln!(
+                        o,
+                        "motion = {{ type = \"harmonic\", amplitude = {}, frequency = {}, direction = {}, phase = {} }}",
+                        f(amplitude),
+                        f(frequency),
+                        v(direction),
+                        f(phase)
+                    );
+                }
+                Some(Motion::Velocity { velocity }) => {
+                    let _ = writeln!(
+                        o,
+                        "motion = {{ type = \"velocity\", velocity = {} }}",
+                        v(velocity)
+                    );
+                }
+                Some(Motion::Rotation {
+                    center,
+                    axis,
+                    angular_velocity,
+                }) => {
+                    let _ = writeln!(
+                        o,
+                        "motion = {{ type = \"rotation\", center = {}, axis = {}, angular_velocity = {} }}",
+                        v(center),
+                        v(axis),
+                        f(angular_velocity)
+                    );
+                }
+            }
+        }
+        for t in &self.tags {
+            o += "\n[[tags]]\n";
+            let _ = writeln!(o, "min = {}\nmax = {}\ntag = {}", v(t.min), v(t.max), t.tag);
+        }
+        if let Some(d) = self.domain {
+            let _ = writeln!(o, "\n[domain]\nmin = {}\nmax = {}", v(d.min), v(d.max));
+        }
+        for b in &self.outlets {
+            let _ = writeln!(o, "\n[[outlets]]\nmin = {}\nmax = {}", v(b.min), v(b.max));
+        }
+        if let Some(p) = &self.particles {
+            let _ = writeln!(o, "\n[input]\nparticles = {}", path(p));
+        }
+        o += "\n[output]\n";
+        let _ = writeln!(o, "dir = {}", path(&self.output_dir));
+        let _ = writeln!(o, "checkpoint_every = {}", self.checkpoint_every);
+        let mut formats = Vec::new();
+        if self.formats.csv {
+            formats.push("\"csv\"");
+        }
+        if self.formats.vtk {
+            formats.push("\"vtk\"");
+        }
+        let _ = writeln!(o, "formats = [{}]", formats.join(", "));
+        let _ = writeln!(o, "wall_forces = {}", self.wall_forces);
+        o
+    }
+
     /// Whether particles can be removed during the run (a domain or outlets).
     pub fn removes(&self) -> bool {
         self.domain.is_some() || !self.outlets.is_empty()
@@ -762,6 +947,60 @@ mod tests {
             msg.contains("poisson_ratio") && msg.contains("(-1, 0.5]"),
             "{msg}"
         );
+    }
+
+    #[test]
+    fn the_resolved_toml_parses_back_to_the_same_scenario() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scenarios/good");
+        for name in ["full.toml", "minimal.toml"] {
+            let s = Scenario::load(&dir.join(name)).unwrap();
+            let again = Scenario::parse(&s.to_toml(), Path::new("run.toml")).unwrap();
+            assert_eq!(again, s, "{name}:\n{}", s.to_toml());
+        }
+        let moving = Scenario::parse(
+            "[[meshes]]\nfile = \"a.stl\"\nmotion = { type = \"harmonic\", amplitude = 1e-3, frequency = 25.0, direction = [0.0, 0.0, 1.0] }\n\
+             [[meshes]]\nfile = \"b c.off\"\nradii = [0.001, 0.0]\nmotion = { type = \"velocity\", velocity = [0.1, 0.0, 0.0] }\n\
+             [[meshes]]\nfile = \"d.off\"\nmotion = { type = \"rotation\", center = [0.0, 1.0, 0.0], axis = [0.0, 1.0, 0.0], angular_velocity = -3.0 }\n\
+             [[tags]]\nmin = [0.0, 0.0, 0.0]\nmax = [1.0, 1.0, 1.0]\ntag = 3\n",
+            Path::new("s.toml"),
+        )
+        .unwrap();
+        let again = Scenario::parse(&moving.to_toml(), Path::new("run.toml")).unwrap();
+        assert_eq!(again, moving, "{}", moving.to_toml());
+        let d = Scenario::default();
+        let mut again = Scenario::parse(&d.to_toml(), Path::new("run.toml")).unwrap();
+        assert!(d.to_toml().contains("# mesh: hourglass.off (built in)"));
+        again.geometry.mesh = d.geometry.mesh.clone();
+        assert_eq!(again, d);
+    }
+
+    #[test]
+    fn changes_name_each_key() {
+        let old = Scenario::parse(
+            "[material]\nfriction_sliding = 0.3\n[[meshes]]\nfile = \"a.off\"\n[[meshes]]\nfile = \"plug.off\"\n",
+            Path::new("s.toml"),
+        )
+        .unwrap();
+        let new = Scenario::parse(
+            "[material]\nfriction_sliding = 0.5\n[[meshes]]\nfile = \"a.off\"\n[[outlets]]\nmin = [0.0, 0.0, 0.0]\nmax = [1.0, 1.0, 1.0]\n[simulation]\nframes = 7\n",
+            Path::new("s.toml"),
+        )
+        .unwrap();
+        let c = changes(&old.to_toml(), &new.to_toml());
+        assert_eq!(
+            c,
+            [
+                "[material] friction_sliding: 0.3 -> 0.5",
+                "[material] friction_twisting: 0.19999999999999998 -> 0.3333333333333333",
+                "[simulation] frames: 100 -> 7",
+                "[[outlets]] #1 min: added [0.0, 0.0, 0.0]",
+                "[[outlets]] #1 max: added [1.0, 1.0, 1.0]",
+                "[[meshes]] #2 file: removed (was \"plug.off\")",
+                "[[meshes]] #2 radii: removed (was [0.0])",
+                "[[meshes]] #2 contacts: removed (was \"merged\")",
+            ]
+        );
+        assert!(changes(&new.to_toml(), &new.to_toml()).is_empty());
     }
 
     #[test]

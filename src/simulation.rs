@@ -227,6 +227,12 @@ pub struct Snapshot {
     pub removed: Removed,
     /// The loads on the mesh files summed since the last frame (`[output] wall_forces`).
     pub wall_sums: Vec<Wrench>,
+    /// The resolved scenario of the run (`Scenario::to_toml`), to tell what a staged run
+    /// changes.
+    pub scenario: String,
+    /// Face count and a hash of the faces of each mesh file, to find them in the mesh of a
+    /// staged run.
+    pub mesh_files: Vec<(u64, u64)>,
 }
 
 /// The partner of a particle in a contact.
@@ -572,6 +578,111 @@ impl Simulation {
         Ok(sim)
     }
 
+    /// Starts a new stage of a study from the snapshot of another run (`tinydem run NEXT
+    /// --from CHECKPOINT`): the particles (ids, materials, tags) and all their contact
+    /// history are the snapshot's, everything else is `scenario`'s, whose clock starts at 0
+    /// (its meshes start their motions at rest, its frames count from 0). Contacts with a
+    /// mesh file are carried when `scenario` has the same file (the same faces), wherever
+    /// it stands in the list; the spawner continues its random stream if the seed is the
+    /// same. When the mesh is the same too, the lists are rebuilt as the run had them, so a
+    /// stage that only adds frames gives the bits of one uninterrupted run. Returns what was
+    /// carried and dropped, for the user.
+    pub fn stage(scenario: Scenario, snapshot: Snapshot) -> Result<(Simulation, Vec<String>)> {
+        if scenario.particles.is_some() {
+            bail!(
+                "[input] particles cannot be combined with --from: the particles are those of the checkpoint"
+            );
+        }
+        let mut sim = Simulation::new(scenario)?;
+        let misfit = |what: String| anyhow::anyhow!("the checkpoint does not fit: {what}");
+        let mut notes = Vec::new();
+        let p = snapshot.particles;
+        if let Some(&m) = p.material.iter().find(|&&m| m != 0) {
+            bail!("the checkpoint holds particles of material {m}; the scenario has one material");
+        }
+        let old_seed = if snapshot.scenario.is_empty() {
+            None
+        } else {
+            let old = Scenario::parse(&snapshot.scenario, std::path::Path::new("checkpoint"))
+                .map_err(|e| misfit(format!("its scenario does not parse: {e:#}")))?;
+            Some(old.simulation.seed)
+        };
+        if old_seed == Some(sim.scenario.simulation.seed) {
+            sim.spawner = Spawner::resume(sim.scenario.simulation.seed, snapshot.spawner);
+            notes.push("spawning continues the random stream of the checkpoint".into());
+        } else {
+            notes.push(format!(
+                "spawning draws from a new random stream (seed {})",
+                sim.scenario.simulation.seed
+            ));
+        }
+        // Each mesh file of the checkpoint's run, found among this scenario's by its faces.
+        let new_files = sim.mesh_signatures();
+        let mut taken = vec![false; new_files.len()];
+        let mut face_map: Vec<Option<u32>> = Vec::new();
+        for old in &snapshot.mesh_files {
+            let found = (0..new_files.len()).find(|&j| !taken[j] && new_files[j] == *old);
+            if let Some(j) = found {
+                taken[j] = true;
+            }
+            let start = found.map(|j| sim.mesh_files[j].faces.start as u32);
+            face_map.extend((0..old.0 as u32).map(|f| start.map(|s| s + f)));
+        }
+        let face_history: Vec<_> = snapshot
+            .face_history
+            .iter()
+            .filter_map(|&(id, f, springs)| {
+                face_map
+                    .get(f as usize)
+                    .copied()
+                    .flatten()
+                    .map(|f| (id, f, springs))
+            })
+            .collect();
+        let dropped = snapshot.face_history.len() - face_history.len();
+        let same_mesh = snapshot.mesh_files == new_files;
+        notes.push(format!(
+            "carried {} particles, {} particle contacts and {} contacts with meshes{}",
+            p.len(),
+            snapshot.pair_history.len(),
+            face_history.len(),
+            if dropped > 0 {
+                format!(" ({dropped} with mesh files this scenario lacks were dropped)")
+            } else {
+                String::new()
+            }
+        ));
+        let history = Histories {
+            pairs: History::in_storage(&p, &snapshot.pair_history, true).map_err(misfit)?,
+            faces: History::in_storage(&p, &face_history, false).map_err(misfit)?,
+        };
+        let built = !snapshot.anchors.is_empty();
+        if built && snapshot.anchors.len() != p.len() {
+            return Err(misfit("one anchor per particle".into()));
+        }
+        sim.particles = p;
+        if built {
+            // The lists at the positions of the run's last rebuild; the allowances of its
+            // lonely particles hold only for the same mesh.
+            let lonely = if same_mesh {
+                snapshot.lonely
+            } else {
+                Vec::new()
+            };
+            sim.regrid_faces();
+            sim.neighbours.restore(
+                &sim.particles,
+                snapshot.anchors,
+                lonely,
+                &sim.mesh.faces,
+                &sim.face_grid,
+                &history,
+            );
+            sim.built();
+        }
+        Ok((sim, notes))
+    }
+
     /// The complete state of the run.
     pub fn snapshot(&self) -> Snapshot {
         let p = &self.particles;
@@ -588,6 +699,8 @@ impl Simulation {
             face_history: history.faces.entries(),
             removed: self.removed.clone(),
             wall_sums: self.wall_sums.clone(),
+            scenario: self.scenario.to_toml(),
+            mesh_files: self.mesh_signatures(),
         }
     }
 
@@ -636,6 +749,22 @@ impl Simulation {
         };
         sim.sum_wall_loads();
         Ok(sim)
+    }
+
+    /// Face count and a hash of the rest geometry of each mesh file (shape, radius and
+    /// contact mode of its faces, in order).
+    pub fn mesh_signatures(&self) -> Vec<(u64, u64)> {
+        self.mesh_files
+            .iter()
+            .map(|file| {
+                let faces = &self.rest_faces[file.faces.clone()];
+                let text: String = faces
+                    .iter()
+                    .map(|f| format!("{:?}{:?}{:?};", f.shape, f.radius, f.contacts))
+                    .collect();
+                (faces.len() as u64, crate::checkpoint::hash(&text))
+            })
+            .collect()
     }
 
     /// Number of neighbour-list rebuilds so far.

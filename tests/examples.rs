@@ -27,6 +27,7 @@ fn every_example_runs_a_few_frames() {
         let options = Options {
             verbosity: Verbosity::Quiet,
             resume: None,
+            from: None,
             stop: None,
         };
         let summary =

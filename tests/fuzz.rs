@@ -143,13 +143,13 @@ proptest! {
 
     #[test]
     fn checkpoint_reader_never_panics(bytes in prop::collection::vec(any::<u8>(), 0..300), flips in prop::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 0..4)) {
-        let _ = checkpoint::decode(&bytes, 1);
+        let _ = checkpoint::decode(&bytes, Some(1));
         let mut valid = checkpoint::encode(&sample_snapshot(), 1);
         for (idx, b) in flips {
             let k = idx.index(valid.len());
             valid[k] ^= b;
         }
-        let _ = checkpoint::decode(&valid, 1);
+        let _ = checkpoint::decode(&valid, Some(1));
     }
 }
 
