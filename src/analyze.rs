@@ -7,11 +7,13 @@ use crate::integrate::Inertia;
 use crate::neighbours::CellGrid;
 use crate::particles::Particles;
 
-/// Kinetic energy, translational and rotational [J], for density `rho`.
-pub fn kinetic_energy(p: &Particles, rho: f64) -> f64 {
+/// Kinetic energy, translational and rotational [J], for the density `rho[m]` of each
+/// particle's material m.
+pub fn kinetic_energy(p: &Particles, rho: &[f64]) -> f64 {
     (0..p.len())
         .map(|k| {
-            let b = Inertia::new(p.radius[k], rho, 0.0);
+            let density = rho.get(p.material[k] as usize).copied().unwrap_or(rho[0]);
+            let b = Inertia::new(p.radius[k], density, 0.0);
             0.5 * b.m * p.v[k].length_squared() + 0.5 * b.i * p.w[k].length_squared()
         })
         .sum()
@@ -166,7 +168,7 @@ mod tests {
         assert!((coordination_number(&p) - 2.0 / 3.0).abs() < 1e-12);
         p.v[2] = DVec3::X;
         let m = 4.0 / 3.0 * std::f64::consts::PI * 1000.0 * 1e-6;
-        assert!((kinetic_energy(&p, 1000.0) - 0.5 * m).abs() < 1e-15);
+        assert!((kinetic_energy(&p, &[1000.0]) - 0.5 * m).abs() < 1e-15);
         assert_eq!(mean_height_of_large(&p, 0.02), None);
     }
 }

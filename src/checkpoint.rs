@@ -52,6 +52,15 @@ pub fn fingerprint(s: &Scenario, mesh: &Mesh) -> u64 {
         s.simulation.spawn_attempts,
         (s.simulation.seed, &mesh.faces),
     );
+    // Named materials (absent from older checkpoints, which stay valid without them).
+    let text = if s.uses_materials() {
+        format!(
+            "{text}|{:?}|{:?}|{}",
+            s.materials, s.interactions, s.geometry.mesh_material
+        )
+    } else {
+        text
+    };
     hash(&text)
 }
 

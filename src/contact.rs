@@ -21,9 +21,9 @@
 
 use glam::DVec3;
 
-use crate::lanes::{Displacement, Lanes};
+use crate::lanes::{Displacement, Gather, Lanes};
 use crate::motion::RigidVelocity;
-use crate::scenario::Material;
+use crate::scenario::{Material, PairCoefficients, Scenario};
 
 /// Displacements of the three static friction springs of one contact (Table 3):
 /// sliding `u_s`, rolling `u_r` and twisting `u_t`. Zero at first touch.
@@ -34,23 +34,64 @@ pub struct Springs<T: Lanes = f64> {
     pub u_t: T,
 }
 
-/// Constants of the contact law derived once from the (single) material.
-#[derive(Clone, Copy, Debug)]
+/// The constants of the contact law for one pair of materials (a particle's with another
+/// particle's, or with a wall's), derived once: one per pair, or one per lane of a group.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Coefficients<T: Lanes = f64> {
+    /// E* and G*, Eqs. (22), (23) for two materials; for a wall, of the particle against a
+    /// rigid body (text after Eq. 25).
+    pub e_star: T,
+    pub g_star: T,
+    /// Damping factor β of the pair's restitution, Eq. (21).
+    pub beta: T,
+    /// c_s / c_n = sqrt(k_s / (30 k_n)) = sqrt(G* / (5 E*)), Eqs. (18), (19), (25).
+    pub c_s_per_c_n: T,
+    /// μ_s, μ_r, μ_t of the pair.
+    pub mu_s: T,
+    pub mu_r: T,
+    pub mu_t: T,
+}
+
+impl Coefficients {
+    /// The same coefficients in every lane.
+    #[inline(always)]
+    pub fn splat<T: Lanes>(&self) -> Coefficients<T> {
+        Coefficients {
+            e_star: T::splat(self.e_star),
+            g_star: T::splat(self.g_star),
+            beta: T::splat(self.beta),
+            c_s_per_c_n: T::splat(self.c_s_per_c_n),
+            mu_s: T::splat(self.mu_s),
+            mu_r: T::splat(self.mu_r),
+            mu_t: T::splat(self.mu_t),
+        }
+    }
+
+    /// Coefficients `c[l]` in lane `l`.
+    #[inline(always)]
+    pub fn gather<T: Gather<N>, const N: usize>(c: [&Coefficients; N]) -> Coefficients<T> {
+        Coefficients {
+            e_star: T::gather(c.map(|c| c.e_star)),
+            g_star: T::gather(c.map(|c| c.g_star)),
+            beta: T::gather(c.map(|c| c.beta)),
+            c_s_per_c_n: T::gather(c.map(|c| c.c_s_per_c_n)),
+            mu_s: T::gather(c.map(|c| c.mu_s)),
+            mu_r: T::gather(c.map(|c| c.mu_r)),
+            mu_t: T::gather(c.map(|c| c.mu_t)),
+        }
+    }
+}
+
+/// The contact law of Section 2.2 with its constants for every pair of materials.
+#[derive(Clone, Debug)]
 pub struct ContactLaw {
-    /// E* and G* between two particles, Eqs. (22), (23).
-    e_star_pp: f64,
-    g_star_pp: f64,
-    /// E* and G* between a particle and a rigid wall (text after Eq. 25).
-    e_star_pw: f64,
-    g_star_pw: f64,
-    /// Damping factor β, Eq. (21).
-    beta: f64,
-    /// c_s / c_n = sqrt(k_s / (30 k_n)) = sqrt((1 - ν) / (10 (2 - ν))), Eqs. (18), (19), (25);
-    /// the same for particle-particle and particle-wall contacts since G*/E* is.
-    c_s_per_c_n: f64,
-    mu_s: f64,
-    mu_r: f64,
-    mu_t: f64,
+    /// Number of materials.
+    materials: usize,
+    /// Particle-particle coefficients of materials (a, b) at `a * materials + b`.
+    pairs: Vec<Coefficients>,
+    /// Particle-wall coefficients of particle material a and wall material w at
+    /// `a * materials + w`.
+    walls: Vec<Coefficients>,
     dt: f64,
 }
 
@@ -191,37 +232,121 @@ pub fn damping_factor(e_n: f64) -> f64 {
 }
 
 impl ContactLaw {
+    /// The law for one material (the paper's).
     pub fn new(material: &Material, dt: f64) -> Self {
-        let e = material.youngs_modulus;
-        let nu = material.poisson_ratio;
-        let g = e / (2.0 * (1.0 + nu)); // Eq. (16), G_i
+        let pair = PairCoefficients {
+            restitution: material.restitution,
+            friction_sliding: material.friction_sliding,
+            friction_rolling: material.friction_rolling,
+            friction_twisting: material.friction_twisting,
+            given: false,
+        };
         ContactLaw {
-            e_star_pp: e / (2.0 * (1.0 - nu * nu)),         // Eq. (22)
-            g_star_pp: e / (4.0 * (2.0 - nu) * (1.0 + nu)), // Eq. (23)
-            e_star_pw: e / (1.0 - nu * nu),
-            g_star_pw: g / (2.0 - nu),
-            beta: damping_factor(material.restitution), // Eq. (21)
-            c_s_per_c_n: ((1.0 - nu) / (10.0 * (2.0 - nu))).sqrt(), // Eq. (25)
-            mu_s: material.friction_sliding,
-            mu_r: material.friction_rolling,
-            mu_t: material.friction_twisting,
+            materials: 1,
+            pairs: vec![Self::particles(material, material, &pair)],
+            walls: vec![Self::wall(material, &pair)],
             dt,
         }
+    }
+
+    /// The law for every pair of the scenario's materials.
+    pub fn of(s: &Scenario) -> Self {
+        let n = s.materials.len();
+        let m = |a: usize| &s.materials[a].properties;
+        let mut law = ContactLaw {
+            materials: n,
+            pairs: Vec::with_capacity(n * n),
+            walls: Vec::with_capacity(n * n),
+            dt: s.simulation.timestep,
+        };
+        for a in 0..n {
+            for b in 0..n {
+                let pair = s.pair(a as u16, b as u16);
+                law.pairs.push(Self::particles(m(a), m(b), &pair));
+                law.walls.push(Self::wall(m(a), &pair));
+            }
+        }
+        law
+    }
+
+    /// Coefficients of two particles of materials `m` and `n`.
+    fn particles(m: &Material, n: &Material, pair: &PairCoefficients) -> Coefficients {
+        let (e_star, g_star, c_s_per_c_n) = if m == n {
+            let (e, nu) = (m.youngs_modulus, m.poisson_ratio);
+            (
+                e / (2.0 * (1.0 - nu * nu)),               // Eq. (22)
+                e / (4.0 * (2.0 - nu) * (1.0 + nu)),       // Eq. (23)
+                ((1.0 - nu) / (10.0 * (2.0 - nu))).sqrt(), // Eq. (25)
+            )
+        } else {
+            // Eqs. (22), (23) for two materials: 1/E* = (1 - ν_i²)/E_i + (1 - ν_j²)/E_j,
+            // 1/G* = (2 - ν_i)/G_i + (2 - ν_j)/G_j with G = E / (2 (1 + ν)) (Eq. 16).
+            let g = |m: &Material| m.youngs_modulus / (2.0 * (1.0 + m.poisson_ratio));
+            let compliance =
+                |m: &Material| (1.0 - m.poisson_ratio * m.poisson_ratio) / m.youngs_modulus;
+            let e_star = 1.0 / (compliance(m) + compliance(n));
+            let g_star = 1.0 / ((2.0 - m.poisson_ratio) / g(m) + (2.0 - n.poisson_ratio) / g(n));
+            (e_star, g_star, (g_star / (5.0 * e_star)).sqrt())
+        };
+        Coefficients {
+            e_star,
+            g_star,
+            beta: damping_factor(pair.restitution), // Eq. (21)
+            c_s_per_c_n,
+            mu_s: pair.friction_sliding,
+            mu_r: pair.friction_rolling,
+            mu_t: pair.friction_twisting,
+        }
+    }
+
+    /// Coefficients of a particle of material `m` against a rigid wall; the wall's material
+    /// enters through the pair's restitution and friction.
+    fn wall(m: &Material, pair: &PairCoefficients) -> Coefficients {
+        let (e, nu) = (m.youngs_modulus, m.poisson_ratio);
+        let g = e / (2.0 * (1.0 + nu)); // Eq. (16), G_i
+        Coefficients {
+            e_star: e / (1.0 - nu * nu),
+            g_star: g / (2.0 - nu),
+            beta: damping_factor(pair.restitution), // Eq. (21)
+            c_s_per_c_n: ((1.0 - nu) / (10.0 * (2.0 - nu))).sqrt(), // Eq. (25)
+            mu_s: pair.friction_sliding,
+            mu_r: pair.friction_rolling,
+            mu_t: pair.friction_twisting,
+        }
+    }
+
+    /// Whether every contact has the same coefficients (one material).
+    #[inline]
+    pub fn uniform(&self) -> bool {
+        self.materials == 1
+    }
+
+    /// The coefficients of two particles of materials `a` and `b`.
+    #[inline(always)]
+    pub fn pair(&self, a: u16, b: u16) -> &Coefficients {
+        &self.pairs[a as usize * self.materials + b as usize]
+    }
+
+    /// The coefficients of a particle of material `a` against a wall of material `w`.
+    #[inline(always)]
+    pub fn with_wall(&self, a: u16, w: u16) -> &Coefficients {
+        &self.walls[a as usize * self.materials + w as usize]
     }
 
     /// Normal stiffness k_n at overlap `delta` between two particles of radii `r_i`, `r_j`
     /// (Eqs. 12, 14, 17); used for reporting derived quantities.
     pub fn normal_stiffness(&self, r_i: f64, r_j: f64, delta: f64) -> f64 {
         let r_star = 1.0 / (1.0 / r_i + 1.0 / r_j);
-        4.0 / 3.0 * self.e_star_pp * (r_star * delta).sqrt()
+        4.0 / 3.0 * self.pair(0, 0).e_star * (r_star * delta).sqrt()
     }
 
     /// Evaluates the contact of particle `i` (radius `radius_i`, mass `m_i`) with body
-    /// `other`, updating the friction springs for the next time step. One contact, or four
-    /// particle pairs in lanes.
+    /// `other` with the pair's coefficients `coef`, updating the friction springs for the
+    /// next time step. One contact, or several in lanes.
     #[inline(always)]
     pub fn evaluate<T>(
         &self,
+        coef: &Coefficients<T>,
         radius_i: T,
         m_i: T,
         other: Other<T>,
@@ -257,27 +382,20 @@ impl ContactLaw {
                 (
                     radius_i * radius_j * sum_m * inv_a, // Eq. (17)
                     m_i * m_j * sum_r * inv_a,           // Eq. (20)
-                    c(self.e_star_pp),
-                    c(self.g_star_pp),
+                    coef.e_star,
+                    coef.g_star,
                     r_i * r_i * r_j * inv_b, // (1/r_i + 1/r_j)^-1 of Eq. (36)
                     r_j * sum_contact * inv_b,
                 )
             }
-            Other::Wall => (
-                radius_i,
-                m_i,
-                c(self.e_star_pw),
-                c(self.g_star_pw),
-                r_i,
-                c(0.0),
-            ),
+            Other::Wall => (radius_i, m_i, coef.e_star, coef.g_star, r_i, c(0.0)),
         };
 
         let a = (r_star * delta).sqrt(); // Eq. (14)
         let k_n = c(4.0 / 3.0) * e_star * a; // Eq. (12)
         let k_s = c(8.0) * g_star * a; // Eq. (13)
-        let c_n = (c(5.0) * m_star * k_n).sqrt() * c(self.beta); // Eq. (18)
-        let c_s = c_n * c(self.c_s_per_c_n); // Eq. (19), as Eq. (25)
+        let c_n = (c(5.0) * m_star * k_n).sqrt() * coef.beta; // Eq. (18)
+        let c_s = c_n * coef.c_s_per_c_n; // Eq. (19), as Eq. (25)
 
         // Normal force, along n̂: f_n = -k_n u_n - c_n v_n with u_n = -δ n̂ (Eqs. 5, 10).
         let v_dot_n = T::dot(v, n);
@@ -290,18 +408,18 @@ impl ContactLaw {
 
         // Sliding friction.
         springs.u_s = project_onto_tangent_plane::<T>(springs.u_s, n); // Eq. (52)
-        let f_s = coulomb_spring(&mut springs.u_s, v_s, k_s, c_s, c(self.mu_s) * f_n_norm, dt); // Eqs. (6), (11), (53)-(55)
+        let f_s = coulomb_spring(&mut springs.u_s, v_s, k_s, c_s, coef.mu_s * f_n_norm, dt); // Eqs. (6), (11), (53)-(55)
         let tau_s = T::cross(f_s, n) * r_i; // Eq. (31)
 
         // Rolling friction, k_r = k_n and c_r = c_n.
         let v_r = T::cross(omega, n) * r_roll; // Eq. (36)
         springs.u_r = project_onto_tangent_plane::<T>(springs.u_r, n); // Eq. (52)
-        let f_r = coulomb_spring(&mut springs.u_r, v_r, k_n, c_n, c(self.mu_r) * f_n_norm, dt); // Eqs. (34), (39), (53)-(55)
+        let f_r = coulomb_spring(&mut springs.u_r, v_r, k_n, c_n, coef.mu_r * f_n_norm, dt); // Eqs. (34), (39), (53)-(55)
         let tau_r = T::cross(n, f_r) * r_star; // Eq. (32)
 
         // Twisting friction, k_t = k_s and c_t = c_s.
         let v_t = r_star * T::dot(omega, n); // Eq. (37)
-        let f_t = coulomb_spring(&mut springs.u_t, v_t, k_s, c_s, c(self.mu_t) * f_n_norm, dt); // Eqs. (35), (40), (53)-(55)
+        let f_t = coulomb_spring(&mut springs.u_t, v_t, k_s, c_s, coef.mu_t * f_n_norm, dt); // Eqs. (35), (40), (53)-(55)
         let tau_t = n * (f_t * r_star); // Eq. (33)
 
         ContactForce {
@@ -498,7 +616,8 @@ mod tests {
                     r: j.radius,
                     m: mass(j.radius),
                 };
-                let force = law.evaluate(i.radius, mass(i.radius), other, &kin, &mut springs);
+                let coef = law.pair(0, 0);
+                let force = law.evaluate(coef, i.radius, mass(i.radius), other, &kin, &mut springs);
                 (force, springs)
             });
 
@@ -521,7 +640,14 @@ mod tests {
                 r: j.radius,
                 m: m(&j),
             };
-            let force = law.evaluate(i.radius, m(&i), other, &kin, &mut springs);
+            let force = law.evaluate(
+                &law.pair(0, 0).splat(),
+                i.radius,
+                m(&i),
+                other,
+                &kin,
+                &mut springs,
+            );
             same_bits(&single, force, springs)
         }
 
@@ -560,6 +686,7 @@ mod tests {
             let single: [_; N] = std::array::from_fn(|l| {
                 let (body, _, mut springs) = contacts[l];
                 let force = law.evaluate(
+                    law.with_wall(0, 0),
                     body.radius,
                     mass(body.radius),
                     Other::Wall,
@@ -583,7 +710,14 @@ mod tests {
             };
             let radius = T::gather(contacts.map(|c| c.0.radius));
             let m = T::gather(contacts.map(|c| mass(c.0.radius)));
-            let force = law.evaluate(radius, m, Other::Wall, &lanes, &mut springs);
+            let force = law.evaluate(
+                &law.with_wall(0, 0).splat(),
+                radius,
+                m,
+                Other::Wall,
+                &lanes,
+                &mut springs,
+            );
             same_bits(&single, force, springs)
         }
 

@@ -46,7 +46,35 @@ impl Inertia {
     /// R³ = (R R) R, the bits of `radius.powi(3)`.
     #[inline(always)]
     pub fn mass<T: Lanes>(radius: T, density: f64) -> T {
-        T::splat(4.0 / 3.0 * std::f64::consts::PI * density) * (radius * radius * radius)
+        Inertia::mass_with(radius, T::splat(Density::new(density, 0.0).mass_per_r3))
+    }
+
+    /// Mass from 4/3 π ρ (`Density::mass_per_r3`, in lanes: each particle's material's).
+    #[inline(always)]
+    pub fn mass_with<T: Lanes>(radius: T, mass_per_r3: T) -> T {
+        mass_per_r3 * (radius * radius * radius)
+    }
+}
+
+/// The quotients of a material's density (and the fluid's viscosity) that Eqs. (1)-(4)
+/// need, computed once per material.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Density {
+    /// 4/3 π ρ: m = (4/3 π ρ) R³
+    pub mass_per_r3: f64,
+    /// 3 / (4 π ρ): 1/m = R⁻³ 3 / (4 π ρ)
+    pub inv_mass_r3: f64,
+    /// 4.5 η / ρ: c = (4.5 η / ρ) / R², Eq. (3)
+    pub drag: f64,
+}
+
+impl Density {
+    pub fn new(density: f64, viscosity: f64) -> Density {
+        Density {
+            mass_per_r3: 4.0 / 3.0 * std::f64::consts::PI * density,
+            inv_mass_r3: 0.75 / std::f64::consts::PI / density,
+            drag: 4.5 * (viscosity / density),
+        }
     }
 }
 
@@ -67,11 +95,18 @@ impl<T: Lanes> Response<T> {
     /// hoisted out of a loop over particles).
     #[inline(always)]
     pub fn new(radius: T, density: f64, viscosity: f64) -> Self {
+        let d = Density::new(density, viscosity);
+        Response::with(radius, T::splat(d.inv_mass_r3), T::splat(d.drag))
+    }
+
+    /// The response from a material's quotients (`Density`; in lanes, each particle's).
+    #[inline(always)]
+    pub fn with(radius: T, inv_mass_r3: T, drag: T) -> Self {
         let k = T::splat;
         let inv_r = k(1.0) / radius;
         let inv_r2 = inv_r * inv_r;
-        let inv_m = inv_r2 * inv_r * k(0.75 / std::f64::consts::PI / density);
-        let c = k(4.5 * (viscosity / density)) * inv_r2; // Eq. (3)
+        let inv_m = inv_r2 * inv_r * inv_mass_r3;
+        let c = drag * inv_r2; // Eq. (3)
         Response {
             inv_m,
             inv_i: k(2.5) * inv_m * inv_r2,

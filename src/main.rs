@@ -543,6 +543,7 @@ fn analyze_command(
     if tag.is_some() {
         header.extend(["tagged", "tagged_mean_height"]);
     }
+    let densities: Vec<f64> = s.materials.iter().map(|m| m.properties.density).collect();
     let mut rows = Vec::new();
     println!(
         "{}",
@@ -557,7 +558,7 @@ fn analyze_command(
             k.to_string(),
             format!("{:.6e}", k as f64 * frame_time),
             p.len().to_string(),
-            format!("{:.6e}", kinetic_energy(&p, s.material.density)),
+            format!("{:.6e}", kinetic_energy(&p, &densities)),
             format!("{:.4}", coordination_number(&p)),
             format!("{:.4}", packing_fraction(&p)),
         ];

@@ -464,8 +464,12 @@ pub fn describe(s: &Scenario) -> Result<String> {
     let m = &s.material;
     let dt = s.simulation.timestep;
     let law = ContactLaw::new(m, dt);
-    let m_min = Inertia::mass(g.radius_min, m.density);
-    let m_max = Inertia::mass(g.radius_max, m.density);
+    let densities = s.materials.iter().map(|m| m.properties.density);
+    let m_min = Inertia::mass(
+        g.radius_min,
+        densities.clone().fold(f64::INFINITY, f64::min),
+    );
+    let m_max = Inertia::mass(g.radius_max, densities.fold(0.0, f64::max));
     // Stiffness of two R_min particles at 10 % relative indentation δ / (2 R*) (Section 2.3).
     let r = g.radius_min;
     let k_10 = law.normal_stiffness(r, r, 0.1 * r);
@@ -491,6 +495,14 @@ pub fn describe(s: &Scenario) -> Result<String> {
                 }
             ),
             Contacts::PerFace => "per face (the original program's)".to_string(),
+        };
+        let contacts = if s.materials.len() > 1 {
+            format!(
+                "{contacts}, material \"{}\"",
+                s.materials[file.material as usize].name
+            )
+        } else {
+            contacts
         };
         meshes += &format!(
             "{:<23}{}: {} faces, contacts {contacts}\n",
@@ -527,10 +539,70 @@ pub fn describe(s: &Scenario) -> Result<String> {
             "wall loads             force and torque on each mesh file, mean per frame ({WALLS})\n"
         );
     }
-    let default_dt = crate::scenario::default_timestep(g.radius_min, m);
+    let mut materials = String::new();
+    if s.materials.len() > 1 || s.materials[0].name != "default" {
+        for (k, m) in s.materials.iter().enumerate() {
+            let p = &m.properties;
+            materials += &format!(
+                "{:<23}{k} \"{}\": density {}, E {:e}, nu {}, e_n {}, mu_s {}, mu_r {}, mu_t {}\n",
+                if k == 0 { "materials" } else { "" },
+                m.name,
+                num(p.density),
+                p.youngs_modulus,
+                num(p.poisson_ratio),
+                num(p.restitution),
+                num(p.friction_sliding),
+                num(p.friction_rolling),
+                num(p.friction_twisting)
+            );
+        }
+        let n = s.materials.len() as u16;
+        let mut first = true;
+        for a in 0..n {
+            for b in a..n {
+                let c = s.pair(a, b);
+                let how = if a == b {
+                    "its own".to_string()
+                } else {
+                    let i = s.interactions.iter().find(|i| i.materials == (a, b));
+                    let mut given = Vec::new();
+                    if let Some(i) = i {
+                        for (name, x) in [
+                            ("e_n", i.restitution),
+                            ("mu_s", i.friction_sliding),
+                            ("mu_r", i.friction_rolling),
+                            ("mu_t", i.friction_twisting),
+                        ] {
+                            if x.is_some() {
+                                given.push(name);
+                            }
+                        }
+                    }
+                    match given.len() {
+                        0 => "means of the two".to_string(),
+                        4 => "[[interactions]]".to_string(),
+                        _ => format!("{} from [[interactions]], the rest means", given.join(", ")),
+                    }
+                };
+                materials += &format!(
+                    "{:<23}{} - {}: e_n {}, mu_s {}, mu_r {}, mu_t {} ({how})\n",
+                    if first { "pairs" } else { "" },
+                    s.materials[a as usize].name,
+                    s.materials[b as usize].name,
+                    num(c.restitution),
+                    num(c.friction_sliding),
+                    num(c.friction_rolling),
+                    num(c.friction_twisting)
+                );
+                first = false;
+            }
+        }
+    }
+    let default_dt = s.eq50_timestep();
     Ok(format!(
         "scenario is valid\n\
          {meshes}\
+         {materials}\
          {bounds}\
          initial particles      {}\n\
          time step              {dt:.6e} s ({:.3} x Eq. 50)\n\
@@ -580,6 +652,14 @@ pub fn describe_stage(s: &Scenario, from: &Path) -> Result<String> {
         out += &format!("{:<23}{note}\n", if k == 0 { "carries" } else { "" });
     }
     Ok(out)
+}
+
+/// A coefficient for people: at most 10 significant digits, no trailing zeros.
+fn num(x: f64) -> String {
+    let s = format!("{:.10e}", x);
+    let (mantissa, exp) = s.split_once('e').unwrap_or((&s, "0"));
+    let value: f64 = format!("{mantissa}e{exp}").parse().unwrap_or(x);
+    format!("{value}")
 }
 
 /// A byte count in kB, MB or GB.

@@ -56,6 +56,8 @@ pub struct Geometry {
     pub mesh_radii: Vec<f64>,
     /// Contacts with the main mesh: merged per surface, or one per face.
     pub mesh_contacts: Contacts,
+    /// The material of the main mesh's faces.
+    pub mesh_material: u16,
     /// s_min, s_max [L]: the spawn box.
     pub spawn_min: DVec3,
     pub spawn_max: DVec3,
@@ -105,6 +107,36 @@ pub struct Simulation {
     pub seed: u64,
 }
 
+/// A material of `[[materials]]` (or the one `[material]`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct MaterialSpec {
+    pub name: String,
+    pub properties: Material,
+}
+
+/// Coefficients of the contact between two materials that override the means of theirs
+/// (`[[interactions]]`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Interaction {
+    /// The two materials (indices, the lower first).
+    pub materials: (u16, u16),
+    pub restitution: Option<f64>,
+    pub friction_sliding: Option<f64>,
+    pub friction_rolling: Option<f64>,
+    pub friction_twisting: Option<f64>,
+}
+
+/// The coefficients of the contact between two materials: e_n, μ_s, μ_r, μ_t.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PairCoefficients {
+    pub restitution: f64,
+    pub friction_sliding: f64,
+    pub friction_rolling: f64,
+    pub friction_twisting: f64,
+    /// Whether `[[interactions]]` set any of them (otherwise the means).
+    pub given: bool,
+}
+
 /// One mesh file with its radii and, optionally, a prescribed motion (`[[meshes]]`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct MeshSpec {
@@ -113,6 +145,8 @@ pub struct MeshSpec {
     pub radii: Vec<f64>,
     pub contacts: Contacts,
     pub motion: Option<Motion>,
+    /// The material of its faces (an index of `Scenario::materials`).
+    pub material: u16,
 }
 
 /// A box that labels the particles whose centre enters it (`[[tags]]`).
@@ -142,7 +176,12 @@ impl Region {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scenario {
     pub geometry: Geometry,
+    /// Material 0 (the one `[material]`, or the first of `[[materials]]`).
     pub material: Material,
+    /// Every material: `[[materials]]` in order, or the one `[material]` (named "default").
+    pub materials: Vec<MaterialSpec>,
+    /// Pair coefficients that override the means (`[[interactions]]`).
+    pub interactions: Vec<Interaction>,
     pub kinetics: Kinetics,
     pub simulation: Simulation,
     /// Further meshes, each with its own radii and motion (`[[meshes]]`).
@@ -261,6 +300,7 @@ struct RawMesh {
     file: PathBuf,
     radii: Option<Vec<f64>>,
     contacts: Option<String>,
+    material: Option<String>,
     motion: Option<RawMotion>,
 }
 
@@ -304,6 +344,10 @@ struct RawScenario {
     #[serde(default)]
     meshes: Vec<RawMesh>,
     #[serde(default)]
+    materials: Vec<RawNamedMaterial>,
+    #[serde(default)]
+    interactions: Vec<RawInteraction>,
+    #[serde(default)]
     tags: Vec<RawTag>,
     domain: Option<RawBox>,
     #[serde(default)]
@@ -330,6 +374,7 @@ struct RawGeometry {
     mesh: Option<PathBuf>,
     mesh_radii: Option<Vec<f64>>,
     mesh_contacts: Option<String>,
+    mesh_material: Option<String>,
     spawn_min: Option<[f64; 3]>,
     spawn_max: Option<[f64; 3]>,
 }
@@ -345,6 +390,57 @@ struct RawMaterial {
     friction_rolling: Option<f64>,
     friction_twisting: Option<f64>,
     viscosity: Option<f64>,
+}
+
+impl RawMaterial {
+    /// Whether it sets a property of the particles (anything but the fluid's viscosity).
+    fn has_particle_keys(&self) -> bool {
+        self.density.is_some()
+            || self.youngs_modulus.is_some()
+            || self.poisson_ratio.is_some()
+            || self.restitution.is_some()
+            || self.friction_sliding.is_some()
+            || self.friction_rolling.is_some()
+            || self.friction_twisting.is_some()
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawNamedMaterial {
+    name: String,
+    density: Option<f64>,
+    youngs_modulus: Option<f64>,
+    poisson_ratio: Option<f64>,
+    restitution: Option<f64>,
+    friction_sliding: Option<f64>,
+    friction_rolling: Option<f64>,
+    friction_twisting: Option<f64>,
+}
+
+impl From<RawNamedMaterial> for RawMaterial {
+    fn from(m: RawNamedMaterial) -> RawMaterial {
+        RawMaterial {
+            density: m.density,
+            youngs_modulus: m.youngs_modulus,
+            poisson_ratio: m.poisson_ratio,
+            restitution: m.restitution,
+            friction_sliding: m.friction_sliding,
+            friction_rolling: m.friction_rolling,
+            friction_twisting: m.friction_twisting,
+            viscosity: None,
+        }
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawInteraction {
+    materials: [String; 2],
+    restitution: Option<f64>,
+    friction_sliding: Option<f64>,
+    friction_rolling: Option<f64>,
+    friction_twisting: Option<f64>,
 }
 
 #[derive(Deserialize, Default)]
@@ -450,6 +546,47 @@ fn region(key: &str, b: RawBox, strict: bool) -> Result<Region> {
     Ok(Region { min, max })
 }
 
+/// Validates the properties of one material (`key` names it in messages).
+fn material(key: &str, m: RawMaterial, viscosity: f64) -> Result<Material> {
+    let key = |name: &str| format!("{key} {name}");
+    let friction_sliding = check(
+        &key("friction_sliding"),
+        m.friction_sliding.unwrap_or(0.3),
+        Range::NonNegative,
+    )?;
+    Ok(Material {
+        density: check(&key("density"), m.density.unwrap_or(1e3), Range::Positive)?,
+        youngs_modulus: check(
+            &key("youngs_modulus"),
+            m.youngs_modulus.unwrap_or(1e6),
+            Range::Positive,
+        )?,
+        poisson_ratio: check(
+            &key("poisson_ratio"),
+            m.poisson_ratio.unwrap_or(0.3),
+            Range::OpenClosed(-1.0, 0.5),
+        )?,
+        restitution: check(
+            &key("restitution"),
+            m.restitution.unwrap_or(0.5),
+            Range::Closed(0.0, 1.0),
+        )?,
+        friction_sliding,
+        friction_rolling: check(
+            &key("friction_rolling"),
+            m.friction_rolling.unwrap_or(0.3),
+            Range::NonNegative,
+        )?,
+        // Eq. (41)
+        friction_twisting: check(
+            &key("friction_twisting"),
+            m.friction_twisting.unwrap_or(2.0 / 3.0 * friction_sliding),
+            Range::NonNegative,
+        )?,
+        viscosity,
+    })
+}
+
 /// The value of a `mesh_contacts` or `contacts` key (default "merged").
 fn contacts(key: &str, value: Option<String>) -> Result<Contacts> {
     match value.as_deref() {
@@ -513,6 +650,7 @@ fn mesh_spec(k: usize, m: RawMesh, base: &Path) -> Result<MeshSpec> {
         radii,
         contacts: contacts(&key("contacts"), m.contacts)?,
         motion,
+        material: 0,
     })
 }
 
@@ -549,7 +687,8 @@ impl Scenario {
     }
 
     fn from_raw(raw: RawScenario, base: &Path) -> Result<Scenario> {
-        let g = raw.geometry;
+        let mut g = raw.geometry;
+        let g_mesh_material = g.mesh_material.take();
         let radius_min = check(
             "[geometry] radius_min",
             g.radius_min.unwrap_or(0.002),
@@ -595,55 +734,96 @@ impl Scenario {
                 .map_or(MeshSource::None, |p| MeshSource::File(base.join(p))),
             mesh_radii,
             mesh_contacts: contacts("[geometry] mesh_contacts", g.mesh_contacts)?,
+            mesh_material: 0,
             spawn_min,
             spawn_max,
         };
 
-        let m = raw.material;
-        let friction_sliding = check(
-            "[material] friction_sliding",
-            m.friction_sliding.unwrap_or(0.3),
+        let viscosity = check(
+            "[material] viscosity",
+            raw.material.viscosity.unwrap_or(0.0),
             Range::NonNegative,
         )?;
-        let material = Material {
-            density: check(
-                "[material] density",
-                m.density.unwrap_or(1e3),
-                Range::Positive,
-            )?,
-            youngs_modulus: check(
-                "[material] youngs_modulus",
-                m.youngs_modulus.unwrap_or(1e6),
-                Range::Positive,
-            )?,
-            poisson_ratio: check(
-                "[material] poisson_ratio",
-                m.poisson_ratio.unwrap_or(0.3),
-                Range::OpenClosed(-1.0, 0.5),
-            )?,
-            restitution: check(
-                "[material] restitution",
-                m.restitution.unwrap_or(0.5),
-                Range::Closed(0.0, 1.0),
-            )?,
-            friction_sliding,
-            friction_rolling: check(
-                "[material] friction_rolling",
-                m.friction_rolling.unwrap_or(0.3),
-                Range::NonNegative,
-            )?,
-            // Eq. (41)
-            friction_twisting: check(
-                "[material] friction_twisting",
-                m.friction_twisting.unwrap_or(2.0 / 3.0 * friction_sliding),
-                Range::NonNegative,
-            )?,
-            viscosity: check(
-                "[material] viscosity",
-                m.viscosity.unwrap_or(0.0),
-                Range::NonNegative,
-            )?,
+        let materials: Vec<MaterialSpec> = if raw.materials.is_empty() {
+            vec![MaterialSpec {
+                name: "default".into(),
+                properties: material("[material]", raw.material, viscosity)?,
+            }]
+        } else {
+            if raw.material.has_particle_keys() {
+                bail!(
+                    "[material] may only set viscosity (of the surrounding fluid) when [[materials]] are given: set the other properties in [[materials]]"
+                );
+            }
+            let mut names = std::collections::BTreeSet::new();
+            raw.materials
+                .into_iter()
+                .enumerate()
+                .map(|(k, m)| {
+                    let key = format!("[[materials]] #{}", k + 1);
+                    let name = m.name.trim().to_string();
+                    if name.is_empty() {
+                        bail!("{key} name must not be empty");
+                    }
+                    if !names.insert(name.clone()) {
+                        bail!("{key} name = \"{name}\" is used by another material");
+                    }
+                    let properties = material(&format!("{key} (\"{name}\")"), m.into(), viscosity)?;
+                    Ok(MaterialSpec { name, properties })
+                })
+                .collect::<Result<_>>()?
         };
+        if materials.len() > u16::MAX as usize {
+            bail!("[[materials]]: at most {} materials", u16::MAX);
+        }
+        let index = |key: &str, name: &str| -> Result<u16> {
+            materials
+                .iter()
+                .position(|m| m.name == name)
+                .map(|k| k as u16)
+                .ok_or_else(|| {
+                    let known: Vec<String> = materials
+                        .iter()
+                        .map(|m| format!("\"{}\"", m.name))
+                        .collect();
+                    anyhow::anyhow!(
+                        "{key} = \"{name}\" is not a material: the materials are {}",
+                        known.join(", ")
+                    )
+                })
+        };
+        let mut interactions: Vec<Interaction> = Vec::new();
+        for (k, i) in raw.interactions.into_iter().enumerate() {
+            let key = |name: &str| format!("[[interactions]] #{} {name}", k + 1);
+            let pair = (
+                index(&key("materials[0]"), &i.materials[0])?,
+                index(&key("materials[1]"), &i.materials[1])?,
+            );
+            let pair = (pair.0.min(pair.1), pair.0.max(pair.1));
+            if interactions.iter().any(|o| o.materials == pair) {
+                bail!(
+                    "{} = [\"{}\", \"{}\"]: that pair is given twice",
+                    key("materials"),
+                    i.materials[0],
+                    i.materials[1]
+                );
+            }
+            let opt = |name: &str, x: Option<f64>, r: Range| -> Result<Option<f64>> {
+                x.map(|x| check(&key(name), x, r)).transpose()
+            };
+            interactions.push(Interaction {
+                materials: pair,
+                restitution: opt("restitution", i.restitution, Range::Closed(0.0, 1.0))?,
+                friction_sliding: opt("friction_sliding", i.friction_sliding, Range::NonNegative)?,
+                friction_rolling: opt("friction_rolling", i.friction_rolling, Range::NonNegative)?,
+                friction_twisting: opt(
+                    "friction_twisting",
+                    i.friction_twisting,
+                    Range::NonNegative,
+                )?,
+            });
+        }
+        let material = materials[0].properties.clone();
 
         let k = raw.kinetics;
         let kinetics = Kinetics {
@@ -661,7 +841,10 @@ impl Scenario {
         let s = raw.simulation;
         let timestep = match s.timestep {
             Some(dt) => check("[simulation] timestep", dt, Range::Positive)?,
-            None => default_timestep(radius_min, &material),
+            None => materials
+                .iter()
+                .map(|m| default_timestep(radius_min, &m.properties))
+                .fold(f64::INFINITY, f64::min),
         };
         let simulation = Simulation {
             timestep,
@@ -696,11 +879,22 @@ impl Scenario {
             );
         }
 
+        let mut geometry = geometry;
+        if let Some(name) = &g_mesh_material {
+            geometry.mesh_material = index("[geometry] mesh_material", name)?;
+        }
         let meshes = raw
             .meshes
             .into_iter()
             .enumerate()
-            .map(|(k, m)| mesh_spec(k, m, base))
+            .map(|(k, mut m)| {
+                let name = m.material.take();
+                let mut spec = mesh_spec(k, m, base)?;
+                if let Some(name) = name {
+                    spec.material = index(&format!("[[meshes]] #{} material", k + 1), &name)?;
+                }
+                Ok(spec)
+            })
             .collect::<Result<Vec<_>>>()?;
 
         let tags = raw
@@ -746,6 +940,8 @@ impl Scenario {
         Ok(Scenario {
             geometry,
             material,
+            materials,
+            interactions,
             kinetics,
             simulation,
             meshes,
@@ -795,22 +991,55 @@ impl Scenario {
         }
         let _ = writeln!(o, "mesh_radii = {}", list(&g.mesh_radii));
         let _ = writeln!(o, "mesh_contacts = {}", contacts(g.mesh_contacts));
+        let material = |k: u16| text(&self.materials[k as usize].name);
+        if self.uses_materials() {
+            let _ = writeln!(o, "mesh_material = {}", material(g.mesh_material));
+        }
         let _ = writeln!(o, "spawn_min = {}", v(g.spawn_min));
         let _ = writeln!(o, "spawn_max = {}", v(g.spawn_max));
-        let m = &self.material;
-        o += "\n[material]\n";
-        for (key, x) in [
-            ("density", m.density),
-            ("youngs_modulus", m.youngs_modulus),
-            ("poisson_ratio", m.poisson_ratio),
-            ("restitution", m.restitution),
-            ("friction_sliding", m.friction_sliding),
-            ("friction_rolling", m.friction_rolling),
-            ("friction_twisting", m.friction_twisting),
-            ("viscosity", m.viscosity),
-        ] {
-            let _ = writeln!(o, "{key} = {}", f(x));
+        let properties = |o: &mut String, m: &Material| {
+            for (key, x) in [
+                ("density", m.density),
+                ("youngs_modulus", m.youngs_modulus),
+                ("poisson_ratio", m.poisson_ratio),
+                ("restitution", m.restitution),
+                ("friction_sliding", m.friction_sliding),
+                ("friction_rolling", m.friction_rolling),
+                ("friction_twisting", m.friction_twisting),
+            ] {
+                let _ = writeln!(o, "{key} = {}", f(x));
+            }
+        };
+        if self.uses_materials() {
+            for m in &self.materials {
+                let _ = writeln!(o, "\n[[materials]]\nname = {}", text(&m.name));
+                properties(&mut o, &m.properties);
+            }
+            for i in &self.interactions {
+                let name = |k: u16| text(&self.materials[k as usize].name);
+                let _ = writeln!(
+                    o,
+                    "\n[[interactions]]\nmaterials = [{}, {}]",
+                    name(i.materials.0),
+                    name(i.materials.1)
+                );
+                for (key, x) in [
+                    ("restitution", i.restitution),
+                    ("friction_sliding", i.friction_sliding),
+                    ("friction_rolling", i.friction_rolling),
+                    ("friction_twisting", i.friction_twisting),
+                ] {
+                    if let Some(x) = x {
+                        let _ = writeln!(o, "{key} = {}", f(x));
+                    }
+                }
+            }
+            o += "\n[material]\n";
+        } else {
+            o += "\n[material]\n";
+            properties(&mut o, &self.material);
         }
+        let _ = writeln!(o, "viscosity = {}", f(self.material.viscosity));
         let k = &self.kinetics;
         o += "\n[kinetics]\n";
         let _ = writeln!(o, "initial_velocity = {}", v(k.initial_velocity));
@@ -837,6 +1066,9 @@ impl Scenario {
             let _ = writeln!(o, "file = {}", path(&mesh.file));
             let _ = writeln!(o, "radii = {}", list(&mesh.radii));
             let _ = writeln!(o, "contacts = {}", contacts(mesh.contacts));
+            if self.uses_materials() {
+                let _ = writeln!(o, "material = {}", material(mesh.material));
+            }
             match mesh.motion {
                 None => {}
                 Some(Motion::Harmonic {
@@ -904,6 +1136,58 @@ impl Scenario {
         o
     }
 
+    /// Whether the scenario names its materials (`[[materials]]`) rather than having the one
+    /// `[material]`.
+    pub fn uses_materials(&self) -> bool {
+        self.materials.len() > 1 || self.materials[0].name != "default"
+    }
+
+    /// The time step of Eq. (50) for the stiffest, lightest of the materials.
+    pub fn eq50_timestep(&self) -> f64 {
+        self.materials
+            .iter()
+            .map(|m| default_timestep(self.geometry.radius_min, &m.properties))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// The coefficients of contacts between materials `a` and `b` (particle or mesh): those
+    /// of `[[interactions]]` where given, otherwise the means of the two materials'.
+    pub fn pair(&self, a: u16, b: u16) -> PairCoefficients {
+        let (m, n) = (
+            &self.materials[a as usize].properties,
+            &self.materials[b as usize].properties,
+        );
+        let mean = |x: f64, y: f64| if a == b { x } else { 0.5 * (x + y) };
+        let given = self
+            .interactions
+            .iter()
+            .find(|i| i.materials == (a.min(b), a.max(b)));
+        let pick = |over: Option<f64>, x: f64, y: f64| over.unwrap_or_else(|| mean(x, y));
+        PairCoefficients {
+            restitution: pick(
+                given.and_then(|i| i.restitution),
+                m.restitution,
+                n.restitution,
+            ),
+            friction_sliding: pick(
+                given.and_then(|i| i.friction_sliding),
+                m.friction_sliding,
+                n.friction_sliding,
+            ),
+            friction_rolling: pick(
+                given.and_then(|i| i.friction_rolling),
+                m.friction_rolling,
+                n.friction_rolling,
+            ),
+            friction_twisting: pick(
+                given.and_then(|i| i.friction_twisting),
+                m.friction_twisting,
+                n.friction_twisting,
+            ),
+            given: given.is_some(),
+        }
+    }
+
     /// Whether particles can be removed during the run (a domain or outlets).
     pub fn removes(&self) -> bool {
         self.domain.is_some() || !self.outlets.is_empty()
@@ -952,7 +1236,7 @@ mod tests {
     #[test]
     fn the_resolved_toml_parses_back_to_the_same_scenario() {
         let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scenarios/good");
-        for name in ["full.toml", "minimal.toml"] {
+        for name in ["full.toml", "minimal.toml", "materials.toml"] {
             let s = Scenario::load(&dir.join(name)).unwrap();
             let again = Scenario::parse(&s.to_toml(), Path::new("run.toml")).unwrap();
             assert_eq!(again, s, "{name}:\n{}", s.to_toml());

@@ -12,8 +12,8 @@ use anyhow::{Result, bail};
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::contact::{Body, ContactLaw, Kinematics, Other, Springs};
-use crate::integrate::{Inertia, Response, State, advance};
+use crate::contact::{Body, Coefficients, ContactLaw, Kinematics, Other, Springs};
+use crate::integrate::{Density, Inertia, Response, State, advance};
 use crate::lanes::{Gather, Lanes};
 use crate::mesh::{Contacts, Face, Mesh};
 use crate::motion::{Motion, Pose, RigidVelocity};
@@ -22,7 +22,7 @@ use crate::neighbours::{
     Store, cut, face_grid,
 };
 use crate::particles::Particles;
-use crate::scenario::{MeshSource, Scenario, default_timestep};
+use crate::scenario::{MeshSource, Scenario};
 use crate::spawn::{Spawner, SpawnerState};
 use crate::surface::{self, Candidate, Fate};
 
@@ -374,6 +374,21 @@ impl std::ops::AddAssign for Wrench {
     }
 }
 
+/// Fails unless every particle's material is one of the scenario's.
+fn check_materials(p: &Particles, s: &Scenario) -> Result<()> {
+    let n = s.materials.len();
+    if let Some(k) = (0..p.len()).find(|&k| p.material[k] as usize >= n) {
+        bail!(
+            "particle {} has material {}, but the scenario has {n} material{} (0 to {})",
+            p.id[k],
+            p.material[k],
+            if n == 1 { "" } else { "s" },
+            n - 1
+        );
+    }
+    Ok(())
+}
+
 /// `face_part` of a face that does not move.
 const STATIC: u32 = u32::MAX;
 
@@ -399,6 +414,8 @@ pub struct MeshFile {
     pub contacts: Contacts,
     /// The point torques on it are taken about: the origin, or the centre of its rotation.
     pub torque_about: DVec3,
+    /// The material of its faces.
+    pub material: u16,
 }
 
 /// A running simulation.
@@ -436,6 +453,10 @@ pub struct Simulation {
     pub removed: Removed,
     /// For each face, its mesh file (an index of `mesh_files`), if wall loads are summed.
     face_file: Vec<u32>,
+    /// For each face, its material.
+    face_material: Vec<u16>,
+    /// For each material, the quotients of its density.
+    densities: Vec<Density>,
     /// The loads on each mesh file summed over the steps since the last call of
     /// [`Simulation::take_wall_loads`] (`[output] wall_forces`).
     wall_sums: Vec<Wrench>,
@@ -461,6 +482,7 @@ impl Simulation {
             faces: 0..mesh.faces.len(),
             contacts: g.mesh_contacts,
             torque_about: DVec3::ZERO,
+            material: g.mesh_material,
         }];
         let mut moving = Vec::new();
         for spec in &scenario.meshes {
@@ -477,6 +499,7 @@ impl Simulation {
                     Some(Motion::Rotation { center, .. }) => center,
                     _ => DVec3::ZERO,
                 },
+                material: spec.material,
             });
             mesh.append(part);
         }
@@ -486,6 +509,9 @@ impl Simulation {
         };
         let mut sim = Simulation::from_parts(scenario, mesh, particles)?;
         sim.mesh_files = files;
+        for file in &sim.mesh_files {
+            sim.face_material[file.faces.clone()].fill(file.material);
+        }
         sim.sum_wall_loads();
         for (faces, motion) in moving {
             for f in faces.clone() {
@@ -597,9 +623,7 @@ impl Simulation {
         let misfit = |what: String| anyhow::anyhow!("the checkpoint does not fit: {what}");
         let mut notes = Vec::new();
         let p = snapshot.particles;
-        if let Some(&m) = p.material.iter().find(|&&m| m != 0) {
-            bail!("the checkpoint holds particles of material {m}; the scenario has one material");
-        }
+        check_materials(&p, &sim.scenario).map_err(|e| misfit(format!("{e:#}")))?;
         let old_seed = if snapshot.scenario.is_empty() {
             None
         } else {
@@ -711,10 +735,11 @@ impl Simulation {
         if particles.len() as u64 > u32::MAX as u64 / 2 {
             bail!("too many particles: {}", particles.len());
         }
+        check_materials(&particles, &scenario)?;
         let skin = SKIN_PER_RADIUS * g.radius_max;
         let face_grid = face_grid(&mesh.faces, max_radius, skin);
         let mut sim = Simulation {
-            law: ContactLaw::new(&scenario.material, scenario.simulation.timestep),
+            law: ContactLaw::of(&scenario),
             neighbours: Neighbours::new(skin),
             face_grid,
             spawner: Spawner::new(scenario.simulation.seed),
@@ -736,7 +761,14 @@ impl Simulation {
                     .first()
                     .map_or_else(Contacts::default, |f| f.contacts),
                 torque_about: DVec3::ZERO,
+                material: scenario.geometry.mesh_material,
             }],
+            face_material: vec![scenario.geometry.mesh_material; mesh.faces.len()],
+            densities: scenario
+                .materials
+                .iter()
+                .map(|m| Density::new(m.properties.density, m.properties.viscosity))
+                .collect(),
             removed: Removed {
                 outlets: vec![Outflow::default(); scenario.outlets.len()],
                 domain: Outflow::default(),
@@ -847,14 +879,15 @@ impl Simulation {
             .map(|&(i, f)| (p.id[i as usize], i, f))
             .collect();
         by_id.sort_unstable();
-        let density = s.material.density;
+        let densities = &self.densities;
         for &(_, i, f) in &by_id {
             let out = match self.removed.outlets.get_mut(f as usize) {
                 Some(o) => o,
                 None => &mut self.removed.domain,
             };
             out.count += 1;
-            out.mass += Inertia::mass(p.radius[i as usize], density);
+            let material = densities[p.material[i as usize] as usize];
+            out.mass += Inertia::mass_with(p.radius[i as usize], material.mass_per_r3);
         }
         let gone: Vec<u32> = gone.into_iter().map(|(i, _)| i).collect();
         self.neighbours.rebuild_without(
@@ -866,10 +899,14 @@ impl Simulation {
         self.built();
     }
 
-    /// Whether frames name each particle's id and material (particles can be removed, so
-    /// the line of a particle is not its id).
+    /// Whether frames name each particle's id and material: particles can be removed (or
+    /// were, in an earlier stage), so the line of a particle is not its id, or there are
+    /// several materials.
     pub fn frames_carry_ids(&self) -> bool {
+        let p = &self.particles;
         self.scenario.removes()
+            || self.scenario.materials.len() > 1
+            || p.next_id as usize != p.len()
     }
 
     /// Starts summing the loads on each mesh file (`take_wall_loads`).
@@ -972,7 +1009,7 @@ impl Simulation {
     pub fn advice(&self) -> String {
         let s = &self.scenario;
         let dt = s.simulation.timestep;
-        let eq50 = default_timestep(s.geometry.radius_min, &s.material);
+        let eq50 = s.eq50_timestep();
         if dt > eq50 {
             format!(
                 "timestep {dt:.3e} s exceeds Eq. 50's {eq50:.3e} s for this stiffness and density \
@@ -1102,7 +1139,17 @@ impl Simulation {
         let deep = Mutex::new(Vec::new());
         let p = &self.particles;
         let law = &self.law;
-        let density = self.scenario.material.density;
+        let densities = &self.densities;
+        // One material: the same coefficients and density in every lane, set up once.
+        let uniform = law.uniform();
+        let one_pair: Coefficients<Group> = law.pair(0, 0).splat();
+        let mass_per_r3 = |idx: &[usize; WIDTH]| {
+            if uniform {
+                Group::splat(densities[0].mass_per_r3)
+            } else {
+                Group::gather(idx.map(|k| densities[p.material[k] as usize].mass_per_r3))
+            }
+        };
         let ContactList {
             start,
             partner,
@@ -1195,10 +1242,18 @@ impl Simulation {
                         let mut lanes = gather_springs(store, c);
                         let other = Other::Particle {
                             r: body_j.radius,
-                            m: Inertia::mass(body_j.radius, density),
+                            m: Inertia::mass_with(body_j.radius, mass_per_r3(&j)),
                         };
-                        let m_i = Inertia::mass(body_i.radius, density);
-                        let force = law.evaluate(body_i.radius, m_i, other, &kin, &mut lanes);
+                        let m_i = Inertia::mass_with(body_i.radius, mass_per_r3(&i));
+                        let coef = if uniform {
+                            one_pair
+                        } else {
+                            Coefficients::gather(std::array::from_fn(|l| {
+                                law.pair(p.material[i[l]], p.material[j[l]])
+                            }))
+                        };
+                        let force =
+                            law.evaluate(&coef, body_i.radius, m_i, other, &kin, &mut lanes);
                         scatter_springs(lanes, store, &c[..group.len()]);
                         let (f, tau_i, tau_j) = (
                             Group::scatter_vec(force.f),
@@ -1246,7 +1301,9 @@ impl Simulation {
         let law = &self.law;
         let faces = &self.mesh.faces;
         let (face_part, moving) = (&self.face_part, &self.moving);
-        let density = self.scenario.material.density;
+        let (densities, face_material) = (&self.densities, &self.face_material);
+        let uniform = law.uniform();
+        let one_wall: Coefficients<Group> = law.with_wall(0, 0).splat();
         let ContactList {
             start,
             partner,
@@ -1411,9 +1468,27 @@ impl Simulation {
                             omega: vector(|k| k.omega),
                         };
                         let radius = Group::gather(i.map(|i| p.radius[i]));
-                        let mass = Inertia::mass(radius, density);
+                        let (mass, coef) = if uniform {
+                            (
+                                Inertia::mass_with(radius, Group::splat(densities[0].mass_per_r3)),
+                                one_wall,
+                            )
+                        } else {
+                            let m = i.map(|i| p.material[i]);
+                            let f = c.map(|c| face_material[partner[first + c.slot] as usize]);
+                            (
+                                Inertia::mass_with(
+                                    radius,
+                                    Group::gather(m.map(|m| densities[m as usize].mass_per_r3)),
+                                ),
+                                Coefficients::gather(std::array::from_fn(|l| {
+                                    law.with_wall(m[l], f[l])
+                                })),
+                            )
+                        };
                         let mut lanes = gather_springs(store, e);
-                        let force = law.evaluate(radius, mass, Other::Wall, &kin, &mut lanes);
+                        let force =
+                            law.evaluate(&coef, radius, mass, Other::Wall, &kin, &mut lanes);
                         scatter_springs(lanes, store, &e[..group.len()]);
                         let (f, tau) =
                             (Group::scatter_vec(force.f), Group::scatter_vec(force.tau_i));
@@ -1453,19 +1528,22 @@ impl Simulation {
     fn integrate(&mut self) -> bool {
         let s = &self.scenario;
         let (dt, g) = (s.simulation.timestep, s.kinetics.gravity);
-        let (density, viscosity) = (s.material.density, s.material.viscosity);
+        let densities = &self.densities;
+        let uniform = densities.len() == 1;
         let p = &mut self.particles;
+        let material = &p.material;
         (
             p.x.par_chunks_mut(WIDTH),
             p.v.par_chunks_mut(WIDTH),
             p.q.par_chunks_mut(WIDTH),
             p.w.par_chunks_mut(WIDTH),
             p.radius.par_chunks(WIDTH),
+            material.par_chunks(WIDTH),
             self.loads.par_chunks_mut(WIDTH),
         )
             .into_par_iter()
             .with_min_len(MIN_PARALLEL_LEN.div_ceil(WIDTH))
-            .map(|(x, v, q, w, radius, load)| {
+            .map(|(x, v, q, w, radius, material, load)| {
                 // `WIDTH` particles at a time in lanes; a short last group repeats its last
                 // particle in the spare lanes. The loads are used up (zeroed for the next
                 // step).
@@ -1482,7 +1560,17 @@ impl Simulation {
                     q: Group::gather_quat_at(q, &lane),
                     w: Group::gather_vec_at(w, &lane),
                 };
-                let body = Response::new(Group::gather_at(radius, &lane), density, viscosity);
+                let (inv_mass_r3, drag) = if uniform {
+                    let d = densities[0];
+                    (Group::splat(d.inv_mass_r3), Group::splat(d.drag))
+                } else {
+                    let d = lane.map(|l| densities[material[l] as usize]);
+                    (
+                        Group::gather(d.map(|d| d.inv_mass_r3)),
+                        Group::gather(d.map(|d| d.drag)),
+                    )
+                };
+                let body = Response::with(Group::gather_at(radius, &lane), inv_mass_r3, drag);
                 let new = advance(
                     state,
                     &body,

@@ -85,3 +85,41 @@ fn bad_scenarios_fail_with_their_stated_error() {
         );
     }
 }
+
+#[test]
+fn materials_scenario_sets_meshes_and_particles_materials() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scenarios/good");
+    let s = Scenario::load(&dir.join("materials.toml")).unwrap();
+    assert_eq!(s.materials.len(), 2);
+    assert_eq!(s.geometry.mesh_material, 1);
+    assert_eq!(s.meshes[0].material, 0);
+    assert_eq!(s.material.viscosity, 1e-5);
+    assert_eq!(s.materials[1].properties.viscosity, 1e-5);
+    let c = s.pair(0, 1);
+    assert_eq!((c.friction_sliding, c.restitution), (0.2, 0.7));
+    let sim = Simulation::new(s).unwrap();
+    assert_eq!(sim.particles.material, vec![1, 1]);
+}
+
+#[test]
+fn particles_of_a_material_the_scenario_lacks_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("p.csv");
+    std::fs::write(
+        &csv,
+        "x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz,material\n0,0,0,0.005,0,0,0,1,0,0,0,0,0,0,2\n",
+    )
+    .unwrap();
+    let toml = dir.path().join("s.toml");
+    std::fs::write(&toml, "[input]\nparticles = \"p.csv\"\n").unwrap();
+    let err = format!(
+        "{:#}",
+        Simulation::new(Scenario::load(&toml).unwrap())
+            .err()
+            .unwrap()
+    );
+    assert!(
+        err.contains("particle 0 has material 2, but the scenario has 1 material (0 to 0)"),
+        "{err}"
+    );
+}
