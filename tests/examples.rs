@@ -12,29 +12,43 @@ fn every_example_runs_a_few_frames() {
     let mut dirs: Vec<_> = std::fs::read_dir(&root)
         .unwrap()
         .map(|e| e.unwrap().path())
+        .filter(|p| p.is_dir())
         .collect();
     dirs.sort();
     for dir in dirs {
-        let file = dir.join("scenario.toml");
-        if !file.exists() {
-            continue;
-        }
-        let mut s = Scenario::load(&file).unwrap_or_else(|e| panic!("{}: {e:#}", file.display()));
-        s.simulation.frames = 2;
-        s.simulation.steps_per_frame = 50;
-        s.simulation.max_particles = s.simulation.max_particles.min(300);
+        // One scenario, or stages `1_*.toml`, `2_*.toml`, ... each run from the checkpoint
+        // of the one before.
+        let mut files: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| {
+                let name = p.file_name().unwrap().to_string_lossy();
+                name == "scenario.toml"
+                    || (name.ends_with(".toml") && name.starts_with(|c: char| c.is_ascii_digit()))
+            })
+            .collect();
+        files.sort();
         let out = tempfile::tempdir().unwrap();
-        let options = Options {
-            verbosity: Verbosity::Quiet,
-            resume: None,
-            from: None,
-            stop: None,
-        };
-        let summary =
-            run(s, out.path(), options).unwrap_or_else(|e| panic!("{}: {e:#}", file.display()));
-        assert_eq!(summary.frames_written, 3);
-        assert!(summary.particles > 0, "{}: no particles", file.display());
-        count += 1;
+        for (k, file) in files.iter().enumerate() {
+            let mut s =
+                Scenario::load(file).unwrap_or_else(|e| panic!("{}: {e:#}", file.display()));
+            s.simulation.frames = 2;
+            s.simulation.steps_per_frame = 50;
+            s.simulation.max_particles = s.simulation.max_particles.min(300);
+            let stage = out.path().join(k.to_string());
+            let from = (k > 0).then(|| out.path().join((k - 1).to_string()).join("checkpoint.bin"));
+            let options = Options {
+                verbosity: Verbosity::Quiet,
+                resume: None,
+                from: from.as_deref(),
+                stop: None,
+            };
+            let summary =
+                run(s, &stage, options).unwrap_or_else(|e| panic!("{}: {e:#}", file.display()));
+            assert_eq!(summary.frames_written, 3);
+            assert!(summary.particles > 0, "{}: no particles", file.display());
+            count += 1;
+        }
     }
     assert!(count >= 4, "found {count} examples");
 }
