@@ -10,6 +10,7 @@ use anyhow::{Context, Result, bail};
 use glam::{DQuat, DVec3};
 
 use crate::particles::{Particle, Particles};
+use crate::simulation::{ContactRecord, Partner};
 
 pub const COLUMNS: [&str; 14] = [
     "x", "y", "z", "R", "vx", "vy", "vz", "q0", "q1", "q2", "q3", "wx", "wy", "wz",
@@ -89,6 +90,47 @@ pub fn write_frame_as(dir: &Path, name: &str, p: &Particles, extra: Extra) -> Re
         std::fs::rename(&tmp, &path)
     };
     write().with_context(|| format!("cannot write frame {}", path.display()))?;
+    Ok(path)
+}
+
+/// The header of a contact network file.
+pub const CONTACT_COLUMNS: &str = "id_i,id_j,face,x,y,z,fn_x,fn_y,fn_z,ft_x,ft_y,ft_z,overlap";
+
+/// Writes the contact network atomically to `dir/name`: a line per contact, `id_j` or
+/// `face` -1 where it does not apply.
+pub fn write_contacts(dir: &Path, name: &str, contacts: &[ContactRecord]) -> Result<PathBuf> {
+    let path = dir.join(name);
+    let tmp = dir.join(format!(".{name}.tmp"));
+    let write = || -> std::io::Result<()> {
+        let mut w = std::io::BufWriter::with_capacity(1 << 20, std::fs::File::create(&tmp)?);
+        writeln!(w, "{CONTACT_COLUMNS}")?;
+        let mut buf = ryu::Buffer::new();
+        let mut line = String::with_capacity(256);
+        for c in contacts {
+            line.clear();
+            let (j, f) = match c.with {
+                Partner::Particle(j) => (j as i64, -1),
+                Partner::Face(f) => (-1, f as i64),
+            };
+            line.push_str(itoa::Buffer::new().format(c.id));
+            for k in [j, f] {
+                line.push(',');
+                line.push_str(itoa::Buffer::new().format(k));
+            }
+            for x in [
+                c.point.x, c.point.y, c.point.z, c.f_n.x, c.f_n.y, c.f_n.z, c.f_t.x, c.f_t.y,
+                c.f_t.z, c.overlap,
+            ] {
+                line.push(',');
+                line.push_str(buf.format(x));
+            }
+            line.push('\n');
+            w.write_all(line.as_bytes())?;
+        }
+        w.into_inner().map_err(|e| e.into_error())?.sync_data()?;
+        std::fs::rename(&tmp, &path)
+    };
+    write().with_context(|| format!("cannot write {}", path.display()))?;
     Ok(path)
 }
 

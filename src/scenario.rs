@@ -15,7 +15,7 @@
 //! [domain]     min, max   (particles whose centre leaves it are removed)
 //! [[outlets]]  min, max   (particles whose centre enters one are removed; any number)
 //! [input]      particles
-//! [output]     dir, checkpoint_every, formats, wall_forces
+//! [output]     dir, checkpoint_every, formats, wall_forces, contacts
 //! ```
 //! Paths are relative to the scenario file. Unknown keys and values outside Table 2's
 //! "Requirements" column are errors naming the key and the allowed range.
@@ -203,6 +203,8 @@ pub struct Scenario {
     pub formats: Formats,
     /// Write `walls.csv`: the force and torque the particles exert on each mesh file.
     pub wall_forces: bool,
+    /// Write the contact network with every frame (`contactsNNNNNN.csv`, and `.vtp` with VTK).
+    pub contact_network: bool,
 }
 
 /// The frame formats of `[output] formats`.
@@ -475,6 +477,7 @@ struct RawOutput {
     checkpoint_every: Option<u64>,
     formats: Option<Vec<String>>,
     wall_forces: Option<bool>,
+    contacts: Option<bool>,
 }
 
 /// A range check of Table 2's "Requirements" column.
@@ -956,6 +959,7 @@ impl Scenario {
             checkpoint_every: raw.output.checkpoint_every.unwrap_or(0),
             formats: Formats::parse(raw.output.formats)?,
             wall_forces: raw.output.wall_forces.unwrap_or(false),
+            contact_network: raw.output.contacts.unwrap_or(false),
         })
     }
 
@@ -1133,6 +1137,7 @@ impl Scenario {
         }
         let _ = writeln!(o, "formats = [{}]", formats.join(", "));
         let _ = writeln!(o, "wall_forces = {}", self.wall_forces);
+        let _ = writeln!(o, "contacts = {}", self.contact_network);
         o
     }
 

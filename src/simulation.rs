@@ -389,6 +389,22 @@ fn check_materials(p: &Particles, s: &Scenario) -> Result<()> {
     Ok(())
 }
 
+/// A contact of the network (`Simulation::contact_network`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactRecord {
+    /// The particle (its id; the lower one of a pair).
+    pub id: u32,
+    /// The other particle (its id) or the face (its index in the mesh).
+    pub with: Partner,
+    /// Where the two touch: x_i - r_i n (Eq. 29).
+    pub point: DVec3,
+    /// The force on particle `id`: its normal and tangential parts [N].
+    pub f_n: DVec3,
+    pub f_t: DVec3,
+    /// δ [L]
+    pub overlap: f64,
+}
+
 /// `face_part` of a face that does not move.
 const STATIC: u32 = u32::MAX;
 
@@ -907,6 +923,103 @@ impl Simulation {
         self.scenario.removes()
             || self.scenario.materials.len() > 1
             || p.next_id as usize != p.len()
+    }
+
+    /// The contact network at the current state: every touching particle pair and
+    /// particle-face contact (as the last step resolved them) with the force the law gives
+    /// it now, from its current springs (left unchanged): the forces the next step applies.
+    /// Pairs by (lower id, higher id), then contacts with faces by (id, face).
+    pub fn contact_network(&self) -> Vec<ContactRecord> {
+        let p = &self.particles;
+        let law = &self.law;
+        let mass = |k: usize| {
+            Inertia::mass_with(
+                p.radius[k],
+                self.densities[p.material[k] as usize].mass_per_r3,
+            )
+        };
+        let body = |k: usize| Body {
+            x: p.x[k],
+            radius: p.radius[k],
+            v: p.v[k],
+            w: p.w[k],
+        };
+        let record = |i: usize, other: Other, kin: &Kinematics, coef, springs: Springs, with| {
+            let mut springs = springs;
+            let force = law.evaluate(coef, p.radius[i], mass(i), other, kin, &mut springs);
+            let f_n = kin.n * kin.n.dot(force.f);
+            ContactRecord {
+                id: p.id[i],
+                with,
+                point: p.x[i] - kin.n * kin.r_i,
+                f_n,
+                f_t: force.f - f_n,
+                overlap: kin.delta,
+            }
+        };
+        let mut out = Vec::new();
+        // Each open contact of `list`: owner, partner and springs.
+        let open = |list: &ContactList| {
+            let mut v = Vec::new();
+            for piece in 0..list.pieces.len().saturating_sub(1) {
+                let store = &list.stores[piece];
+                for i in list.pieces[piece] as usize..list.pieces[piece + 1] as usize {
+                    for k in list.run(i) {
+                        if list.contact[k] != NONE {
+                            let springs = store.springs[list.contact[k] as usize];
+                            v.push((i, list.partner[k] as usize, springs));
+                        }
+                    }
+                }
+            }
+            v
+        };
+        for (a, b, springs) in open(&self.neighbours.pairs) {
+            let (i, j) = if p.id[a] < p.id[b] { (a, b) } else { (b, a) };
+            let Some(kin) = Kinematics::between_particles(&body(i), &body(j)) else {
+                continue;
+            };
+            let other = Other::Particle {
+                r: p.radius[j],
+                m: mass(j),
+            };
+            let coef = law.pair(p.material[i], p.material[j]);
+            out.push(record(
+                i,
+                other,
+                &kin,
+                coef,
+                springs,
+                Partner::Particle(p.id[j] as usize),
+            ));
+        }
+        for (i, f, springs) in open(&self.neighbours.faces) {
+            let face = &self.mesh.faces[f];
+            let wall = match self.face_part[f] {
+                STATIC => RigidVelocity::default(),
+                part => self.moving[part as usize].velocity,
+            };
+            let b = body(i);
+            let (d, feature) = face.separation_and_feature(b.x);
+            let (d, _) = surface::snap(face, b.x, b.radius, d, feature);
+            let Some(kin) = Kinematics::with_wall(&b, d, face.radius, &wall) else {
+                continue;
+            };
+            let coef = law.with_wall(p.material[i], self.face_material[f]);
+            out.push(record(
+                i,
+                Other::Wall,
+                &kin,
+                coef,
+                springs,
+                Partner::Face(f),
+            ));
+        }
+        out.sort_by_key(|r| match r.with {
+            Partner::Particle(j) => (0, r.id, j),
+            Partner::Face(f) => (1, r.id, f),
+        });
+        out
     }
 
     /// Starts summing the loads on each mesh file (`take_wall_loads`).

@@ -12,6 +12,7 @@ use anyhow::{Context, Result};
 
 use crate::mesh::{Mesh, Primitive};
 use crate::particles::Particles;
+use crate::simulation::{ContactRecord, Partner};
 
 /// Where an array goes in the file.
 #[derive(Clone, Copy)]
@@ -103,14 +104,35 @@ impl Vtu {
     }
 
     fn write(&self, path: &Path, points: usize, cells: usize) -> Result<()> {
+        self.write_as(
+            path,
+            points,
+            cells,
+            "UnstructuredGrid",
+            "Cells",
+            "NumberOfCells",
+        )
+    }
+
+    /// Writes the file as a `kind` (`UnstructuredGrid`, or `PolyData` whose cells are
+    /// `Lines`).
+    fn write_as(
+        &self,
+        path: &Path,
+        points: usize,
+        cells: usize,
+        kind: &str,
+        cells_tag: &str,
+        count_attribute: &str,
+    ) -> Result<()> {
         let mut text = String::new();
         text.push_str("<?xml version=\"1.0\"?>\n");
-        text.push_str(
-            "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n",
-        );
-        text.push_str("  <UnstructuredGrid>\n");
         text.push_str(&format!(
-            "    <Piece NumberOfPoints=\"{points}\" NumberOfCells=\"{cells}\">\n"
+            "<VTKFile type=\"{kind}\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
+        ));
+        text.push_str(&format!("  <{kind}>\n"));
+        text.push_str(&format!(
+            "    <Piece NumberOfPoints=\"{points}\" {count_attribute}=\"{cells}\">\n"
         ));
         text.push_str(&format!(
             "      <PointData>\n{}      </PointData>\n",
@@ -121,10 +143,13 @@ impl Vtu {
             self.cell_data
         ));
         text.push_str(&format!("      <Points>\n{}      </Points>\n", self.points));
-        text.push_str(&format!("      <Cells>\n{}      </Cells>\n", self.cells));
-        text.push_str(
-            "    </Piece>\n  </UnstructuredGrid>\n  <AppendedData encoding=\"raw\">\n   _",
-        );
+        text.push_str(&format!(
+            "      <{cells_tag}>\n{}      </{cells_tag}>\n",
+            self.cells
+        ));
+        text.push_str(&format!(
+            "    </Piece>\n  </{kind}>\n  <AppendedData encoding=\"raw\">\n   _"
+        ));
         let tail = "\n  </AppendedData>\n</VTKFile>\n";
         atomic_write(path, &[text.as_bytes(), &self.appended, tail.as_bytes()])
     }
@@ -225,6 +250,62 @@ pub fn write_mesh(path: &Path, mesh: &Mesh) -> Result<()> {
     v.array(Cells, "offsets", 1, nc, offsets.into_iter());
     v.array(Cells, "types", 1, nc, types.into_iter());
     v.write(path, np, nc)
+}
+
+/// Writes the contact network as `.vtp` lines: particle centre to particle centre for a
+/// pair, centre to contact point for a face, with the cell arrays `normal_force` and
+/// `tangential_force` (magnitudes [N]), `overlap` [m] and `face` (-1 for pairs).
+pub fn write_contacts(path: &Path, p: &Particles, contacts: &[ContactRecord]) -> Result<()> {
+    use Section::*;
+    let mut at = vec![u32::MAX; p.next_id as usize];
+    for (k, &id) in p.id.iter().enumerate() {
+        at[id as usize] = k as u32;
+    }
+    let mut points = Vec::with_capacity(2 * contacts.len());
+    for c in contacts {
+        points.push(p.x[at[c.id as usize] as usize]);
+        points.push(match c.with {
+            Partner::Particle(j) => p.x[at[j] as usize],
+            Partner::Face(_) => c.point,
+        });
+    }
+    let n = contacts.len();
+    let mut v = Vtu::new();
+    v.array(
+        CellData,
+        "normal_force",
+        1,
+        n,
+        contacts.iter().map(|c| c.f_n.length()),
+    );
+    v.array(
+        CellData,
+        "tangential_force",
+        1,
+        n,
+        contacts.iter().map(|c| c.f_t.length()),
+    );
+    v.array(
+        CellData,
+        "overlap",
+        1,
+        n,
+        contacts.iter().map(|c| c.overlap),
+    );
+    v.array(
+        CellData,
+        "face",
+        1,
+        n,
+        contacts.iter().map(|c| match c.with {
+            Partner::Particle(_) => -1i64,
+            Partner::Face(f) => f as i64,
+        }),
+    );
+    v.vectors(Points, "points", 2 * n, points.into_iter());
+    v.array(Cells, "connectivity", 1, 2 * n, 0..2 * n as i64);
+    v.array(Cells, "offsets", 1, n, (1..=n as i64).map(|k| 2 * k));
+    v.write_as(path, 2 * n, n, "PolyData", "Lines", "NumberOfLines")
 }
 
 /// Writes a `.pvd` collection of `(time, file name)` entries.

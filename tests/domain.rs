@@ -289,3 +289,66 @@ fn a_run_logs_outlets_and_wall_loads_and_resumes_them() {
     assert_eq!(read(b.join("walls.csv")), walls);
     assert_eq!(read(b.join("particles000004.csv")), frame);
 }
+
+/// The contact network of a settled bed: the faces hold up its weight, every grain is in
+/// balance under its contacts and gravity, and each contact point lies r_i from the centre.
+#[test]
+fn the_contact_network_of_a_settled_bed_balances_every_grain() {
+    use tinydem::simulation::Partner;
+    let s = common::scenario(
+        "[geometry]\nradius_min = 0.003\nradius_max = 0.004\nmesh_radii = [0.0]\n\
+         spawn_min = [-0.025, -0.025, 0.01]\nspawn_max = [0.025, 0.025, 0.09]\n\
+         [material]\nrestitution = 0.2\n\
+         [kinetics]\ninitial_velocity = [0.0, 0.0, 0.0]\n\
+         [simulation]\nmax_particles = 150\n",
+    );
+    let mesh = Mesh::parse_off(BOX, "box", &s.geometry.mesh_radii).unwrap();
+    let mut sim = Simulation::from_parts(s, mesh, Particles::default()).unwrap();
+    for _ in 0..14_000 {
+        sim.step().unwrap();
+    }
+    let network = sim.contact_network();
+    let p = &sim.particles;
+    let at = |id: u32| p.id.iter().position(|&k| k == id).unwrap();
+    let mut net = vec![DVec3::ZERO; p.len()];
+    let mut from_faces = DVec3::ZERO;
+    let (mut pairs, mut faces) = (0, 0);
+    for c in &network {
+        let i = at(c.id);
+        let f = c.f_n + c.f_t;
+        assert!(c.f_n.dot(c.f_t).abs() <= 1e-9 * f.length_squared().max(1e-30));
+        net[i] += f;
+        let lever = (c.point - p.x[i]).length();
+        assert!(
+            (lever - (p.radius[i] - 0.5 * c.overlap)).abs() < 1e-12,
+            "{c:?}"
+        );
+        match c.with {
+            Partner::Particle(j) => {
+                assert!((j as u32) > c.id, "a pair is listed under its lower id");
+                net[at(j as u32)] -= f;
+                pairs += 1;
+            }
+            Partner::Face(_) => {
+                from_faces += f;
+                faces += 1;
+            }
+        }
+    }
+    assert!(pairs > 150 && faces > 30, "{pairs} pairs, {faces} faces");
+    let weight: f64 = p.radius.iter().map(|&r| Inertia::mass(r, RHO) * 9.81).sum();
+    assert!(
+        (from_faces.z / weight - 1.0).abs() < 0.01,
+        "{from_faces} vs {weight}"
+    );
+    // Every grain at rest: its contacts balance its weight.
+    for (k, f) in net.iter().enumerate() {
+        let w = Inertia::mass(p.radius[k], RHO) * 9.81;
+        let residual = (*f + DVec3::new(0.0, 0.0, -w)).length();
+        assert!(
+            residual < 0.05 * w,
+            "grain {}: residual {residual} of {w}",
+            p.id[k]
+        );
+    }
+}

@@ -29,7 +29,7 @@ fn vtk_frames_match_csv_frames_in_a_real_reader() {
              spawn_min = [-0.02, -0.02, 0.05]\nspawn_max = [0.02, 0.02, 0.1]\n\
              [kinetics]\ninitial_angular_velocity = [1.0, 2.0, 3.0]\n\
              [simulation]\nmax_particles = 150\nspawn_attempts = 5\nframes = 3\nsteps_per_frame = 500\n\
-             [output]\nformats = [\"csv\", \"vtk\"]\n",
+             [output]\nformats = [\"csv\", \"vtk\"]\ncontacts = true\n",
             root.join("tests/scenarios/good/box.off").display()
         ),
     )
