@@ -25,7 +25,7 @@ use crate::mesh::Mesh;
 use crate::particles::{Particle, Particles};
 use crate::scenario::Scenario;
 use crate::simulation::{Outflow, Removed, Snapshot, Wrench};
-use crate::spawn::SpawnerState;
+use crate::spawn::{RegionState, SpawnerState};
 
 const MAGIC: &[u8; 12] = b"TINYDEM CKPT";
 const VERSION: u32 = 3;
@@ -149,6 +149,13 @@ pub fn encode(snapshot: &Snapshot, fingerprint: u64) -> Vec<u8> {
     for &(faces, hash) in &snapshot.mesh_files {
         out.extend_from_slice(&faces.to_le_bytes());
         out.extend_from_slice(&hash.to_le_bytes());
+    }
+    let regions = &snapshot.spawner.regions;
+    out.extend_from_slice(&(regions.len() as u64).to_le_bytes());
+    for r in regions {
+        out.extend_from_slice(&r.inserted.to_le_bytes());
+        out.push(r.pending_radius.is_some() as u8);
+        put_f64s(&mut out, &[r.pending_radius.unwrap_or(0.0)]);
     }
     let crc = crc32fast::hash(&out);
     out.extend_from_slice(&crc.to_le_bytes());
@@ -301,6 +308,7 @@ pub fn decode(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<Snapsho
     let mut wall_sums = Vec::new();
     let mut scenario = String::new();
     let mut mesh_files = Vec::new();
+    let mut regions = Vec::new();
     if v3 {
         let outflow = |r: &mut Reader| -> Result<Outflow> {
             Ok(Outflow {
@@ -329,6 +337,18 @@ pub fn decode(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<Snapsho
         mesh_files = (0..files)
             .map(|_| Ok((r.u64()?, r.u64()?)))
             .collect::<Result<_>>()?;
+        let count = r.count(17)?;
+        regions = (0..count)
+            .map(|_| {
+                let inserted = r.u64()?;
+                let has = r.u8()? != 0;
+                let radius = r.f64()?;
+                Ok(RegionState {
+                    inserted,
+                    pending_radius: has.then_some(radius),
+                })
+            })
+            .collect::<Result<_>>()?;
     }
     if r.at != body.len() {
         bail!(
@@ -343,6 +363,7 @@ pub fn decode(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<Snapsho
         spawner: SpawnerState {
             word_pos,
             pending_radius: has_pending.then_some(pending),
+            regions,
         },
         anchors,
         lonely,
@@ -407,6 +428,16 @@ mod tests {
             spawner: SpawnerState {
                 word_pos: 987654321,
                 pending_radius: Some(0.0042),
+                regions: vec![
+                    RegionState {
+                        inserted: 7,
+                        pending_radius: None,
+                    },
+                    RegionState {
+                        inserted: 0,
+                        pending_radius: Some(0.003),
+                    },
+                ],
             },
             anchors: vec![DVec3::new(0.1, 0.2, 0.2999)],
             lonely: vec![(0, 0.25)],
@@ -443,12 +474,13 @@ mod tests {
         let mut s = snapshot();
         (s.removed, s.wall_sums) = (Removed::default(), Vec::new());
         (s.scenario, s.mesh_files) = (String::new(), Vec::new());
+        s.spawner.regions = Vec::new();
         let v3 = encode(&s, 7);
         let body = &v3[..v3.len() - 4];
         // The one particle's record starts at byte 77 (after the header and the count); its
         // material is the last 2 of its 122 bytes; the counts of removals, loads, scenario
         // and mesh files end the body.
-        let mut v2 = [&body[..77 + 120], &body[77 + 122..body.len() - 48]].concat();
+        let mut v2 = [&body[..77 + 120], &body[77 + 122..body.len() - 56]].concat();
         v2[12..16].copy_from_slice(&2u32.to_le_bytes());
         let crc = crc32fast::hash(&v2);
         v2.extend_from_slice(&crc.to_le_bytes());

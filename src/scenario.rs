@@ -14,6 +14,10 @@
 //! [[tags]]     min, max, tag   (a box that labels particles entering it; any number)
 //! [domain]     min, max   (particles whose centre leaves it are removed)
 //! [[outlets]]  min, max   (particles whose centre enters one are removed; any number)
+//! [[spawn]]    min, max, material, velocity, count, rate, start, stop, radius = {
+//!              distribution = "uniform" | "normal" | "lognormal" | "table", ... }
+//! [[materials]] name, density, youngs_modulus, poisson_ratio, restitution, friction_*
+//! [[interactions]] materials = [a, b], restitution, friction_*
 //! [input]      particles
 //! [output]     dir, checkpoint_every, formats, wall_forces, contacts
 //! ```
@@ -149,6 +153,48 @@ pub struct MeshSpec {
     pub material: u16,
 }
 
+/// How the radii of spawned particles are drawn (`[[spawn]] radius`).
+#[derive(Clone, Debug, PartialEq)]
+pub enum RadiusDistribution {
+    /// Uniform in [min, max] (the paper's, with R_min and R_max).
+    Uniform { min: f64, max: f64 },
+    /// Normal with `mean` and `std`, truncated to [min, max] (drawn again outside).
+    Normal {
+        mean: f64,
+        std: f64,
+        min: f64,
+        max: f64,
+    },
+    /// Log-normal with the `mean` and `std` of the radius, truncated to [min, max].
+    LogNormal {
+        mean: f64,
+        std: f64,
+        min: f64,
+        max: f64,
+    },
+    /// One of `radii`, each with its share of the number of particles (`weights`, relative).
+    Table { radii: Vec<f64>, weights: Vec<f64> },
+}
+
+/// A region that inserts particles (`[[spawn]]`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SpawnRegion {
+    /// Where the centres are drawn (uniformly).
+    pub region: Region,
+    pub material: u16,
+    /// Initial velocity of its particles (default `[kinetics] initial_velocity`).
+    pub velocity: DVec3,
+    /// How many particles it inserts in all (None: no limit but the rate's and
+    /// `max_particles`).
+    pub count: Option<u64>,
+    /// Particles per second (None: as fast as `spawn_attempts` per step allow).
+    pub rate: Option<f64>,
+    /// When it is active [s], from `start` until `stop`.
+    pub start: f64,
+    pub stop: f64,
+    pub radius: RadiusDistribution,
+}
+
 /// A box that labels the particles whose centre enters it (`[[tags]]`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TagRegion {
@@ -193,6 +239,9 @@ pub struct Scenario {
     pub domain: Option<Region>,
     /// Boxes that remove the particles whose centre enters them (`[[outlets]]`).
     pub outlets: Vec<Region>,
+    /// Insertion regions (`[[spawn]]`); when there are any, the `[geometry]` spawn box is not
+    /// used.
+    pub spawn: Vec<SpawnRegion>,
     /// Initial particles (CSV), if any.
     pub particles: Option<PathBuf>,
     /// Output directory.
@@ -335,6 +384,45 @@ struct RawTag {
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
+struct RawSpawn {
+    min: [f64; 3],
+    max: [f64; 3],
+    material: Option<String>,
+    velocity: Option<[f64; 3]>,
+    count: Option<u64>,
+    rate: Option<f64>,
+    start: Option<f64>,
+    stop: Option<f64>,
+    radius: Option<RawRadius>,
+}
+
+#[derive(Deserialize)]
+#[serde(tag = "distribution", rename_all = "lowercase", deny_unknown_fields)]
+enum RawRadius {
+    Uniform {
+        min: Option<f64>,
+        max: Option<f64>,
+    },
+    Normal {
+        mean: f64,
+        std: f64,
+        min: Option<f64>,
+        max: Option<f64>,
+    },
+    Lognormal {
+        mean: f64,
+        std: f64,
+        min: Option<f64>,
+        max: Option<f64>,
+    },
+    Table {
+        radii: Vec<f64>,
+        weights: Option<Vec<f64>>,
+    },
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
 struct RawBox {
     min: [f64; 3],
     max: [f64; 3],
@@ -354,6 +442,8 @@ struct RawScenario {
     domain: Option<RawBox>,
     #[serde(default)]
     outlets: Vec<RawBox>,
+    #[serde(default)]
+    spawn: Vec<RawSpawn>,
     #[serde(default)]
     geometry: RawGeometry,
     #[serde(default)]
@@ -547,6 +637,153 @@ fn region(key: &str, b: RawBox, strict: bool) -> Result<Region> {
         bail!("{key} max = {max} must be >= min = {min} in every component");
     }
     Ok(Region { min, max })
+}
+
+/// Validates one `[[spawn]]` region: `index` finds a material by name, `velocity` is the
+/// default initial velocity, radii must lie in [R_min, R_max] (`radii`).
+fn spawn_region(
+    key: &str,
+    r: RawSpawn,
+    index: &dyn Fn(&str, &str) -> Result<u16>,
+    velocity: DVec3,
+    radii: (f64, f64),
+) -> Result<SpawnRegion> {
+    let k = |name: &str| format!("{key} {name}");
+    let region = region(
+        key,
+        RawBox {
+            min: r.min,
+            max: r.max,
+        },
+        false,
+    )?;
+    let material = match &r.material {
+        Some(name) => index(&k("material"), name)?,
+        None => 0,
+    };
+    let velocity = match r.velocity {
+        Some(v) => check_vec(&k("velocity"), v)?,
+        None => velocity,
+    };
+    let rate = r
+        .rate
+        .map(|x| check(&k("rate"), x, Range::Positive))
+        .transpose()?;
+    if r.count.is_none() && rate.is_none() {
+        bail!("{key} needs a count (particles in all) or a rate (particles per second), or both");
+    }
+    let start = check(&k("start"), r.start.unwrap_or(0.0), Range::NonNegative)?;
+    let stop = match r.stop {
+        Some(t) => check(&k("stop"), t, Range::NonNegative)?,
+        None => f64::INFINITY,
+    };
+    if stop <= start {
+        bail!("{} = {stop} must be after start = {start}", k("stop"));
+    }
+    let (lo, hi) = radii;
+    let within = |name: &str, x: f64| -> Result<f64> {
+        let x = check(&k(&format!("radius.{name}")), x, Range::Positive)?;
+        if x < lo || x > hi {
+            bail!(
+                "{} = {x} must lie within [geometry] radius_min = {lo} and radius_max = {hi}",
+                k(&format!("radius.{name}"))
+            );
+        }
+        Ok(x)
+    };
+    let bounds = |min: Option<f64>, max: Option<f64>| -> Result<(f64, f64)> {
+        let (min, max) = (
+            within("min", min.unwrap_or(lo))?,
+            within("max", max.unwrap_or(hi))?,
+        );
+        if max < min {
+            bail!("{} = {max} must be >= min = {min}", k("radius.max"));
+        }
+        Ok((min, max))
+    };
+    let spread = |mean: f64, std: f64, min: f64, max: f64| -> Result<(f64, f64)> {
+        let mean = check(&k("radius.mean"), mean, Range::Positive)?;
+        let std = check(&k("radius.std"), std, Range::NonNegative)?;
+        if std == 0.0 && (mean < min || mean > max) {
+            bail!(
+                "{} = {mean} must lie within [{min}, {max}]",
+                k("radius.mean")
+            );
+        }
+        Ok((mean, std))
+    };
+    let radius = match r.radius {
+        None => RadiusDistribution::Uniform { min: lo, max: hi },
+        Some(RawRadius::Uniform { min, max }) => {
+            let (min, max) = bounds(min, max)?;
+            RadiusDistribution::Uniform { min, max }
+        }
+        Some(RawRadius::Normal {
+            mean,
+            std,
+            min,
+            max,
+        }) => {
+            let (min, max) = bounds(min, max)?;
+            let (mean, std) = spread(mean, std, min, max)?;
+            RadiusDistribution::Normal {
+                mean,
+                std,
+                min,
+                max,
+            }
+        }
+        Some(RawRadius::Lognormal {
+            mean,
+            std,
+            min,
+            max,
+        }) => {
+            let (min, max) = bounds(min, max)?;
+            let (mean, std) = spread(mean, std, min, max)?;
+            RadiusDistribution::LogNormal {
+                mean,
+                std,
+                min,
+                max,
+            }
+        }
+        Some(RawRadius::Table { radii, weights }) => {
+            if radii.is_empty() {
+                bail!("{} must hold at least one radius", k("radius.radii"));
+            }
+            for (i, &x) in radii.iter().enumerate() {
+                within(&format!("radii[{i}]"), x)?;
+            }
+            let weights = weights.unwrap_or_else(|| vec![1.0; radii.len()]);
+            if weights.len() != radii.len() {
+                bail!(
+                    "{} has {} entries, radii {}: one weight per radius",
+                    k("radius.weights"),
+                    weights.len(),
+                    radii.len()
+                );
+            }
+            for (i, &w) in weights.iter().enumerate() {
+                check(&k(&format!("radius.weights[{i}]")), w, Range::NonNegative)?;
+            }
+            let total: f64 = weights.iter().sum();
+            if total <= 0.0 {
+                bail!("{} must not all be zero", k("radius.weights"));
+            }
+            RadiusDistribution::Table { radii, weights }
+        }
+    };
+    Ok(SpawnRegion {
+        region,
+        material,
+        velocity,
+        count: r.count,
+        rate,
+        start,
+        stop,
+        radius,
+    })
 }
 
 /// Validates the properties of one material (`key` names it in messages).
@@ -927,7 +1164,36 @@ impl Scenario {
             .enumerate()
             .map(|(k, b)| region(&format!("[[outlets]] #{}", k + 1), b, false))
             .collect::<Result<Vec<_>>>()?;
+        let spawn = raw
+            .spawn
+            .into_iter()
+            .enumerate()
+            .map(|(k, r)| {
+                spawn_region(
+                    &format!("[[spawn]] #{}", k + 1),
+                    r,
+                    &index,
+                    kinetics.initial_velocity,
+                    (radius_min, radius_max),
+                )
+            })
+            .collect::<Result<Vec<_>>>()?;
+        for (k, r) in spawn.iter().enumerate() {
+            if let Some(d) = domain
+                && !(d.contains(r.region.min) && d.contains(r.region.max))
+            {
+                bail!(
+                    "[[spawn]] #{} box {} .. {} must lie inside [domain] {} .. {}",
+                    k + 1,
+                    r.region.min,
+                    r.region.max,
+                    d.min,
+                    d.max
+                );
+            }
+        }
         if let Some(d) = domain
+            && spawn.is_empty()
             && simulation.max_particles > 0
             && simulation.spawn_attempts > 0
             && !(d.contains(spawn_min) && d.contains(spawn_max))
@@ -951,6 +1217,7 @@ impl Scenario {
             tags,
             domain,
             outlets,
+            spawn,
             particles: raw.input.particles.map(|p| base.join(p)),
             output_dir: raw
                 .output
@@ -1121,6 +1388,65 @@ impl Scenario {
         }
         for b in &self.outlets {
             let _ = writeln!(o, "\n[[outlets]]\nmin = {}\nmax = {}", v(b.min), v(b.max));
+        }
+        for r in &self.spawn {
+            let _ = writeln!(
+                o,
+                "\n[[spawn]]\nmin = {}\nmax = {}\nvelocity = {}",
+                v(r.region.min),
+                v(r.region.max),
+                v(r.velocity)
+            );
+            if self.uses_materials() {
+                let _ = writeln!(o, "material = {}", material(r.material));
+            }
+            if let Some(n) = r.count {
+                let _ = writeln!(o, "count = {n}");
+            }
+            if let Some(rate) = r.rate {
+                let _ = writeln!(o, "rate = {}", f(rate));
+            }
+            let _ = writeln!(o, "start = {}", f(r.start));
+            if r.stop.is_finite() {
+                let _ = writeln!(o, "stop = {}", f(r.stop));
+            }
+            let radius = match &r.radius {
+                RadiusDistribution::Uniform { min, max } => format!(
+                    "{{ distribution = \"uniform\", min = {}, max = {} }}",
+                    f(*min),
+                    f(*max)
+                ),
+                RadiusDistribution::Normal {
+                    mean,
+                    std,
+                    min,
+                    max,
+                } => format!(
+                    "{{ distribution = \"normal\", mean = {}, std = {}, min = {}, max = {} }}",
+                    f(*mean),
+                    f(*std),
+                    f(*min),
+                    f(*max)
+                ),
+                RadiusDistribution::LogNormal {
+                    mean,
+                    std,
+                    min,
+                    max,
+                } => format!(
+                    "{{ distribution = \"lognormal\", mean = {}, std = {}, min = {}, max = {} }}",
+                    f(*mean),
+                    f(*std),
+                    f(*min),
+                    f(*max)
+                ),
+                RadiusDistribution::Table { radii, weights } => format!(
+                    "{{ distribution = \"table\", radii = {}, weights = {} }}",
+                    list(radii),
+                    list(weights)
+                ),
+            };
+            let _ = writeln!(o, "radius = {radius}");
         }
         if let Some(p) = &self.particles {
             let _ = writeln!(o, "\n[input]\nparticles = {}", path(p));

@@ -648,7 +648,13 @@ impl Simulation {
             Some(old.simulation.seed)
         };
         if old_seed == Some(sim.scenario.simulation.seed) {
-            sim.spawner = Spawner::resume(sim.scenario.simulation.seed, snapshot.spawner);
+            // The stage's [[spawn]] regions are its own: their counts start at 0 with its
+            // clock.
+            let state = SpawnerState {
+                regions: Vec::new(),
+                ..snapshot.spawner
+            };
+            sim.spawner = Spawner::resume(sim.scenario.simulation.seed, state);
             notes.push("spawning continues the random stream of the checkpoint".into());
         } else {
             notes.push(format!(
@@ -1187,13 +1193,25 @@ impl Simulation {
         !self.moving.is_empty()
     }
 
-    /// Stage 1 (Section 3.1): new particles in the spawn box.
+    /// Particles inserted by each `[[spawn]]` region so far.
+    pub fn spawned(&self) -> Vec<u64> {
+        let mut n = self.spawner.inserted();
+        n.resize(self.scenario.spawn.len(), 0);
+        n
+    }
+
+    /// Stage 1 (Section 3.1): new particles in the spawn box or the `[[spawn]]` regions.
     #[inline(never)] // a stage of its own in profiles
     fn spawn(&mut self) {
         let s = &self.scenario;
         if (self.particles.next_id as u64) < s.simulation.max_particles {
-            self.spawner
-                .spawn(s, &mut self.particles, &self.mesh.faces, &self.face_grid);
+            self.spawner.spawn(
+                s,
+                &mut self.particles,
+                &self.mesh.faces,
+                &self.face_grid,
+                self.time,
+            );
         }
     }
 

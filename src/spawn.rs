@@ -1,4 +1,6 @@
-//! Particle spawning in a box (paper Section 3.1).
+//! Particle spawning (paper Section 3.1): in the `[geometry]` spawn box, or in `[[spawn]]`
+//! regions with a count, a rate, a time window, a material, a velocity and a distribution of
+//! radii.
 
 use glam::{DQuat, DVec3};
 use rand::{RngExt, SeedableRng};
@@ -8,15 +10,24 @@ use rustc_hash::FxHashMap;
 use crate::mesh::Face;
 use crate::neighbours::{CellGrid, cell_of, key};
 use crate::particles::{Particle, Particles};
-use crate::scenario::Scenario;
+use crate::scenario::{RadiusDistribution, Region, Scenario};
 
 /// Draws spawn attempts from a seeded random stream, so the same seed gives the same run.
 #[derive(Clone, Debug)]
 pub struct Spawner {
     rng: ChaCha8Rng,
     /// A radius whose attempt failed, carried over to the next attempt so that the size
-    /// distribution is not biased toward small particles.
+    /// distribution is not biased toward small particles (the spawn box's).
     pending_radius: Option<f64>,
+    /// What each `[[spawn]]` region has done so far.
+    regions: Vec<RegionState>,
+}
+
+/// How far a `[[spawn]]` region has got: particles inserted, and its pending radius.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RegionState {
+    pub inserted: u64,
+    pub pending_radius: Option<f64>,
 }
 
 /// Uniform in [lo, hi]; exactly `lo` for a degenerate interval (2D and 1D spawn regions).
@@ -28,11 +39,77 @@ fn uniform(rng: &mut ChaCha8Rng, lo: f64, hi: f64) -> f64 {
     }
 }
 
+/// A standard normal number (Box-Muller, from two uniform draws).
+fn standard_normal(rng: &mut ChaCha8Rng) -> f64 {
+    let u1: f64 = 1.0 - rng.random_range(0.0..1.0); // in (0, 1]
+    let u2: f64 = rng.random_range(0.0..1.0);
+    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+}
+
+/// A radius drawn from `d`. Truncated distributions draw again outside their bounds (at
+/// most a thousand times, then the nearest bound: only for a range far in a tail).
+fn draw(rng: &mut ChaCha8Rng, d: &RadiusDistribution) -> f64 {
+    let truncated = |rng: &mut ChaCha8Rng, min: f64, max: f64, f: &dyn Fn(f64) -> f64| {
+        let mut r = f(standard_normal(rng));
+        for _ in 0..1000 {
+            if (min..=max).contains(&r) {
+                return r;
+            }
+            r = f(standard_normal(rng));
+        }
+        r.clamp(min, max)
+    };
+    match *d {
+        RadiusDistribution::Uniform { min, max } => uniform(rng, min, max),
+        RadiusDistribution::Normal {
+            mean,
+            std,
+            min,
+            max,
+        } => truncated(rng, min, max, &|z| mean + std * z),
+        RadiusDistribution::LogNormal {
+            mean,
+            std,
+            min,
+            max,
+        } => {
+            // ln R ~ N(mu, sigma²) with the mean and deviation of R itself.
+            let sigma2 = (1.0 + (std / mean).powi(2)).ln();
+            let mu = mean.ln() - 0.5 * sigma2;
+            truncated(rng, min, max, &|z| (mu + sigma2.sqrt() * z).exp())
+        }
+        RadiusDistribution::Table {
+            ref radii,
+            ref weights,
+        } => {
+            let total: f64 = weights.iter().sum();
+            let u = rng.random_range(0.0..1.0) * total;
+            let mut sum = 0.0;
+            for (r, w) in radii.iter().zip(weights) {
+                sum += w;
+                if u < sum {
+                    return *r;
+                }
+            }
+            *radii.last().expect("at least one radius")
+        }
+    }
+}
+
 /// The position of a spawner in its random stream, for checkpoints.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct SpawnerState {
     pub word_pos: u128,
     pub pending_radius: Option<f64>,
+    pub regions: Vec<RegionState>,
+}
+
+/// What one insertion draws from and where it puts its particles.
+struct Source<'a> {
+    region: Region,
+    radius: &'a RadiusDistribution,
+    velocity: DVec3,
+    material: u16,
 }
 
 impl Spawner {
@@ -40,6 +117,7 @@ impl Spawner {
         SpawnerState {
             word_pos: self.rng.get_word_pos(),
             pending_radius: self.pending_radius,
+            regions: self.regions.clone(),
         }
     }
 
@@ -48,6 +126,7 @@ impl Spawner {
         let mut s = Spawner::new(seed);
         s.rng.set_word_pos(state.word_pos);
         s.pending_radius = state.pending_radius;
+        s.regions = state.regions;
         s
     }
 
@@ -55,49 +134,154 @@ impl Spawner {
         Spawner {
             rng: ChaCha8Rng::seed_from_u64(seed),
             pending_radius: None,
+            regions: Vec::new(),
         }
     }
 
-    /// Makes up to `N_spawn` attempts (until `N_max` particles have been created, those
-    /// removed since included): a uniform centre in
-    /// the spawn box and a uniform radius in [R_min, R_max], rejected if the sphere would
-    /// overlap a particle or a mesh face. Returns the number of particles added.
+    /// Particles inserted by each `[[spawn]]` region so far.
+    pub fn inserted(&self) -> Vec<u64> {
+        self.regions.iter().map(|r| r.inserted).collect()
+    }
+
+    /// One step of spawning at time `t` (the step ends at `t + dt`), until `N_max`
+    /// particles have been created (those removed since included). Without `[[spawn]]`
+    /// regions: up to `N_spawn` attempts in the spawn box, each with a uniform centre and a
+    /// uniform radius in [R_min, R_max] (the paper's). With regions: each active one (from
+    /// `start` until `stop`) makes up to `N_spawn` attempts until it has inserted what its
+    /// rate asks for by the end of the step (floor(rate (t + dt - start))) or its count. An
+    /// attempt is rejected if the sphere would overlap a particle or a mesh face. Returns
+    /// the number of particles added.
     pub fn spawn(
         &mut self,
         s: &Scenario,
         particles: &mut Particles,
         faces: &[Face],
         face_grid: &CellGrid,
+        t: f64,
     ) -> usize {
         let g = &s.geometry;
-        let max = s.simulation.max_particles as usize;
-        if s.simulation.spawn_attempts == 0 || particles.next_id as usize >= max {
+        let max = s.simulation.max_particles;
+        let attempts = s.simulation.spawn_attempts;
+        if attempts == 0 || particles.next_id as u64 >= max {
             return 0;
         }
-        // A grid of the current particles, grown as particles are added.
-        let h = 2.0 * g.radius_max.max(particles.max_radius());
+        if s.spawn.is_empty() {
+            let uniform = RadiusDistribution::Uniform {
+                min: g.radius_min,
+                max: g.radius_max,
+            };
+            let source = Source {
+                region: Region {
+                    min: g.spawn_min,
+                    max: g.spawn_max,
+                },
+                radius: &uniform,
+                velocity: s.kinetics.initial_velocity,
+                material: 0,
+            };
+            let mut pending = self.pending_radius;
+            let n = self.insert(
+                s,
+                &source,
+                attempts,
+                u64::MAX,
+                &mut pending,
+                particles,
+                faces,
+                face_grid,
+            );
+            self.pending_radius = pending;
+            return n as usize;
+        }
+        self.regions.resize(s.spawn.len(), RegionState::default());
+        let dt = s.simulation.timestep;
+        let mut added = 0;
+        for (k, r) in s.spawn.iter().enumerate() {
+            if t < r.start || t >= r.stop {
+                continue;
+            }
+            let due = match r.rate {
+                Some(rate) => (rate * (t + dt - r.start)).floor() as u64,
+                None => u64::MAX,
+            }
+            .min(r.count.unwrap_or(u64::MAX));
+            let state = self.regions[k];
+            if state.inserted >= due {
+                continue;
+            }
+            let source = Source {
+                region: r.region,
+                radius: &r.radius,
+                velocity: r.velocity,
+                material: r.material,
+            };
+            let mut pending = state.pending_radius;
+            let n = self.insert(
+                s,
+                &source,
+                attempts,
+                due - state.inserted,
+                &mut pending,
+                particles,
+                faces,
+                face_grid,
+            );
+            self.regions[k] = RegionState {
+                inserted: state.inserted + n,
+                pending_radius: pending,
+            };
+            added += n as usize;
+        }
+        added
+    }
+
+    /// Up to `attempts` attempts to insert at most `budget` particles from `source`
+    /// (and no more than `N_max` created in all); `pending` is the radius carried over
+    /// from a failed attempt. Returns how many it inserted.
+    #[allow(clippy::too_many_arguments)]
+    fn insert(
+        &mut self,
+        s: &Scenario,
+        source: &Source,
+        attempts: u64,
+        budget: u64,
+        pending: &mut Option<f64>,
+        particles: &mut Particles,
+        faces: &[Face],
+        face_grid: &CellGrid,
+    ) -> u64 {
+        let max = s.simulation.max_particles;
+        // A grid of the particles that a sphere in the region could touch, grown as
+        // particles are added.
+        let h = 2.0 * s.geometry.radius_max.max(particles.max_radius());
         let inv_h = 1.0 / h;
+        let near = Region {
+            min: source.region.min - DVec3::splat(h),
+            max: source.region.max + DVec3::splat(h),
+        };
         let mut cells: FxHashMap<u64, Vec<u32>> = FxHashMap::default();
         for (i, &x) in particles.x.iter().enumerate() {
-            cells
-                .entry(key(cell_of(x, inv_h)))
-                .or_default()
-                .push(i as u32);
+            if near.contains(x) {
+                cells
+                    .entry(key(cell_of(x, inv_h)))
+                    .or_default()
+                    .push(i as u32);
+            }
         }
-
-        let before = particles.len();
-        for _ in 0..s.simulation.spawn_attempts {
-            if particles.next_id as usize >= max {
+        let (lo, hi) = (source.region.min, source.region.max);
+        let mut inserted = 0;
+        for _ in 0..attempts {
+            if particles.next_id as u64 >= max || inserted >= budget {
                 break;
             }
-            let radius = match self.pending_radius {
+            let radius = match *pending {
                 Some(r) => r,
-                None => uniform(&mut self.rng, g.radius_min, g.radius_max),
+                None => draw(&mut self.rng, source.radius),
             };
             let x = DVec3::new(
-                uniform(&mut self.rng, g.spawn_min.x, g.spawn_max.x),
-                uniform(&mut self.rng, g.spawn_min.y, g.spawn_max.y),
-                uniform(&mut self.rng, g.spawn_min.z, g.spawn_max.z),
+                uniform(&mut self.rng, lo.x, hi.x),
+                uniform(&mut self.rng, lo.y, hi.y),
+                uniform(&mut self.rng, lo.z, hi.z),
             );
             let c = cell_of(x, inv_h);
             let mut free = true;
@@ -125,10 +309,10 @@ impl Spawner {
                     face.separation(x).length_squared() >= reach * reach
                 });
             if !free {
-                self.pending_radius = Some(radius);
+                *pending = Some(radius);
                 continue;
             }
-            self.pending_radius = None;
+            *pending = None;
             cells
                 .entry(key(c))
                 .or_default()
@@ -136,13 +320,14 @@ impl Spawner {
             particles.push(Particle {
                 x,
                 radius,
-                v: s.kinetics.initial_velocity,
+                v: source.velocity,
                 q: DQuat::IDENTITY,
                 w: s.kinetics.initial_angular_velocity,
                 tag: 0,
-                material: 0,
+                material: source.material,
             });
+            inserted += 1;
         }
-        particles.len() - before
+        inserted
     }
 }

@@ -1,0 +1,135 @@
+//! `[[spawn]]` regions: a rate within one particle of rate x time when there is room, a
+//! count, a time window, materials and velocities, and the distributions of radii.
+
+mod common;
+
+use tinydem::simulation::Simulation;
+
+fn sim(spawn: &str, extra: &str, attempts: u32) -> Simulation {
+    common::simulate(
+        &format!(
+            "[geometry]\nradius_min = 0.001\nradius_max = 0.002\n\
+             [kinetics]\ngravity = [0.0, 0.0, 0.0]\n\
+             [simulation]\ntimestep = 1e-4\nmax_particles = 100000\nspawn_attempts = {attempts}\n\
+             {extra}\n{spawn}"
+        ),
+        0,
+    )
+}
+
+#[test]
+fn a_rate_is_kept_to_within_one_particle() {
+    let mut s = sim(
+        "[[spawn]]\nmin = [-0.5, -0.5, -0.5]\nmax = [0.5, 0.5, 0.5]\nrate = 3000.0\nstart = 0.01\n",
+        "",
+        50,
+    );
+    for step in 0..500 {
+        let t = s.time;
+        s.step().unwrap();
+        let expected = (3000.0 * (t + 1e-4 - 0.01)).max(0.0);
+        let n = s.particles.len() as f64;
+        assert!(
+            (n - expected).abs() <= 1.0,
+            "step {step}: {n} particles, rate x time = {expected}"
+        );
+    }
+    assert_eq!(s.spawned(), vec![s.particles.len() as u64]);
+}
+
+#[test]
+fn a_count_in_a_time_window_with_its_material_and_velocity() {
+    let mut s = sim(
+        "[[spawn]]\nmin = [-0.5, -0.5, -0.5]\nmax = [0.5, 0.5, 0.5]\ncount = 120\nstart = 0.002\nstop = 0.004\n\
+         material = \"b\"\nvelocity = [0.0, 1.0, 0.0]\n\
+         [[spawn]]\nmin = [-0.5, -0.5, -0.5]\nmax = [0.5, 0.5, 0.5]\nrate = 1e4\nstop = 0.003\n",
+        "[[materials]]\nname = \"a\"\n[[materials]]\nname = \"b\"\ndensity = 3000.0\n",
+        50,
+    );
+    for _ in 0..100 {
+        let t = s.time;
+        let before = s.spawned();
+        s.step().unwrap();
+        let after = s.spawned();
+        if !(0.002 - 1e-12..0.004).contains(&t) {
+            assert_eq!(
+                after[0], before[0],
+                "region 1 outside its window at t = {t}"
+            );
+        }
+        if t >= 0.003 {
+            assert_eq!(after[1], before[1], "region 2 after its stop at t = {t}");
+        }
+    }
+    // 50 attempts a step into an empty metre cube: the count is reached in three steps.
+    assert_eq!(s.spawned(), vec![120, 30]);
+    let p = &s.particles;
+    for k in 0..p.len() {
+        let first = p.material[k] == 1;
+        assert_eq!(p.v[k].y, if first { 1.0 } else { 0.0 });
+        assert!(first || p.v[k].z == -1.0, "the default velocity");
+    }
+}
+
+/// Mean and standard deviation of the radii of `s`.
+fn stats(s: &Simulation) -> (f64, f64, usize) {
+    let r = &s.particles.radius;
+    let n = r.len() as f64;
+    let mean = r.iter().sum::<f64>() / n;
+    let var = r.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (mean, var.sqrt(), r.len())
+}
+
+fn drawn(radius: &str) -> Simulation {
+    let mut s = sim(
+        &format!(
+            "[[spawn]]\nmin = [-1.0, -1.0, -1.0]\nmax = [1.0, 1.0, 1.0]\ncount = 4000\nradius = {radius}\n"
+        ),
+        "",
+        5000,
+    );
+    while s.particles.len() < 4000 {
+        s.step().unwrap();
+    }
+    s
+}
+
+#[test]
+fn radii_follow_their_distribution() {
+    // Uniform in [1.2, 1.8] mm: mean 1.5, deviation 0.6 / sqrt(12).
+    let (mean, std, n) = stats(&drawn(
+        "{ distribution = \"uniform\", min = 0.0012, max = 0.0018 }",
+    ));
+    let sem = |std: f64| 4.0 * std / (n as f64).sqrt();
+    assert!((mean - 0.0015).abs() < sem(std), "uniform mean {mean}");
+    assert!(
+        (std / (0.0006 / 12f64.sqrt()) - 1.0).abs() < 0.05,
+        "uniform std {std}"
+    );
+    // Normal 1.5 +- 0.1 mm, far inside its bounds.
+    let (mean, std, _) = stats(&drawn(
+        "{ distribution = \"normal\", mean = 0.0015, std = 0.0001 }",
+    ));
+    assert!((mean - 0.0015).abs() < sem(std), "normal mean {mean}");
+    assert!((std / 0.0001 - 1.0).abs() < 0.05, "normal std {std}");
+    // Log-normal with mean 1.4 mm and deviation 0.1 mm.
+    let s = drawn("{ distribution = \"lognormal\", mean = 0.0014, std = 0.0001 }");
+    let (mean, std, _) = stats(&s);
+    assert!((mean - 0.0014).abs() < sem(std), "lognormal mean {mean}");
+    assert!((std / 0.0001 - 1.0).abs() < 0.05, "lognormal std {std}");
+    assert!(
+        s.particles
+            .radius
+            .iter()
+            .all(|&r| (0.001..=0.002).contains(&r))
+    );
+    // A table: three small for each large one.
+    let s = drawn("{ distribution = \"table\", radii = [0.001, 0.002], weights = [3.0, 1.0] }");
+    let large = s.particles.radius.iter().filter(|&&r| r == 0.002).count() as f64;
+    let share = large / 4000.0;
+    assert!(
+        (share - 0.25).abs() < 4.0 * (0.25f64 * 0.75 / 4000.0).sqrt(),
+        "{share}"
+    );
+    assert!(s.particles.radius.iter().all(|&r| r == 0.001 || r == 0.002));
+}
