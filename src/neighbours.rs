@@ -187,6 +187,60 @@ impl CellGrid {
 /// A slot without a contact.
 pub const NONE: u32 = u32::MAX;
 
+/// Periodic axes of the domain: space repeats with period `length` along each `axes[a]`,
+/// from `min`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Periodic {
+    pub min: DVec3,
+    pub length: DVec3,
+    pub axes: [bool; 3],
+}
+
+impl Periodic {
+    /// Puts `x` back into [min, min + length) along the periodic axes.
+    #[inline]
+    pub fn wrap(&self, x: DVec3) -> DVec3 {
+        let mut x = x.to_array();
+        for (a, x) in x.iter_mut().enumerate() {
+            if self.axes[a] && x.is_finite() {
+                let (lo, l) = (self.min[a], self.length[a]);
+                let mut w = lo + (*x - lo).rem_euclid(l);
+                if w >= lo + l {
+                    w = lo; // rem_euclid of a tiny negative number rounds up to l
+                }
+                *x = w;
+            }
+        }
+        DVec3::from_array(x)
+    }
+
+    /// The shifts by which the images of a point at `x` (in the box) come within `reach` of
+    /// the box: for each periodic axis where it is within `reach` of a side, the period
+    /// towards the other side, and their combinations (edges, corners).
+    fn image_shifts(&self, x: DVec3, reach: f64, out: &mut Vec<DVec3>) {
+        out.clear();
+        out.push(DVec3::ZERO);
+        for a in 0..3 {
+            if !self.axes[a] {
+                continue;
+            }
+            let mut e = DVec3::ZERO;
+            if x[a] - self.min[a] < reach {
+                e[a] = self.length[a];
+            } else if self.min[a] + self.length[a] - x[a] < reach {
+                e[a] = -self.length[a];
+            } else {
+                continue;
+            }
+            for k in 0..out.len() {
+                let s = out[k] + e;
+                out.push(s);
+            }
+        }
+        out.remove(0);
+    }
+}
+
 /// The friction springs of the touching contacts of one piece of a list, and its free
 /// entries. A contact stage runs a piece in one task, which opens and closes entries in the
 /// piece's own store.
@@ -304,6 +358,22 @@ impl ContactList {
             self.live()
                 .filter_map(|(i, k, s)| key(i, self.partner[k]).map(|(a, other)| (a, other, s))),
         )
+    }
+
+    /// The contact history of several lists of the same kind (particle pairs, within the
+    /// box and across periodic sides), as [`ContactList::history`].
+    fn history_of(
+        lists: &[&ContactList],
+        keys: usize,
+        key: impl Fn(usize, u32) -> Option<(u32, u32)> + Sync,
+    ) -> History {
+        let entries = || {
+            lists.iter().flat_map(|list| {
+                list.live()
+                    .filter_map(|(i, k, s)| key(i, list.partner[k]).map(|(a, o)| (a, o, s)))
+            })
+        };
+        History::from_entries(keys, entries().map(|e| e.0), entries())
     }
 
     /// A list from runs in compressed form cut into pieces at `pieces` (owner bounds), each
@@ -553,6 +623,12 @@ pub struct Neighbours {
     pub pairs: ContactList,
     /// Particle-face pairs.
     pub faces: ContactList,
+    /// Particle pairs that touch across a periodic boundary: partner `j` seen at
+    /// `x_j + shift[slot]`.
+    pub wrapped: ContactList,
+    pub shift: Vec<DVec3>,
+    /// The periodic axes of the domain, if any.
+    pub periodic: Option<Periodic>,
     /// Positions at the last rebuild (the anchors of the Verlet criterion).
     x_at_build: Vec<DVec3>,
     /// Particles with nothing within reach at the last rebuild, each with how far it may
@@ -599,6 +675,15 @@ impl Neighbours {
     pub fn new(skin: f64) -> Self {
         Neighbours {
             skin,
+            ..Default::default()
+        }
+    }
+
+    /// Lists for a domain with the periodic axes `periodic`.
+    pub fn with_periodic(skin: f64, periodic: Option<Periodic>) -> Self {
+        Neighbours {
+            skin,
+            periodic,
             ..Default::default()
         }
     }
@@ -711,7 +796,11 @@ impl Neighbours {
         };
         let candidates: Vec<usize> = (0..n).filter(|&i| !listed(i)).collect();
         const BUDGET: usize = 4_000_000;
-        if candidates.is_empty() || candidates.len() * (n + faces.len()) > BUDGET {
+        // Clearances by brute force do not see periodic images: no lonely particles then.
+        if candidates.is_empty()
+            || candidates.len() * (n + faces.len()) > BUDGET
+            || self.periodic.is_some()
+        {
             self.lonely = Vec::new();
             return;
         }
@@ -732,7 +821,7 @@ impl Neighbours {
     /// The contact histories of the current lists by id.
     pub fn history(&self, ids: &[u32], id_count: usize) -> Histories {
         Histories {
-            pairs: self.pairs.history(id_count, pair_key(ids)),
+            pairs: ContactList::history_of(&[&self.pairs, &self.wrapped], id_count, pair_key(ids)),
             faces: self.faces.history(id_count, |i, f| Some((ids[i], f))),
         }
     }
@@ -763,6 +852,15 @@ impl Neighbours {
         faces: &[Face],
         face_grid: &CellGrid,
     ) {
+        if let Some(periodic) = self.periodic {
+            // Between rebuilds particles move freely across periodic sides; here they are
+            // put back into the box.
+            particles
+                .x
+                .par_iter_mut()
+                .with_min_len(4 * MIN_PARALLEL_LEN)
+                .for_each(|x| *x = periodic.wrap(*x));
+        }
         let layout = Layout::of(&particles.radius, self.skin);
         let inv_h = 1.0 / layout.h;
         let keys: Vec<(u64, u32)> = particles
@@ -796,7 +894,7 @@ impl Neighbours {
         }
         let kept = |a: u32| (a != NONE).then_some(a);
         let history = Histories {
-            pairs: self.pairs.history(n, |i, j| {
+            pairs: ContactList::history_of(&[&self.pairs, &self.wrapped], n, |i, j| {
                 let (a, b) = (kept(new[i])?, kept(new[j as usize])?);
                 Some((a.min(b), a.max(b)))
             }),
@@ -806,6 +904,7 @@ impl Neighbours {
         // The old lists and anchors go before the new ones are made.
         self.pairs = ContactList::default();
         self.faces = ContactList::default();
+        self.wrapped = ContactList::default();
         self.x_at_build = Vec::new();
         if let Some(order) = order {
             particles.permute(&order);
@@ -946,9 +1045,55 @@ impl Neighbours {
             pairs.par_sort_unstable();
             compress(n, pairs.iter().map(|&k| ((k >> 32) as u32, k as u32)))
         };
-        drop(grid);
         let slabs = slabs_of(&start, &partner);
         self.pairs = ContactList::with_springs(start, partner, slabs, &history.pairs);
+        if let Some(periodic) = self.periodic {
+            // Pairs across periodic sides: each image x_j + s of a particle near a side
+            // against the particles i < j near it; one shift per pair, since a period is
+            // longer than twice any reach (checked by the scenario).
+            let max_radius = radius.iter().copied().fold(0.0, f64::max);
+            let reach_max = 2.0 * max_radius + skin;
+            let m = (reach_max / layout.h).ceil().max(1.0) as i32;
+            let mut found: Vec<(u32, u32, DVec3)> = (0..n as u32)
+                .into_par_iter()
+                .with_min_len(4 * MIN_PARALLEL_LEN)
+                .fold(
+                    || (Vec::new(), Vec::new()),
+                    |(mut out, mut shifts): (Vec<(u32, u32, DVec3)>, Vec<DVec3>), j| {
+                        periodic.image_shifts(x[j as usize], reach_max, &mut shifts);
+                        for &s in &shifts {
+                            let image = x[j as usize] + s;
+                            let c = cell_of(image, 1.0 / layout.h);
+                            for dz in -m..=m {
+                                for dy in -m..=m {
+                                    for dx in -m..=m {
+                                        for &i in grid.in_cell(c + IVec3::new(dx, dy, dz)) {
+                                            let reach =
+                                                radius[i as usize] + radius[j as usize] + skin;
+                                            if i < j
+                                                && (x[i as usize] - image).length_squared()
+                                                    < reach * reach
+                                            {
+                                                out.push((i, j, s));
+                                            }
+                                        }
+                                    }
+                                }
+                            }
+                        }
+                        (out, shifts)
+                    },
+                )
+                .map(|(out, _)| out)
+                .flatten()
+                .collect();
+            found.sort_unstable_by_key(|&(i, j, _)| (i, j));
+            let (start, partner) = compress(n, found.iter().map(|&(i, j, _)| (i, j)));
+            self.shift = found.into_iter().map(|(_, _, s)| s).collect();
+            let pieces = pieces_of(&start, FACE_PIECE);
+            self.wrapped = ContactList::with_springs(start, partner, pieces, &history.pairs);
+        }
+        drop(grid);
 
         // The items of a grid cell come in ascending order, so each particle's run of faces
         // is sorted.

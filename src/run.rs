@@ -113,15 +113,16 @@ impl Frames<'_> {
     }
 
     fn write(&self, k: u64, sim: &Simulation) -> Result<()> {
+        let particles = sim.particles_in_domain();
         if self.formats.csv {
-            write_frame(self.dir, k, &sim.particles, self.extra)?;
+            write_frame(self.dir, k, &particles, self.extra)?;
         }
         if sim.scenario.contact_network {
             let contacts = sim.contact_network();
             crate::csv::write_contacts(self.dir, &format!("contacts{k:06}.csv"), &contacts)?;
             if self.formats.vtk {
                 let name = format!("contacts{k:06}.vtp");
-                crate::vtk::write_contacts(&self.dir.join(&name), &sim.particles, &contacts)?;
+                crate::vtk::write_contacts(&self.dir.join(&name), &particles, &contacts)?;
                 let entries: Vec<(f64, String)> = (0..=k)
                     .map(|f| (f as f64 * self.frame_time, format!("contacts{f:06}.vtp")))
                     .collect();
@@ -130,7 +131,7 @@ impl Frames<'_> {
         }
         if self.formats.vtk {
             let name = format!("particles{k:06}.vtu");
-            crate::vtk::write_particles(&self.dir.join(&name), &sim.particles)?;
+            crate::vtk::write_particles(&self.dir.join(&name), &particles)?;
             let entries: Vec<(f64, String)> = (0..=k)
                 .map(|f| (f as f64 * self.frame_time, format!("particles{f:06}.vtu")))
                 .collect();

@@ -12,7 +12,8 @@
 //!              phase } | { type = "velocity", velocity } | { type = "rotation", center, axis,
 //!              angular_velocity }   (any number of these)
 //! [[tags]]     min, max, tag   (a box that labels particles entering it; any number)
-//! [domain]     min, max   (particles whose centre leaves it are removed)
+//! [domain]     min, max, periodic = [bool, bool, bool]   (particles whose centre leaves
+//!              it through a side that is not periodic are removed)
 //! [[outlets]]  min, max   (particles whose centre enters one are removed; any number)
 //! [[spawn]]    min, max, material, velocity, count, rate, start, stop, radius = {
 //!              distribution = "uniform" | "normal" | "lognormal" | "table", ... }
@@ -237,6 +238,8 @@ pub struct Scenario {
     /// The bounds of the simulated space (`[domain]`): particles whose centre leaves it are
     /// removed. None: unbounded.
     pub domain: Option<Region>,
+    /// The axes along which the domain is periodic (`[domain] periodic`).
+    pub periodic: [bool; 3],
     /// Boxes that remove the particles whose centre enters them (`[[outlets]]`).
     pub outlets: Vec<Region>,
     /// Insertion regions (`[[spawn]]`); when there are any, the `[geometry]` spawn box is not
@@ -423,6 +426,14 @@ enum RawRadius {
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
+struct RawDomain {
+    min: [f64; 3],
+    max: [f64; 3],
+    periodic: Option<[bool; 3]>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
 struct RawBox {
     min: [f64; 3],
     max: [f64; 3],
@@ -439,7 +450,7 @@ struct RawScenario {
     interactions: Vec<RawInteraction>,
     #[serde(default)]
     tags: Vec<RawTag>,
-    domain: Option<RawBox>,
+    domain: Option<RawDomain>,
     #[serde(default)]
     outlets: Vec<RawBox>,
     #[serde(default)]
@@ -1154,10 +1165,37 @@ impl Scenario {
                 })
             })
             .collect::<Result<Vec<_>>>()?;
+        let periodic = raw
+            .domain
+            .as_ref()
+            .and_then(|d| d.periodic)
+            .unwrap_or([false; 3]);
         let domain = raw
             .domain
-            .map(|b| region("[domain]", b, true))
+            .map(|d| {
+                region(
+                    "[domain]",
+                    RawBox {
+                        min: d.min,
+                        max: d.max,
+                    },
+                    true,
+                )
+            })
             .transpose()?;
+        if let Some(d) = domain {
+            // A period must hold twice the reach of the widest pair (2 R_max and the skin
+            // R_max / 2), so that a pair sees one image of the other.
+            let shortest = 6.0 * radius_max;
+            for (a, name) in ["x", "y", "z"].iter().enumerate() {
+                let length = d.max[a] - d.min[a];
+                if periodic[a] && length < shortest {
+                    bail!(
+                        "[domain] is periodic along {name} with a period of {length}: it must be at least 6 radius_max = {shortest}"
+                    );
+                }
+            }
+        }
         let outlets = raw
             .outlets
             .into_iter()
@@ -1216,6 +1254,7 @@ impl Scenario {
             meshes,
             tags,
             domain,
+            periodic,
             outlets,
             spawn,
             particles: raw.input.particles.map(|p| base.join(p)),
@@ -1385,6 +1424,8 @@ impl Scenario {
         }
         if let Some(d) = self.domain {
             let _ = writeln!(o, "\n[domain]\nmin = {}\nmax = {}", v(d.min), v(d.max));
+            let [x, y, z] = self.periodic;
+            let _ = writeln!(o, "periodic = [{x}, {y}, {z}]");
         }
         for b in &self.outlets {
             let _ = writeln!(o, "\n[[outlets]]\nmin = {}\nmax = {}", v(b.min), v(b.max));
@@ -1519,9 +1560,22 @@ impl Scenario {
         }
     }
 
-    /// Whether particles can be removed during the run (a domain or outlets).
+    /// Whether particles can be removed during the run (a domain with a side that is not
+    /// periodic, or outlets).
     pub fn removes(&self) -> bool {
-        self.domain.is_some() || !self.outlets.is_empty()
+        (self.domain.is_some() && self.periodic != [true; 3]) || !self.outlets.is_empty()
+    }
+
+    /// The periodic axes of the domain, if it has any.
+    pub fn periodicity(&self) -> Option<crate::neighbours::Periodic> {
+        let d = self.domain?;
+        self.periodic
+            .contains(&true)
+            .then(|| crate::neighbours::Periodic {
+                min: d.min,
+                length: d.max - d.min,
+                axes: self.periodic,
+            })
     }
 
     /// Total simulated time N_frames N_steps Δt.

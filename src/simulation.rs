@@ -597,7 +597,8 @@ impl Simulation {
             sim.steps = snapshot.steps;
             sim.time = sim.steps as f64 * dt;
             sim.move_meshes();
-            sim.neighbours = Neighbours::new(sim.neighbours.skin);
+            sim.neighbours =
+                Neighbours::with_periodic(sim.neighbours.skin, sim.neighbours.periodic);
             return Ok(sim);
         }
         // The lists of the last rebuild, built again with the mesh where it was then.
@@ -758,11 +759,22 @@ impl Simulation {
             bail!("too many particles: {}", particles.len());
         }
         check_materials(&particles, &scenario)?;
+        if let Some(periodic) = scenario.periodicity() {
+            let shortest = 6.0 * max_radius;
+            for a in 0..3 {
+                if periodic.axes[a] && periodic.length[a] < shortest {
+                    bail!(
+                        "the period {} of the domain along axis {a} is shorter than 6 times the largest radius ({shortest})",
+                        periodic.length[a]
+                    );
+                }
+            }
+        }
         let skin = SKIN_PER_RADIUS * g.radius_max;
         let face_grid = face_grid(&mesh.faces, max_radius, skin);
         let mut sim = Simulation {
             law: ContactLaw::of(&scenario),
-            neighbours: Neighbours::new(skin),
+            neighbours: Neighbours::with_periodic(skin, scenario.periodicity()),
             face_grid,
             spawner: Spawner::new(scenario.simulation.seed),
             loads: Vec::new(),
@@ -833,7 +845,24 @@ impl Simulation {
 
     /// Number of particle-particle and particle-face contacts in the last step.
     pub fn contact_count(&self) -> usize {
-        self.neighbours.pairs.contacts() + self.neighbours.faces.contacts()
+        let nb = &self.neighbours;
+        nb.pairs.contacts() + nb.wrapped.contacts() + nb.faces.contacts()
+    }
+
+    /// The particles with their positions put back into the domain along its periodic
+    /// axes (between neighbour-list rebuilds they may be up to half the skin beyond a side),
+    /// for output; the particles themselves if it has none.
+    pub fn particles_in_domain(&self) -> std::borrow::Cow<'_, Particles> {
+        match self.scenario.periodicity() {
+            None => std::borrow::Cow::Borrowed(&self.particles),
+            Some(periodic) => {
+                let mut p = self.particles.clone();
+                for x in &mut p.x {
+                    *x = periodic.wrap(*x);
+                }
+                std::borrow::Cow::Owned(p)
+            }
+        }
     }
 
     /// Advances the simulation by one time step Δt.
@@ -875,15 +904,19 @@ impl Simulation {
         if !s.removes() {
             return;
         }
-        let (domain, outlets) = (s.domain, &s.outlets);
+        let (domain, outlets, periodic) = (s.domain, &s.outlets, s.periodic);
+        // Outside the domain through a side that is not periodic.
+        let outside = |x: DVec3| {
+            domain.is_some_and(|d| {
+                (0..3).any(|a| !periodic[a] && (x[a] < d.min[a] || x[a] > d.max[a]))
+            })
+        };
         // Where each removed particle goes: an outlet, or `outlets.len()` for the domain.
         let fate = |x: &DVec3| -> Option<u32> {
             if let Some(k) = outlets.iter().position(|o| o.contains(*x)) {
                 return Some(k as u32);
             }
-            domain
-                .is_some_and(|d| !d.contains(*x))
-                .then_some(outlets.len() as u32)
+            outside(*x).then_some(outlets.len() as u32)
         };
         let p = &self.particles;
         let gone: Vec<(u32, u32)> =
@@ -983,6 +1016,41 @@ impl Simulation {
         for (a, b, springs) in open(&self.neighbours.pairs) {
             let (i, j) = if p.id[a] < p.id[b] { (a, b) } else { (b, a) };
             let Some(kin) = Kinematics::between_particles(&body(i), &body(j)) else {
+                continue;
+            };
+            let other = Other::Particle {
+                r: p.radius[j],
+                m: mass(j),
+            };
+            let coef = law.pair(p.material[i], p.material[j]);
+            out.push(record(
+                i,
+                other,
+                &kin,
+                coef,
+                springs,
+                Partner::Particle(p.id[j] as usize),
+            ));
+        }
+        let nb = &self.neighbours;
+        let wrapped: Vec<_> = (0..nb.wrapped.owners())
+            .flat_map(|a| nb.wrapped.run(a).map(move |k| (a, k)))
+            .filter(|&(_, k)| nb.wrapped.contact[k] != NONE)
+            .collect();
+        for (a, k) in wrapped {
+            let piece = nb.wrapped.pieces.partition_point(|&o| o as usize <= a) - 1;
+            let springs = nb.wrapped.stores[piece].springs[nb.wrapped.contact[k] as usize];
+            let b = nb.wrapped.partner[k] as usize;
+            let (i, j, shift) = if p.id[a] < p.id[b] {
+                (a, b, nb.shift[k])
+            } else {
+                (b, a, -nb.shift[k])
+            };
+            let bj = Body {
+                x: p.x[j] + shift,
+                ..body(j)
+            };
+            let Some(kin) = Kinematics::between_particles(&body(i), &bj) else {
                 continue;
             };
             let other = Other::Particle {
@@ -1413,7 +1481,80 @@ impl Simulation {
                 });
             });
         }
-        deep.into_inner().expect("not poisoned")
+        let mut deep = deep.into_inner().expect("not poisoned");
+        self.wrapped_contacts(&mut deep);
+        deep
+    }
+
+    /// Stage 3, across periodic sides: the pairs of `Neighbours::wrapped`, partner j seen at
+    /// its image x_j + shift, one by one in slot order (they are few: those at the sides),
+    /// after the slabs; the law as for any pair, body i the lower id.
+    fn wrapped_contacts(&mut self, deep: &mut Vec<Deep>) {
+        let p = &self.particles;
+        let law = &self.law;
+        let nb = &mut self.neighbours;
+        let ContactList {
+            start,
+            partner,
+            contact,
+            pieces,
+            stores,
+        } = &mut nb.wrapped;
+        let mass = |k: usize| {
+            Inertia::mass_with(
+                p.radius[k],
+                self.densities[p.material[k] as usize].mass_per_r3,
+            )
+        };
+        for piece in 0..pieces.len().saturating_sub(1) {
+            let store = &mut stores[piece];
+            for a in pieces[piece] as usize..pieces[piece + 1] as usize {
+                for k in start[a] as usize..start[a + 1] as usize {
+                    let b = partner[k] as usize;
+                    // Seen from the lower id: the other at its image.
+                    let (i, j, shift) = if p.id[a] < p.id[b] {
+                        (a, b, nb.shift[k])
+                    } else {
+                        (b, a, -nb.shift[k])
+                    };
+                    let body = |k: usize, x: DVec3| Body {
+                        x,
+                        radius: p.radius[k],
+                        v: p.v[k],
+                        w: p.w[k],
+                    };
+                    let (bi, bj) = (body(i, p.x[i]), body(j, p.x[j] + shift));
+                    let Some(kin) = Kinematics::between_particles(&bi, &bj) else {
+                        if contact[k] != NONE {
+                            store.close(contact[k]);
+                            contact[k] = NONE;
+                        }
+                        continue;
+                    };
+                    if contact[k] == NONE {
+                        contact[k] = store.open();
+                    }
+                    let springs = &mut store.springs[contact[k] as usize];
+                    let other = Other::Particle {
+                        r: p.radius[j],
+                        m: mass(j),
+                    };
+                    let coef = law.pair(p.material[i], p.material[j]);
+                    let force = law.evaluate(coef, p.radius[i], mass(i), other, &kin, springs);
+                    self.loads[i].add(force.f, force.tau_i);
+                    self.loads[j].add(-force.f, force.tau_j); // Eqs. (56)-(60)
+                    let limit = p.radius[i].min(p.radius[j]);
+                    if kin.delta > limit {
+                        deep.push(Deep {
+                            i,
+                            other: Partner::Particle(j),
+                            delta: kin.delta,
+                            limit,
+                        });
+                    }
+                }
+            }
+        }
     }
 
     /// Stage 4 (Sections 2.2, 3.3): the force of every particle-face contact. Returns the

@@ -263,10 +263,16 @@ pub fn write_contacts(path: &Path, p: &Particles, contacts: &[ContactRecord]) ->
     }
     let mut points = Vec::with_capacity(2 * contacts.len());
     for c in contacts {
-        points.push(p.x[at[c.id as usize] as usize]);
+        let xi = p.x[at[c.id as usize] as usize];
+        points.push(xi);
         points.push(match c.with {
-            Partner::Particle(j) => p.x[at[j] as usize],
-            Partner::Face(_) => c.point,
+            // A pair across a periodic side: to the contact point rather than across the box.
+            Partner::Particle(j)
+                if (p.x[at[j] as usize] - xi).length() <= 4.0 * (c.point - xi).length() =>
+            {
+                p.x[at[j] as usize]
+            }
+            _ => c.point,
         });
     }
     let n = contacts.len();

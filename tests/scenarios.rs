@@ -47,6 +47,7 @@ fn full_scenario_sets_every_key() {
     assert_eq!(s.meshes[0].contacts, Contacts::Merged);
     assert_eq!(s.domain.unwrap().max, glam::DVec3::splat(0.5));
     assert_eq!(s.outlets.len(), 1);
+    assert_eq!(s.periodic, [true, false, false]);
     assert!(s.wall_forces);
     let sim = Simulation::new(s).unwrap();
     assert_eq!(sim.mesh.faces.len(), 10);

@@ -1,0 +1,171 @@
+//! Periodic domains: a pair that touches across a periodic side behaves as the same pair
+//! inside the box; a periodic gas keeps its particles and its momentum; a periodic run
+//! resumes bit for bit.
+
+mod common;
+
+use glam::{DQuat, DVec3};
+use tinydem::integrate::Inertia;
+use tinydem::particles::{Particle, Particles};
+use tinydem::simulation::Simulation;
+
+const R: f64 = 0.004;
+
+fn grain(x: DVec3, v: DVec3, w: DVec3) -> Particle {
+    Particle {
+        x,
+        radius: R,
+        v,
+        q: DQuat::IDENTITY,
+        w,
+        tag: 0,
+        material: 0,
+    }
+}
+
+fn periodic(particles: Vec<Particle>, extra: &str) -> Simulation {
+    let s = common::scenario(&format!(
+        "[geometry]\nradius_min = {R}\nradius_max = {R}\n\
+         [material]\nfriction_sliding = 0.5\nfriction_rolling = 0.2\n\
+         [kinetics]\ngravity = [0.0, 0.0, 0.0]\n\
+         [simulation]\ntimestep = 1e-5\nmax_particles = 0\nspawn_attempts = 0\n\
+         [domain]\nmin = [-0.05, -0.05, -0.05]\nmax = [0.05, 0.05, 0.05]\nperiodic = [true, true, true]\n{extra}"
+    ));
+    Simulation::from_parts(
+        s,
+        Default::default(),
+        particles.into_iter().collect::<Particles>(),
+    )
+    .unwrap()
+}
+
+/// An oblique, spinning collision: at `o` inside the box, or across the corner of the box.
+fn collision(o: DVec3) -> Simulation {
+    let d = DVec3::new(R + 2e-5, 0.3 * R, -0.2 * R);
+    periodic(
+        vec![
+            grain(o - d, DVec3::new(0.4, 0.05, 0.0), DVec3::new(0.0, 5.0, 1.0)),
+            grain(
+                o + d,
+                DVec3::new(-0.3, 0.0, 0.02),
+                DVec3::new(2.0, 0.0, -3.0),
+            ),
+        ],
+        "",
+    )
+}
+
+#[test]
+fn a_pair_across_a_periodic_side_equals_the_pair_inside() {
+    let mut inside = collision(DVec3::new(0.01, -0.02, 0.0));
+    let mut across = collision(DVec3::new(0.05, 0.05, -0.05)); // a corner: three sides
+    let mut touched = 0;
+    for step in 0..3000 {
+        inside.step().unwrap();
+        across.step().unwrap();
+        touched += (inside.contact_count() > 0) as u32;
+        assert_eq!(
+            inside.contact_count(),
+            across.contact_count(),
+            "step {step}"
+        );
+        let state = |s: &Simulation| {
+            let p: Vec<_> = s.particles.iter_by_id().map(|(_, q)| q).collect();
+            let period = |d: DVec3| d - (d / 0.1).round() * 0.1;
+            (period(p[1].x - p[0].x), p[0].v, p[1].v, p[0].w, p[1].w)
+        };
+        let (a, b) = (state(&inside), state(&across));
+        let close = |x: DVec3, y: DVec3, scale: f64| (x - y).length() <= 1e-12 * scale;
+        assert!(
+            close(a.0, b.0, 0.1),
+            "step {step}: separation {} vs {}",
+            a.0,
+            b.0
+        );
+        for (x, y) in [(a.1, b.1), (a.2, b.2)] {
+            assert!(close(x, y, 1.0), "step {step}: velocity {x} vs {y}");
+        }
+        for (x, y) in [(a.3, b.3), (a.4, b.4)] {
+            assert!(close(x, y, 100.0), "step {step}: spin {x} vs {y}");
+        }
+    }
+    assert!(
+        touched > 100,
+        "the grains collided ({touched} steps in contact)"
+    );
+}
+
+/// A dense periodic gas: nothing leaves, momentum stays, frames lie in the box.
+fn gas() -> Vec<Particle> {
+    let mut p = Vec::new();
+    let mut k = 0u32;
+    for i in 0..8 {
+        for j in 0..8 {
+            for l in 0..8 {
+                let x = DVec3::new(i as f64, j as f64, l as f64) * 0.0125 - DVec3::splat(0.045);
+                let h = |m: u32| {
+                    ((k.wrapping_mul(2654435761).wrapping_add(m) >> 8) % 1000) as f64 / 1000.0 - 0.5
+                };
+                p.push(grain(
+                    x,
+                    DVec3::new(h(1), h(2), h(3)),
+                    DVec3::new(h(4), h(5), h(6)) * 50.0,
+                ));
+                k += 1;
+            }
+        }
+    }
+    p
+}
+
+#[test]
+fn a_periodic_gas_keeps_its_particles_and_momentum() {
+    let mut s = periodic(gas(), "");
+    let momentum = |s: &Simulation| -> DVec3 {
+        let m = Inertia::mass(R, 1000.0);
+        s.particles.v.iter().map(|v| *v * m).sum()
+    };
+    let p0 = momentum(&s);
+    let mut contacts = 0;
+    for _ in 0..4000 {
+        s.step().unwrap();
+        contacts = contacts.max(s.contact_count());
+    }
+    assert_eq!(s.particles.len(), 512);
+    assert_eq!(s.removed.count(), 0);
+    let scale = Inertia::mass(R, 1000.0) * 512.0;
+    assert!(
+        (momentum(&s) - p0).length() < 1e-12 * scale,
+        "{} vs {p0}",
+        momentum(&s)
+    );
+    let inside = s.particles_in_domain();
+    assert!(
+        inside
+            .x
+            .iter()
+            .all(|x| x.cmpge(DVec3::splat(-0.05)).all() && x.cmplt(DVec3::splat(0.05)).all())
+    );
+    assert!(s.particles.x.iter().any(|x| x.abs().max_element() > 0.05) || s.rebuilds() > 0);
+    assert!(contacts > 10);
+}
+
+#[test]
+fn a_periodic_run_resumes_bit_for_bit() {
+    let mut whole = periodic(gas(), "");
+    let mut first = periodic(gas(), "");
+    for _ in 0..1500 {
+        whole.step().unwrap();
+        first.step().unwrap();
+    }
+    let snapshot = first.snapshot();
+    let mut resumed = Simulation::restore(first.scenario.clone(), snapshot).unwrap();
+    for _ in 0..1500 {
+        whole.step().unwrap();
+        resumed.step().unwrap();
+    }
+    assert!(
+        whole.particles == resumed.particles,
+        "the resumed run differs"
+    );
+}
