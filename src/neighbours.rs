@@ -217,7 +217,7 @@ impl Periodic {
     /// The shifts by which the images of a point at `x` (in the box) come within `reach` of
     /// the box: for each periodic axis where it is within `reach` of a side, the period
     /// towards the other side, and their combinations (edges, corners).
-    fn image_shifts(&self, x: DVec3, reach: f64, out: &mut Vec<DVec3>) {
+    pub(crate) fn image_shifts(&self, x: DVec3, reach: f64, out: &mut Vec<DVec3>) {
         out.clear();
         out.push(DVec3::ZERO);
         for a in 0..3 {

@@ -259,9 +259,14 @@ impl Spawner {
             min: source.region.min - DVec3::splat(h),
             max: source.region.max + DVec3::splat(h),
         };
+        // In a periodic domain a sphere may touch the images of particles near the far side.
+        let periodic = s.periodicity();
+        let wrap = |x: DVec3| periodic.map_or(x, |p| p.wrap(x));
+        let mut shifts = Vec::new();
         let mut cells: FxHashMap<u64, Vec<u32>> = FxHashMap::default();
         for (i, &x) in particles.x.iter().enumerate() {
-            if near.contains(x) {
+            let x = wrap(x);
+            if periodic.is_some() || near.contains(x) {
                 cells
                     .entry(key(cell_of(x, inv_h)))
                     .or_default()
@@ -283,24 +288,31 @@ impl Spawner {
                 uniform(&mut self.rng, lo.y, hi.y),
                 uniform(&mut self.rng, lo.z, hi.z),
             );
-            let c = cell_of(x, inv_h);
-            let mut free = true;
-            'cells: for dz in -1..=1 {
-                for dy in -1..=1 {
-                    for dx in -1..=1 {
-                        let Some(list) = cells.get(&key(c + glam::IVec3::new(dx, dy, dz))) else {
-                            continue;
-                        };
-                        for &j in list {
-                            let j = j as usize;
-                            let reach = radius + particles.radius[j];
-                            if (x - particles.x[j]).length_squared() < reach * reach {
-                                free = false;
-                                break 'cells;
+            let overlaps = |at: DVec3| {
+                let c = cell_of(at, inv_h);
+                for dz in -1..=1 {
+                    for dy in -1..=1 {
+                        for dx in -1..=1 {
+                            let Some(list) = cells.get(&key(c + glam::IVec3::new(dx, dy, dz)))
+                            else {
+                                continue;
+                            };
+                            for &j in list {
+                                let j = j as usize;
+                                let reach = radius + particles.radius[j];
+                                if (at - wrap(particles.x[j])).length_squared() < reach * reach {
+                                    return true;
+                                }
                             }
                         }
                     }
                 }
+                false
+            };
+            let mut free = !overlaps(x);
+            if free && let Some(p) = periodic {
+                p.image_shifts(wrap(x), h, &mut shifts);
+                free = shifts.iter().all(|&s| !overlaps(wrap(x) + s));
             }
             free = free
                 && face_grid.at(x).iter().all(|&f| {
@@ -314,7 +326,7 @@ impl Spawner {
             }
             *pending = None;
             cells
-                .entry(key(c))
+                .entry(key(cell_of(wrap(x), inv_h)))
                 .or_default()
                 .push(particles.len() as u32);
             particles.push(Particle {

@@ -169,3 +169,32 @@ fn a_periodic_run_resumes_bit_for_bit() {
         "the resumed run differs"
     );
 }
+
+/// Spawning into a periodic box sees the images: no grain starts overlapping another across
+/// a side.
+#[test]
+fn spawned_grains_do_not_overlap_across_periodic_sides() {
+    let mut s = common::simulate(
+        &format!(
+            "[geometry]\nradius_min = {R}\nradius_max = {R}\n\
+             [kinetics]\ngravity = [0.0, 0.0, 0.0]\ninitial_velocity = [0.0, 0.0, 0.0]\n\
+             [simulation]\nmax_particles = 900\nspawn_attempts = 20000\n\
+             [domain]\nmin = [-0.05, -0.05, -0.05]\nmax = [0.05, 0.05, 0.05]\nperiodic = [true, true, true]\n\
+             [[spawn]]\nmin = [-0.05, -0.05, -0.05]\nmax = [0.05, 0.05, 0.05]\ncount = 900\n"
+        ),
+        0,
+    );
+    s.step().unwrap();
+    let x = &s.particles.x;
+    assert!(x.len() > 600, "{} grains", x.len());
+    let period = |d: DVec3| d - (d / 0.1).round() * 0.1;
+    for i in 0..x.len() {
+        for j in i + 1..x.len() {
+            let d = period(x[i] - x[j]).length();
+            assert!(
+                d >= 2.0 * R * (1.0 - 1e-9),
+                "grains {i} and {j} overlap: {d}"
+            );
+        }
+    }
+}
