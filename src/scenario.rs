@@ -1261,7 +1261,7 @@ impl Scenario {
             output_dir: raw
                 .output
                 .dir
-                .map_or_else(|| PathBuf::from("output"), |d| base.join(d)),
+                .map_or_else(|| base.join("output"), |d| base.join(d)),
             checkpoint_every: raw.output.checkpoint_every.unwrap_or(0),
             formats: Formats::parse(raw.output.formats)?,
             wall_forces: raw.output.wall_forces.unwrap_or(false),
@@ -1680,6 +1680,7 @@ mod tests {
         )
         .unwrap();
         assert_eq!(s.particles, Some(PathBuf::from("cases/a/p.csv")));
-        assert_eq!(s.output_dir, PathBuf::from("output"));
+        // Given or not, the output directory is relative to the scenario too.
+        assert_eq!(s.output_dir, PathBuf::from("cases/a/output"));
     }
 }
