@@ -997,7 +997,7 @@ impl Simulation {
             }
         };
         let mut out = Vec::new();
-        // Each open contact of `list`: owner, partner and springs.
+        // Each open contact of `list`: owner, partner, springs and slot.
         let open = |list: &ContactList| {
             let mut v = Vec::new();
             for piece in 0..list.pieces.len().saturating_sub(1) {
@@ -1006,45 +1006,26 @@ impl Simulation {
                     for k in list.run(i) {
                         if list.contact[k] != NONE {
                             let springs = store.springs[list.contact[k] as usize];
-                            v.push((i, list.partner[k] as usize, springs));
+                            v.push((i, list.partner[k] as usize, springs, k));
                         }
                     }
                 }
             }
             v
         };
-        for (a, b, springs) in open(&self.neighbours.pairs) {
-            let (i, j) = if p.id[a] < p.id[b] { (a, b) } else { (b, a) };
-            let Some(kin) = Kinematics::between_particles(&body(i), &body(j)) else {
-                continue;
-            };
-            let other = Other::Particle {
-                r: p.radius[j],
-                m: mass(j),
-            };
-            let coef = law.pair(p.material[i], p.material[j]);
-            out.push(record(
-                i,
-                other,
-                &kin,
-                coef,
-                springs,
-                Partner::Particle(p.id[j] as usize),
-            ));
-        }
+        // Pairs within the box, and across periodic sides with the partner at its image.
         let nb = &self.neighbours;
-        let wrapped: Vec<_> = (0..nb.wrapped.owners())
-            .flat_map(|a| nb.wrapped.run(a).map(move |k| (a, k)))
-            .filter(|&(_, k)| nb.wrapped.contact[k] != NONE)
-            .collect();
-        for (a, k) in wrapped {
-            let piece = nb.wrapped.pieces.partition_point(|&o| o as usize <= a) - 1;
-            let springs = nb.wrapped.stores[piece].springs[nb.wrapped.contact[k] as usize];
-            let b = nb.wrapped.partner[k] as usize;
+        let within = open(&nb.pairs)
+            .into_iter()
+            .map(|(a, b, s, _)| (a, b, s, DVec3::ZERO));
+        let across = open(&nb.wrapped)
+            .into_iter()
+            .map(|(a, b, s, k)| (a, b, s, nb.shift[k]));
+        for (a, b, springs, shift) in within.chain(across) {
             let (i, j, shift) = if p.id[a] < p.id[b] {
-                (a, b, nb.shift[k])
+                (a, b, shift)
             } else {
-                (b, a, -nb.shift[k])
+                (b, a, -shift)
             };
             let bj = Body {
                 x: p.x[j] + shift,
@@ -1067,7 +1048,7 @@ impl Simulation {
                 Partner::Particle(p.id[j] as usize),
             ));
         }
-        for (i, f, springs) in open(&self.neighbours.faces) {
+        for (i, f, springs, _) in open(&self.neighbours.faces) {
             let face = &self.mesh.faces[f];
             let wall = match self.face_part[f] {
                 STATIC => RigidVelocity::default(),

@@ -69,6 +69,12 @@ fn a_pair_across_a_periodic_side_equals_the_pair_inside() {
             across.contact_count(),
             "step {step}"
         );
+        // The contact network sees the pair across the sides too, with the same force.
+        let (a, b) = (inside.contact_network(), across.contact_network());
+        assert_eq!(a.len(), b.len(), "step {step}");
+        for (a, b) in a.iter().zip(&b) {
+            assert!((a.f_n - b.f_n).length() <= 1e-9 * a.f_n.length().max(1e-12));
+        }
         let state = |s: &Simulation| {
             let p: Vec<_> = s.particles.iter_by_id().map(|(_, q)| q).collect();
             let period = |d: DVec3| d - (d / 0.1).round() * 0.1;
