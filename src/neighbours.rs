@@ -188,18 +188,51 @@ impl CellGrid {
 pub const NONE: u32 = u32::MAX;
 
 /// Periodic axes of the domain: space repeats with period `length` along each `axes[a]`,
-/// from `min`.
+/// from `min`; with `shear`, the images across the gradient axis slide (Lees-Edwards).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Periodic {
     pub min: DVec3,
     pub length: DVec3,
     pub axes: [bool; 3],
+    pub shear: Option<Shear>,
+}
+
+/// Lees-Edwards boundaries: the image of the box beyond the `gradient` axis's upper side is
+/// shifted along the `axis` by `offset` = V t and moves with `velocity` V along it (the one
+/// below by -V t, with -V), which imposes a simple shear of rate V / L_gradient.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Shear {
+    pub velocity: f64,
+    pub axis: usize,
+    pub gradient: usize,
+    /// The current offset V t (not reduced by the period).
+    pub offset: f64,
 }
 
 impl Periodic {
     /// Puts `x` back into [min, min + length) along the periodic axes.
     #[inline]
     pub fn wrap(&self, x: DVec3) -> DVec3 {
+        self.wrap_state(x, DVec3::ZERO).0
+    }
+
+    /// Puts a particle at `x` with velocity `v` back into the box: crossing the gradient axis
+    /// of a sheared domain also shifts it along the shear axis by the offset and changes its
+    /// velocity by the image's.
+    #[inline]
+    pub fn wrap_state(&self, x: DVec3, v: DVec3) -> (DVec3, DVec3) {
+        let (mut x, mut v) = (x, v);
+        if let Some(sh) = self.shear
+            && x[sh.gradient].is_finite()
+        {
+            let (lo, l) = (self.min[sh.gradient], self.length[sh.gradient]);
+            let crossings = ((x[sh.gradient] - lo) / l).floor();
+            if crossings != 0.0 {
+                x[sh.gradient] -= crossings * l;
+                x[sh.axis] -= crossings * self.offset_in_period(sh);
+                v[sh.axis] -= crossings * sh.velocity;
+            }
+        }
         let mut x = x.to_array();
         for (a, x) in x.iter_mut().enumerate() {
             if self.axes[a] && x.is_finite() {
@@ -211,30 +244,61 @@ impl Periodic {
                 *x = w;
             }
         }
-        DVec3::from_array(x)
+        (DVec3::from_array(x), v)
     }
 
-    /// The shifts by which the images of a point at `x` (in the box) come within `reach` of
-    /// the box: for each periodic axis where it is within `reach` of a side, the period
-    /// towards the other side, and their combinations (edges, corners).
-    pub(crate) fn image_shifts(&self, x: DVec3, reach: f64, out: &mut Vec<DVec3>) {
+    /// The shear offset reduced to [0, L) of the shear axis.
+    fn offset_in_period(&self, sh: Shear) -> f64 {
+        sh.offset.rem_euclid(self.length[sh.axis])
+    }
+
+    /// The images of a point at `x` (in the box) that come within `reach` of the box: their
+    /// shifts and how many times each crosses the gradient axis (-1, 0, 1; 0 without
+    /// shear). For each periodic axis where the point (or an image of it) is within `reach`
+    /// of a side, the period towards the other side, and their combinations (edges,
+    /// corners); across the gradient axis of a sheared box, with the offset along the shear
+    /// axis, brought back into the period.
+    pub(crate) fn image_shifts(&self, x: DVec3, reach: f64, out: &mut Vec<(DVec3, i8)>) {
         out.clear();
-        out.push(DVec3::ZERO);
-        for a in 0..3 {
-            if !self.axes[a] {
-                continue;
-            }
-            let mut e = DVec3::ZERO;
-            if x[a] - self.min[a] < reach {
-                e[a] = self.length[a];
-            } else if self.min[a] + self.length[a] - x[a] < reach {
-                e[a] = -self.length[a];
+        out.push((DVec3::ZERO, 0));
+        let near = |p: DVec3, a: usize| -> f64 {
+            if p[a] - self.min[a] < reach {
+                self.length[a]
+            } else if self.min[a] + self.length[a] - p[a] < reach {
+                -self.length[a]
             } else {
+                0.0
+            }
+        };
+        if let Some(sh) = self.shear {
+            let (g, s) = (sh.gradient, sh.axis);
+            let step = near(x, g);
+            if step != 0.0 {
+                let n = step.signum();
+                let mut e = DVec3::ZERO;
+                e[g] = step;
+                e[s] = n * self.offset_in_period(sh);
+                let (lo, l) = (self.min[s], self.length[s]);
+                if x[s] + e[s] >= lo + l {
+                    e[s] -= l;
+                } else if x[s] + e[s] < lo {
+                    e[s] += l;
+                }
+                out.push((e, n as i8));
+            }
+        }
+        for a in 0..3 {
+            if !self.axes[a] || self.shear.is_some_and(|sh| sh.gradient == a) {
                 continue;
             }
             for k in 0..out.len() {
-                let s = out[k] + e;
-                out.push(s);
+                let (e0, n) = out[k];
+                let step = near(x + e0, a);
+                if step != 0.0 {
+                    let mut e = e0;
+                    e[a] += step;
+                    out.push((e, n));
+                }
             }
         }
         out.remove(0);
@@ -627,6 +691,11 @@ pub struct Neighbours {
     /// `x_j + shift[slot]`.
     pub wrapped: ContactList,
     pub shift: Vec<DVec3>,
+    /// For each slot of `wrapped`, how often the partner's image crosses the gradient axis
+    /// of a sheared domain (its shift then grows by that times V (t - t_build)).
+    pub crossings: Vec<i8>,
+    /// The shear offset V t at the last rebuild.
+    pub offset_at_build: f64,
     /// The periodic axes of the domain, if any.
     pub periodic: Option<Periodic>,
     /// Positions at the last rebuild (the anchors of the Verlet criterion).
@@ -677,6 +746,30 @@ impl Neighbours {
             skin,
             ..Default::default()
         }
+    }
+
+    /// Where the partner of slot `k` of `wrapped` is seen, relative to where it is: the
+    /// shift of its image now, and the velocity the image adds.
+    #[inline]
+    pub fn image(&self, k: usize) -> (DVec3, DVec3) {
+        let n = self.crossings[k] as f64;
+        match self.periodic.and_then(|p| p.shear) {
+            Some(sh) if n != 0.0 => {
+                let mut drift = DVec3::ZERO;
+                drift[sh.axis] = n * (sh.offset - self.offset_at_build);
+                let mut dv = DVec3::ZERO;
+                dv[sh.axis] = n * sh.velocity;
+                (self.shift[k] + drift, dv)
+            }
+            _ => (self.shift[k], DVec3::ZERO),
+        }
+    }
+
+    /// How far the images across a sheared side have slid since the last rebuild.
+    pub fn shear_drift(&self) -> f64 {
+        self.periodic
+            .and_then(|p| p.shear)
+            .map_or(0.0, |sh| (sh.offset - self.offset_at_build).abs())
     }
 
     /// Lists for a domain with the periodic axes `periodic`.
@@ -858,8 +951,9 @@ impl Neighbours {
             particles
                 .x
                 .par_iter_mut()
+                .zip(particles.v.par_iter_mut())
                 .with_min_len(4 * MIN_PARALLEL_LEN)
-                .for_each(|x| *x = periodic.wrap(*x));
+                .for_each(|(x, v)| (*x, *v) = periodic.wrap_state(*x, *v));
         }
         let layout = Layout::of(&particles.radius, self.skin);
         let inv_h = 1.0 / layout.h;
@@ -1054,14 +1148,15 @@ impl Neighbours {
             let max_radius = radius.iter().copied().fold(0.0, f64::max);
             let reach_max = 2.0 * max_radius + skin;
             let m = (reach_max / layout.h).ceil().max(1.0) as i32;
-            let mut found: Vec<(u32, u32, DVec3)> = (0..n as u32)
+            type Found = (u32, u32, DVec3, i8);
+            let mut found: Vec<Found> = (0..n as u32)
                 .into_par_iter()
                 .with_min_len(4 * MIN_PARALLEL_LEN)
                 .fold(
                     || (Vec::new(), Vec::new()),
-                    |(mut out, mut shifts): (Vec<(u32, u32, DVec3)>, Vec<DVec3>), j| {
+                    |(mut out, mut shifts): (Vec<Found>, Vec<(DVec3, i8)>), j| {
                         periodic.image_shifts(x[j as usize], reach_max, &mut shifts);
-                        for &s in &shifts {
+                        for &(s, crossing) in &shifts {
                             let image = x[j as usize] + s;
                             let c = cell_of(image, 1.0 / layout.h);
                             for dz in -m..=m {
@@ -1074,7 +1169,7 @@ impl Neighbours {
                                                 && (x[i as usize] - image).length_squared()
                                                     < reach * reach
                                             {
-                                                out.push((i, j, s));
+                                                out.push((i, j, s, crossing));
                                             }
                                         }
                                     }
@@ -1087,9 +1182,11 @@ impl Neighbours {
                 .map(|(out, _)| out)
                 .flatten()
                 .collect();
-            found.sort_unstable_by_key(|&(i, j, _)| (i, j));
-            let (start, partner) = compress(n, found.iter().map(|&(i, j, _)| (i, j)));
-            self.shift = found.into_iter().map(|(_, _, s)| s).collect();
+            found.sort_unstable_by_key(|&(i, j, _, _)| (i, j));
+            let (start, partner) = compress(n, found.iter().map(|&(i, j, _, _)| (i, j)));
+            self.shift = found.iter().map(|f| f.2).collect();
+            self.crossings = found.iter().map(|f| f.3).collect();
+            self.offset_at_build = periodic.shear.map_or(0.0, |sh| sh.offset);
             let pieces = pieces_of(&start, FACE_PIECE);
             self.wrapped = ContactList::with_springs(start, partner, pieces, &history.pairs);
         }

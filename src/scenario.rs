@@ -240,6 +240,9 @@ pub struct Scenario {
     pub domain: Option<Region>,
     /// The axes along which the domain is periodic (`[domain] periodic`).
     pub periodic: [bool; 3],
+    /// Lees-Edwards boundaries: the velocity V of the images across the gradient axis, and
+    /// the shear and gradient axes (`[domain] lees_edwards`).
+    pub lees_edwards: Option<(f64, usize, usize)>,
     /// Boxes that remove the particles whose centre enters them (`[[outlets]]`).
     pub outlets: Vec<Region>,
     /// Insertion regions (`[[spawn]]`); when there are any, the `[geometry]` spawn box is not
@@ -430,6 +433,15 @@ struct RawDomain {
     min: [f64; 3],
     max: [f64; 3],
     periodic: Option<[bool; 3]>,
+    lees_edwards: Option<RawShear>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawShear {
+    velocity: f64,
+    shear_axis: String,
+    gradient_axis: String,
 }
 
 #[derive(Deserialize)]
@@ -1170,6 +1182,41 @@ impl Scenario {
             .as_ref()
             .and_then(|d| d.periodic)
             .unwrap_or([false; 3]);
+        let lees_edwards = match raw.domain.as_ref().and_then(|d| d.lees_edwards.as_ref()) {
+            None => None,
+            Some(le) => {
+                let key = "[domain] lees_edwards";
+                let axis = |name: &str, value: &str| -> Result<usize> {
+                    match value {
+                        "x" => Ok(0),
+                        "y" => Ok(1),
+                        "z" => Ok(2),
+                        other => bail!(
+                            "{key} {name} = \"{other}\" is not allowed: it must be \"x\", \"y\" or \"z\""
+                        ),
+                    }
+                };
+                let (s, g) = (
+                    axis("shear_axis", &le.shear_axis)?,
+                    axis("gradient_axis", &le.gradient_axis)?,
+                );
+                if s == g {
+                    bail!("{key}: shear_axis and gradient_axis must differ");
+                }
+                if !(periodic[s] && periodic[g]) {
+                    bail!(
+                        "{key}: the domain must be periodic along the shear axis {} and the gradient axis {}",
+                        le.shear_axis,
+                        le.gradient_axis
+                    );
+                }
+                Some((
+                    check(&format!("{key} velocity"), le.velocity, Range::Finite)?,
+                    s,
+                    g,
+                ))
+            }
+        };
         let domain = raw
             .domain
             .map(|d| {
@@ -1255,6 +1302,7 @@ impl Scenario {
             tags,
             domain,
             periodic,
+            lees_edwards,
             outlets,
             spawn,
             particles: raw.input.particles.map(|p| base.join(p)),
@@ -1426,6 +1474,16 @@ impl Scenario {
             let _ = writeln!(o, "\n[domain]\nmin = {}\nmax = {}", v(d.min), v(d.max));
             let [x, y, z] = self.periodic;
             let _ = writeln!(o, "periodic = [{x}, {y}, {z}]");
+            if let Some((velocity, s, g)) = self.lees_edwards {
+                let name = |a: usize| ["x", "y", "z"][a];
+                let _ = writeln!(
+                    o,
+                    "lees_edwards = {{ velocity = {}, shear_axis = \"{}\", gradient_axis = \"{}\" }}",
+                    f(velocity),
+                    name(s),
+                    name(g)
+                );
+            }
         }
         for b in &self.outlets {
             let _ = writeln!(o, "\n[[outlets]]\nmin = {}\nmax = {}", v(b.min), v(b.max));
@@ -1575,6 +1633,14 @@ impl Scenario {
                 min: d.min,
                 length: d.max - d.min,
                 axes: self.periodic,
+                shear: self.lees_edwards.map(|(velocity, axis, gradient)| {
+                    crate::neighbours::Shear {
+                        velocity,
+                        axis,
+                        gradient,
+                        offset: 0.0,
+                    }
+                }),
             })
     }
 

@@ -601,9 +601,11 @@ impl Simulation {
                 Neighbours::with_periodic(sim.neighbours.skin, sim.neighbours.periodic);
             return Ok(sim);
         }
-        // The lists of the last rebuild, built again with the mesh where it was then.
+        // The lists of the last rebuild, built again with the mesh (and sheared images)
+        // where they were then.
         sim.steps = snapshot.built_at;
         sim.time = sim.steps as f64 * dt;
+        sim.slide_images();
         sim.move_meshes();
         sim.regrid_faces();
         sim.neighbours.restore(
@@ -646,6 +648,11 @@ impl Simulation {
         } else {
             let old = Scenario::parse(&snapshot.scenario, std::path::Path::new("checkpoint"))
                 .map_err(|e| misfit(format!("its scenario does not parse: {e:#}")))?;
+            if old.lees_edwards.is_some() {
+                bail!(
+                    "a run with Lees-Edwards boundaries cannot start a stage yet (its images would jump back to offset 0): continue it with --resume"
+                );
+            }
             Some(old.simulation.seed)
         };
         if old_seed == Some(sim.scenario.simulation.seed) {
@@ -855,10 +862,11 @@ impl Simulation {
     pub fn particles_in_domain(&self) -> std::borrow::Cow<'_, Particles> {
         match self.scenario.periodicity() {
             None => std::borrow::Cow::Borrowed(&self.particles),
-            Some(periodic) => {
+            Some(_) => {
+                let periodic = self.neighbours.periodic.expect("set from the scenario");
                 let mut p = self.particles.clone();
-                for x in &mut p.x {
-                    *x = periodic.wrap(*x);
+                for (x, v) in p.x.iter_mut().zip(p.v.iter_mut()) {
+                    (*x, *v) = periodic.wrap_state(*x, *v);
                 }
                 std::borrow::Cow::Owned(p)
             }
@@ -871,6 +879,7 @@ impl Simulation {
     /// deeper than the smaller radius, or a non-finite position or velocity.
     pub fn step(&mut self) -> Result<(), Unstable> {
         let t = Instant::now();
+        self.slide_images();
         self.move_meshes();
         let t = self.stage_times.add(Stage::MoveMeshes, t);
         self.spawn();
@@ -1020,15 +1029,17 @@ impl Simulation {
             .map(|(a, b, s, _)| (a, b, s, DVec3::ZERO));
         let across = open(&nb.wrapped)
             .into_iter()
-            .map(|(a, b, s, k)| (a, b, s, nb.shift[k]));
-        for (a, b, springs, shift) in within.chain(across) {
-            let (i, j, shift) = if p.id[a] < p.id[b] {
-                (a, b, shift)
+            .map(|(a, b, s, k)| (a, b, s, nb.image(k)));
+        let within = within.map(|(a, b, s, shift)| (a, b, s, (shift, DVec3::ZERO)));
+        for (a, b, springs, (shift, dv)) in within.chain(across) {
+            let (i, j, shift, dv) = if p.id[a] < p.id[b] {
+                (a, b, shift, dv)
             } else {
-                (b, a, -shift)
+                (b, a, -shift, -dv)
             };
             let bj = Body {
                 x: p.x[j] + shift,
+                v: p.v[j] + dv,
                 ..body(j)
             };
             let Some(kin) = Kinematics::between_particles(&body(i), &bj) else {
@@ -1264,14 +1275,28 @@ impl Simulation {
         }
     }
 
+    /// Lees-Edwards: the images across the gradient sides of a sheared domain to their
+    /// offset V t now (for the lists and the spawner).
+    fn slide_images(&mut self) {
+        let time = self.time;
+        if let Some(periodic) = &mut self.neighbours.periodic
+            && let Some(shear) = &mut periodic.shear
+        {
+            shear.offset = shear.velocity * time;
+        }
+        self.spawner.periodic = self.neighbours.periodic;
+    }
+
     /// Stage 2 (Section 3.3): rebuild the Verlet lists when they may miss a contact.
     #[inline(never)] // a stage of its own in profiles
     fn update_neighbours(&mut self) {
         let p = &self.particles;
-        if self
-            .neighbours
-            .stale(&p.x, &p.radius, &self.mesh.faces, self.mesh_drift)
-        {
+        if self.neighbours.stale(
+            &p.x,
+            &p.radius,
+            &self.mesh.faces,
+            self.mesh_drift.max(self.neighbours.shear_drift()),
+        ) {
             self.rebuild_lists(!self.moving.is_empty());
         }
     }
@@ -1474,6 +1499,8 @@ impl Simulation {
         let p = &self.particles;
         let law = &self.law;
         let nb = &mut self.neighbours;
+        let images: Vec<(DVec3, DVec3)> = (0..nb.shift.len()).map(|k| nb.image(k)).collect();
+        let image = |k: usize| images[k];
         let ContactList {
             start,
             partner,
@@ -1492,19 +1519,20 @@ impl Simulation {
             for a in pieces[piece] as usize..pieces[piece + 1] as usize {
                 for k in start[a] as usize..start[a + 1] as usize {
                     let b = partner[k] as usize;
-                    // Seen from the lower id: the other at its image.
-                    let (i, j, shift) = if p.id[a] < p.id[b] {
-                        (a, b, nb.shift[k])
+                    // Seen from the lower id: the other at its image (and its velocity).
+                    let (shift, dv) = image(k);
+                    let (i, j, shift, dv) = if p.id[a] < p.id[b] {
+                        (a, b, shift, dv)
                     } else {
-                        (b, a, -nb.shift[k])
+                        (b, a, -shift, -dv)
                     };
-                    let body = |k: usize, x: DVec3| Body {
+                    let body = |k: usize, x: DVec3, dv: DVec3| Body {
                         x,
                         radius: p.radius[k],
-                        v: p.v[k],
+                        v: p.v[k] + dv,
                         w: p.w[k],
                     };
-                    let (bi, bj) = (body(i, p.x[i]), body(j, p.x[j] + shift));
+                    let (bi, bj) = (body(i, p.x[i], DVec3::ZERO), body(j, p.x[j] + shift, dv));
                     let Some(kin) = Kinematics::between_particles(&bi, &bj) else {
                         if contact[k] != NONE {
                             store.close(contact[k]);

@@ -21,6 +21,9 @@ pub struct Spawner {
     pending_radius: Option<f64>,
     /// What each `[[spawn]]` region has done so far.
     regions: Vec<RegionState>,
+    /// The periodic axes of the domain, as they are now (its shear offset), to test
+    /// candidates against the images of particles across the sides.
+    pub periodic: Option<crate::neighbours::Periodic>,
 }
 
 /// How far a `[[spawn]]` region has got: particles inserted, and its pending radius.
@@ -135,6 +138,7 @@ impl Spawner {
             rng: ChaCha8Rng::seed_from_u64(seed),
             pending_radius: None,
             regions: Vec::new(),
+            periodic: None,
         }
     }
 
@@ -260,7 +264,7 @@ impl Spawner {
             max: source.region.max + DVec3::splat(h),
         };
         // In a periodic domain a sphere may touch the images of particles near the far side.
-        let periodic = s.periodicity();
+        let periodic = self.periodic;
         let wrap = |x: DVec3| periodic.map_or(x, |p| p.wrap(x));
         let mut shifts = Vec::new();
         let mut cells: FxHashMap<u64, Vec<u32>> = FxHashMap::default();
@@ -312,7 +316,7 @@ impl Spawner {
             let mut free = !overlaps(x);
             if free && let Some(p) = periodic {
                 p.image_shifts(wrap(x), h, &mut shifts);
-                free = shifts.iter().all(|&s| !overlaps(wrap(x) + s));
+                free = shifts.iter().all(|&(s, _)| !overlaps(wrap(x) + s));
             }
             free = free
                 && face_grid.at(x).iter().all(|&f| {

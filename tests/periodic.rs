@@ -204,3 +204,74 @@ fn spawned_grains_do_not_overlap_across_periodic_sides() {
         }
     }
 }
+
+/// Lees-Edwards boundaries across z sliding along x at V: a gas that starts without mean
+/// flow takes up the imposed profile v_x(z) = V (z - z_0) / L_z.
+#[test]
+fn lees_edwards_boundaries_impose_the_shear_profile() {
+    let v = 0.5;
+    let mut s = periodic(
+        gas(),
+        &format!(
+            "lees_edwards = {{ velocity = {v}, shear_axis = \"x\", gradient_axis = \"z\" }}\n"
+        ),
+    );
+    for _ in 0..30_000 {
+        s.step().unwrap();
+    }
+    // The profile, averaged over the last 10,000 steps in 5 layers.
+    let mut sum = [0.0; 5];
+    let mut count = [0usize; 5];
+    for step in 0..10_000 {
+        s.step().unwrap();
+        if step % 100 == 0 {
+            let p = s.particles_in_domain();
+            for (x, u) in p.x.iter().zip(&p.v) {
+                let k = (((x.z + 0.05) / 0.02) as usize).min(4);
+                sum[k] += u.x;
+                count[k] += 1;
+            }
+        }
+    }
+    let profile: Vec<f64> = (0..5).map(|k| sum[k] / count[k] as f64).collect();
+    // Least-squares slope against the layer centres.
+    let z: Vec<f64> = (0..5).map(|k| -0.04 + 0.02 * k as f64).collect();
+    let slope = z.iter().zip(&profile).map(|(z, u)| z * u).sum::<f64>()
+        / z.iter().map(|z| z * z).sum::<f64>();
+    assert!(
+        (slope / (v / 0.1) - 1.0).abs() < 0.15,
+        "slope {slope} 1/s, imposed {} 1/s; profile {profile:?}",
+        v / 0.1
+    );
+    assert_eq!(s.particles.len(), 512);
+}
+
+/// Across the sheared sides the image moves: a grain at rest near the top is struck by the
+/// image of a grain at rest near the bottom, which slides past at V.
+#[test]
+fn the_image_across_a_sheared_side_moves_with_the_shear_velocity() {
+    let v = 0.5;
+    let mut s = periodic(
+        vec![
+            grain(DVec3::new(0.0, 0.0, 0.047), DVec3::ZERO, DVec3::ZERO),
+            grain(DVec3::new(-0.012, 0.0, -0.047), DVec3::ZERO, DVec3::ZERO),
+        ],
+        &format!(
+            "lees_edwards = {{ velocity = {v}, shear_axis = \"x\", gradient_axis = \"z\" }}\n"
+        ),
+    );
+    for _ in 0..6000 {
+        s.step().unwrap();
+    }
+    let p: Vec<_> = s.particles.iter_by_id().map(|(_, q)| q).collect();
+    // The top grain is pushed along +x and down (the image of the other is above it, across
+    // the upper side), the bottom one along -x and up.
+    assert!(p[0].v.x > 0.1 * v && p[0].v.z < 0.0, "top grain {}", p[0].v);
+    assert!(
+        p[1].v.x < -0.1 * v && p[1].v.z > 0.0,
+        "bottom grain {}",
+        p[1].v
+    );
+    // In the frame of the collision momentum is kept: equal and opposite changes.
+    assert!((p[0].v + p[1].v).length() < 1e-9, "{} {}", p[0].v, p[1].v);
+}
