@@ -35,10 +35,24 @@ const OLDEST: u32 = 2;
 /// A fingerprint of everything a checkpoint's state depends on: the physics, time step,
 /// spawning and mesh. The number of frames and the output may change on resume.
 pub fn fingerprint(s: &Scenario, mesh: &Mesh) -> u64 {
+    // The material as checkpoints of format 2 wrote it (cohesion, when there is any, is
+    // added below), so that they resume.
+    let m = &s.material;
+    let material = format!(
+        "Material {{ density: {:?}, youngs_modulus: {:?}, poisson_ratio: {:?}, restitution: {:?}, friction_sliding: {:?}, friction_rolling: {:?}, friction_twisting: {:?}, viscosity: {:?} }}",
+        m.density,
+        m.youngs_modulus,
+        m.poisson_ratio,
+        m.restitution,
+        m.friction_sliding,
+        m.friction_rolling,
+        m.friction_twisting,
+        m.viscosity
+    );
     let text = format!(
-        "{:?}|{:?}|{:?}|{:?}|{}|{}|{}|{}|{:?}",
+        "{:?}|{}|{:?}|{:?}|{}|{}|{}|{}|{:?}",
         s.geometry.mesh_radii,
-        s.material,
+        material,
         s.kinetics,
         (
             s.geometry.radius_min,
@@ -52,6 +66,11 @@ pub fn fingerprint(s: &Scenario, mesh: &Mesh) -> u64 {
         s.simulation.spawn_attempts,
         (s.simulation.seed, &mesh.faces),
     );
+    let text = if m.cohesion != 0.0 {
+        format!("{text}|cohesion {:?}", m.cohesion)
+    } else {
+        text
+    };
     // Named materials (absent from older checkpoints, which stay valid without them).
     let text = if s.uses_materials() {
         format!(
@@ -460,6 +479,24 @@ mod tests {
             scenario: "[simulation]\nframes = 3\n".into(),
             mesh_files: vec![(0, 1), (12, 0xdead_beef)],
         }
+    }
+
+    /// The fingerprint of the default scenario in the checkpoints of the build of
+    /// 2026-12-02 (format 2, commit 40d4a3a).
+    const FORMAT_2_DEFAULT: u64 = 3511474096700281170;
+
+    #[test]
+    fn the_fingerprint_of_the_default_scenario_is_that_of_format_2() {
+        // As written by the build of 2026-12-02 (format 2), so its checkpoints resume.
+        let s = Scenario::default();
+        let mesh = crate::mesh::Mesh::parse_off(
+            crate::scenario::HOURGLASS_OFF,
+            "hourglass",
+            &s.geometry.mesh_radii,
+        )
+        .unwrap()
+        .with_contacts(s.geometry.mesh_contacts);
+        assert_eq!(fingerprint(&s, &mesh), FORMAT_2_DEFAULT);
     }
 
     #[test]

@@ -50,6 +50,8 @@ pub struct Coefficients<T: Lanes = f64> {
     pub mu_s: T,
     pub mu_r: T,
     pub mu_t: T,
+    /// k_c of the simplified JKR cohesion [J/m³].
+    pub cohesion: T,
 }
 
 impl Coefficients {
@@ -64,6 +66,7 @@ impl Coefficients {
             mu_s: T::splat(self.mu_s),
             mu_r: T::splat(self.mu_r),
             mu_t: T::splat(self.mu_t),
+            cohesion: T::splat(self.cohesion),
         }
     }
 
@@ -78,6 +81,7 @@ impl Coefficients {
             mu_s: T::gather(c.map(|c| c.mu_s)),
             mu_r: T::gather(c.map(|c| c.mu_r)),
             mu_t: T::gather(c.map(|c| c.mu_t)),
+            cohesion: T::gather(c.map(|c| c.cohesion)),
         }
     }
 }
@@ -92,6 +96,8 @@ pub struct ContactLaw {
     /// Particle-wall coefficients of particle material a and wall material w at
     /// `a * materials + w`.
     walls: Vec<Coefficients>,
+    /// Whether any pair is cohesive (otherwise the law skips the cohesion term).
+    cohesive: bool,
     dt: f64,
 }
 
@@ -239,12 +245,14 @@ impl ContactLaw {
             friction_sliding: material.friction_sliding,
             friction_rolling: material.friction_rolling,
             friction_twisting: material.friction_twisting,
+            cohesion: material.cohesion,
             given: false,
         };
         ContactLaw {
             materials: 1,
             pairs: vec![Self::particles(material, material, &pair)],
             walls: vec![Self::wall(material, &pair)],
+            cohesive: pair.cohesion > 0.0,
             dt,
         }
     }
@@ -257,6 +265,7 @@ impl ContactLaw {
             materials: n,
             pairs: Vec::with_capacity(n * n),
             walls: Vec::with_capacity(n * n),
+            cohesive: false,
             dt: s.simulation.timestep,
         };
         for a in 0..n {
@@ -264,6 +273,7 @@ impl ContactLaw {
                 let pair = s.pair(a as u16, b as u16);
                 law.pairs.push(Self::particles(m(a), m(b), &pair));
                 law.walls.push(Self::wall(m(a), &pair));
+                law.cohesive |= pair.cohesion > 0.0;
             }
         }
         law
@@ -296,6 +306,7 @@ impl ContactLaw {
             mu_s: pair.friction_sliding,
             mu_r: pair.friction_rolling,
             mu_t: pair.friction_twisting,
+            cohesion: pair.cohesion,
         }
     }
 
@@ -312,6 +323,7 @@ impl ContactLaw {
             mu_s: pair.friction_sliding,
             mu_r: pair.friction_rolling,
             mu_t: pair.friction_twisting,
+            cohesion: pair.cohesion,
         }
     }
 
@@ -422,8 +434,26 @@ impl ContactLaw {
         let f_t = coulomb_spring(&mut springs.u_t, v_t, k_s, c_s, coef.mu_t * f_n_norm, dt); // Eqs. (35), (40), (53)-(55)
         let tau_t = n * (f_t * r_star); // Eq. (33)
 
+        // Cohesion, the simplified JKR model: a pull k_c A along -n̂ over the area A = π a²
+        // of the contact circle (of the two spheres' lens, or of the sphere cut by the
+        // wall's plane). It adds to the force only: the Coulomb limits above rest on the
+        // repulsive load |f_n|, which at rest carries the outer load and the pull together.
+        let f = if self.cohesive {
+            let a2 = match other {
+                Other::Particle { r: radius_j, .. } => {
+                    let d = radius_i + radius_j - delta;
+                    let x = (d * d + radius_i * radius_i - radius_j * radius_j) / (c(2.0) * d);
+                    radius_i * radius_i - x * x
+                }
+                Other::Wall => delta * (c(2.0) * radius_i - delta),
+            };
+            f_n + f_s - n * (coef.cohesion * c(std::f64::consts::PI) * a2)
+        } else {
+            f_n + f_s
+        };
+
         ContactForce {
-            f: f_n + f_s,
+            f,
             tau_i: tau_s + tau_r + tau_t,
             // A wall takes no reaction torque; avoid ∞ · 0 there.
             tau_j: match other {
@@ -558,6 +588,7 @@ mod tests {
                 friction_rolling: 0.05,
                 friction_twisting: 0.02,
                 viscosity: 1e-5,
+                cohesion: 0.0,
             };
             ContactLaw::new(&material, 1e-5)
         }

@@ -557,7 +557,7 @@ pub fn describe(s: &Scenario) -> Result<String> {
         for (k, m) in s.materials.iter().enumerate() {
             let p = &m.properties;
             materials += &format!(
-                "{:<23}{k} \"{}\": density {}, E {:e}, nu {}, e_n {}, mu_s {}, mu_r {}, mu_t {}\n",
+                "{:<23}{k} \"{}\": density {}, E {:e}, nu {}, e_n {}, mu_s {}, mu_r {}, mu_t {}{}\n",
                 if k == 0 { "materials" } else { "" },
                 m.name,
                 num(p.density),
@@ -566,7 +566,12 @@ pub fn describe(s: &Scenario) -> Result<String> {
                 num(p.restitution),
                 num(p.friction_sliding),
                 num(p.friction_rolling),
-                num(p.friction_twisting)
+                num(p.friction_twisting),
+                if p.cohesion > 0.0 {
+                    format!(", cohesion {} J/m^3", num(p.cohesion))
+                } else {
+                    String::new()
+                }
             );
         }
         let n = s.materials.len() as u16;
@@ -585,6 +590,7 @@ pub fn describe(s: &Scenario) -> Result<String> {
                             ("mu_s", i.friction_sliding),
                             ("mu_r", i.friction_rolling),
                             ("mu_t", i.friction_twisting),
+                            ("k_c", i.cohesion),
                         ] {
                             if x.is_some() {
                                 given.push(name);
@@ -593,19 +599,20 @@ pub fn describe(s: &Scenario) -> Result<String> {
                     }
                     match given.len() {
                         0 => "means of the two".to_string(),
-                        4 => "[[interactions]]".to_string(),
+                        5 => "[[interactions]]".to_string(),
                         _ => format!("{} from [[interactions]], the rest means", given.join(", ")),
                     }
                 };
                 materials += &format!(
-                    "{:<23}{} - {}: e_n {}, mu_s {}, mu_r {}, mu_t {} ({how})\n",
+                    "{:<23}{} - {}: e_n {}, mu_s {}, mu_r {}, mu_t {}, k_c {} ({how})\n",
                     if first { "pairs" } else { "" },
                     s.materials[a as usize].name,
                     s.materials[b as usize].name,
                     num(c.restitution),
                     num(c.friction_sliding),
                     num(c.friction_rolling),
-                    num(c.friction_twisting)
+                    num(c.friction_twisting),
+                    num(c.cohesion)
                 );
                 first = false;
             }

@@ -5,7 +5,7 @@
 //! [geometry]   radius_min, radius_max, mesh, mesh_radii, mesh_contacts, spawn_min,
 //!              spawn_max
 //! [material]   density, youngs_modulus, poisson_ratio, restitution, friction_sliding,
-//!              friction_rolling, friction_twisting, viscosity
+//!              friction_rolling, friction_twisting, cohesion, viscosity
 //! [kinetics]   initial_velocity, initial_angular_velocity, gravity
 //! [simulation] timestep, max_particles, frames, steps_per_frame, spawn_attempts, seed
 //! [[meshes]]   file, radii, contacts, motion = { type = "harmonic", amplitude, frequency, direction,
@@ -84,6 +84,9 @@ pub struct Material {
     pub friction_twisting: f64,
     /// η [M/LT]
     pub viscosity: f64,
+    /// k_c [M/LT²] = [J/m³]: the simplified JKR cohesion, a pull k_c A over the contact
+    /// area A.
+    pub cohesion: f64,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -129,15 +132,17 @@ pub struct Interaction {
     pub friction_sliding: Option<f64>,
     pub friction_rolling: Option<f64>,
     pub friction_twisting: Option<f64>,
+    pub cohesion: Option<f64>,
 }
 
-/// The coefficients of the contact between two materials: e_n, μ_s, μ_r, μ_t.
+/// The coefficients of the contact between two materials: e_n, μ_s, μ_r, μ_t, k_c.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PairCoefficients {
     pub restitution: f64,
     pub friction_sliding: f64,
     pub friction_rolling: f64,
     pub friction_twisting: f64,
+    pub cohesion: f64,
     /// Whether `[[interactions]]` set any of them (otherwise the means).
     pub given: bool,
 }
@@ -497,6 +502,7 @@ struct RawGeometry {
 #[derive(Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 struct RawMaterial {
+    cohesion: Option<f64>,
     density: Option<f64>,
     youngs_modulus: Option<f64>,
     poisson_ratio: Option<f64>,
@@ -517,6 +523,7 @@ impl RawMaterial {
             || self.friction_sliding.is_some()
             || self.friction_rolling.is_some()
             || self.friction_twisting.is_some()
+            || self.cohesion.is_some()
     }
 }
 
@@ -524,6 +531,7 @@ impl RawMaterial {
 #[serde(deny_unknown_fields)]
 struct RawNamedMaterial {
     name: String,
+    cohesion: Option<f64>,
     density: Option<f64>,
     youngs_modulus: Option<f64>,
     poisson_ratio: Option<f64>,
@@ -544,6 +552,7 @@ impl From<RawNamedMaterial> for RawMaterial {
             friction_rolling: m.friction_rolling,
             friction_twisting: m.friction_twisting,
             viscosity: None,
+            cohesion: m.cohesion,
         }
     }
 }
@@ -552,6 +561,7 @@ impl From<RawNamedMaterial> for RawMaterial {
 #[serde(deny_unknown_fields)]
 struct RawInteraction {
     materials: [String; 2],
+    cohesion: Option<f64>,
     restitution: Option<f64>,
     friction_sliding: Option<f64>,
     friction_rolling: Option<f64>,
@@ -847,6 +857,11 @@ fn material(key: &str, m: RawMaterial, viscosity: f64) -> Result<Material> {
             Range::NonNegative,
         )?,
         viscosity,
+        cohesion: check(
+            &key("cohesion"),
+            m.cohesion.unwrap_or(0.0),
+            Range::NonNegative,
+        )?,
     })
 }
 
@@ -1084,6 +1099,7 @@ impl Scenario {
                     i.friction_twisting,
                     Range::NonNegative,
                 )?,
+                cohesion: opt("cohesion", i.cohesion, Range::NonNegative)?,
             });
         }
         let material = materials[0].properties.clone();
@@ -1364,6 +1380,7 @@ impl Scenario {
                 ("friction_sliding", m.friction_sliding),
                 ("friction_rolling", m.friction_rolling),
                 ("friction_twisting", m.friction_twisting),
+                ("cohesion", m.cohesion),
             ] {
                 let _ = writeln!(o, "{key} = {}", f(x));
             }
@@ -1386,6 +1403,7 @@ impl Scenario {
                     ("friction_sliding", i.friction_sliding),
                     ("friction_rolling", i.friction_rolling),
                     ("friction_twisting", i.friction_twisting),
+                    ("cohesion", i.cohesion),
                 ] {
                     if let Some(x) = x {
                         let _ = writeln!(o, "{key} = {}", f(x));
@@ -1614,6 +1632,7 @@ impl Scenario {
                 m.friction_twisting,
                 n.friction_twisting,
             ),
+            cohesion: pick(given.and_then(|i| i.cohesion), m.cohesion, n.cohesion),
             given: given.is_some(),
         }
     }

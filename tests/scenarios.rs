@@ -98,6 +98,10 @@ fn materials_scenario_sets_meshes_and_particles_materials() {
     assert_eq!(s.materials[1].properties.viscosity, 1e-5);
     let c = s.pair(0, 1);
     assert_eq!((c.friction_sliding, c.restitution), (0.2, 0.7));
+    assert_eq!(
+        (c.cohesion, s.pair(0, 0).cohesion, s.pair(1, 1).cohesion),
+        (50.0, 200.0, 0.0)
+    );
     let sim = Simulation::new(s).unwrap();
     assert_eq!(sim.particles.material, vec![1, 1]);
 }
