@@ -399,6 +399,12 @@ fn bench(sizes: &[usize], workers: &[usize], steps: Option<u64>, repeats: usize)
     Ok(())
 }
 
+/// The `run.toml` an output directory holds, if any: the scenario of the run that wrote it.
+fn run_toml(dir: &std::path::Path) -> Option<PathBuf> {
+    let p = dir.join(tinydem::run::RUN_TOML);
+    p.is_file().then_some(p)
+}
+
 /// `tinydem render`: one frame, or every frame of a directory.
 fn render_command(
     path: &std::path::Path,
@@ -408,6 +414,13 @@ fn render_command(
     style: &Style,
     gif: bool,
 ) -> Result<()> {
+    let scenario = scenario.or_else(|| {
+        if path.is_dir() {
+            run_toml(path)
+        } else {
+            path.parent().and_then(run_toml)
+        }
+    });
     let mut sim = match &scenario {
         Some(s) => {
             let s = Scenario::load(s)?;
@@ -501,7 +514,7 @@ fn analyze_command(
     plot: Option<(PathBuf, String)>,
 ) -> Result<()> {
     use tinydem::analyze::*;
-    let s = match scenario {
+    let s = match scenario.or_else(|| run_toml(dir)) {
         Some(p) => Scenario::load(&p)?,
         None => Scenario::parse("", std::path::Path::new("defaults"))?,
     };

@@ -26,6 +26,10 @@ pub const UNSTABLE: &str = "unstable.csv";
 pub const OUTLETS: &str = "outlets.csv";
 /// Name of the log of the loads on each mesh file (`frame,time,mesh,fx,fy,fz,tx,ty,tz`).
 pub const WALLS: &str = "walls.csv";
+/// Name of the list of frames written (`frame,step,time`).
+pub const FRAMES: &str = "frames.csv";
+/// Name of the resolved scenario of the run in its output directory.
+pub const RUN_TOML: &str = "run.toml";
 
 /// How much to tell the user while running.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -82,11 +86,14 @@ impl std::fmt::Display for Interrupted {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "interrupted after step {} (t = {:.6e} s); checkpoint written to {}: continue with --resume {}",
+            "interrupted after step {} (t = {:.6e} s); checkpoint written to {}: continue with --resume {} --output {}",
             self.step,
             self.time,
             self.checkpoint.display(),
-            self.checkpoint.display()
+            self.checkpoint.display(),
+            self.checkpoint
+                .parent()
+                .map_or_else(|| ".".into(), |d| d.display().to_string())
         )
     }
 }
@@ -234,7 +241,10 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
             )
         })
         .transpose()?;
+    let mut frame_log = Log::open(output_dir, FRAMES, "frame,step,time", resumed_at)?;
+    write_run_toml(output_dir, &sim.scenario)?;
     let mut log = |sim: &mut Simulation, frame: u64| -> Result<()> {
+        frame_log.row(&[&frame, &sim.steps, &sim.time])?;
         if let Some(log) = &mut outlets {
             for (k, o) in sim.removed.outlets.iter().enumerate() {
                 log.row(&[&frame, &sim.time, &k, &o.count, &o.mass])?;
@@ -384,6 +394,25 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
         advice: sim.advice(),
         removed: sim.removed.clone(),
     })
+}
+
+/// Writes `run.toml`: the resolved scenario of the run (every default filled in, paths
+/// absolute), with the program version and command line, so that the output directory says
+/// what made it and `analyze` and `render` need no `--scenario`.
+fn write_run_toml(dir: &Path, s: &Scenario) -> Result<()> {
+    let command: Vec<String> = std::env::args().collect();
+    let text = format!(
+        "# The resolved scenario of the run whose output is in this directory: every default\n\
+         # filled in, paths absolute. Written by tinydem {}.\n# command: {}\n{}",
+        env!("CARGO_PKG_VERSION"),
+        command.join(" "),
+        s.absolute().to_toml()
+    );
+    let path = dir.join(RUN_TOML);
+    let tmp = dir.join(format!(".{RUN_TOML}.tmp"));
+    std::fs::write(&tmp, text)
+        .and_then(|()| std::fs::rename(&tmp, &path))
+        .with_context(|| format!("cannot write {}", path.display()))
 }
 
 /// A CSV log in the output directory with a row per frame (or several).

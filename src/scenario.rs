@@ -1637,6 +1637,22 @@ impl Scenario {
         }
     }
 
+    /// The scenario with every file path absolute (for `run.toml`, which must resolve
+    /// wherever it is read from).
+    pub fn absolute(&self) -> Scenario {
+        let abs = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+        let mut s = self.clone();
+        if let MeshSource::File(p) = &s.geometry.mesh {
+            s.geometry.mesh = MeshSource::File(abs(p));
+        }
+        for m in &mut s.meshes {
+            m.file = abs(&m.file);
+        }
+        s.particles = s.particles.as_deref().map(abs);
+        s.output_dir = abs(&s.output_dir);
+        s
+    }
+
     /// Whether particles can be removed during the run (a domain with a side that is not
     /// periodic, or outlets).
     pub fn removes(&self) -> bool {

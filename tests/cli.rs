@@ -7,6 +7,8 @@ use common::tinydem;
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
+use tinydem::scenario::Scenario;
+
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
@@ -481,4 +483,37 @@ fn a_run_reports_where_its_time_went() {
     let o = tinydem(&["run", "s.toml", "-q", "--output", "out2"], dir.path());
     assert!(o.status.success());
     assert!(stderr(&o).is_empty(), "{}", stderr(&o));
+}
+
+/// An output directory describes itself: `run.toml` is the resolved scenario (it loads back
+/// to the same one, from anywhere), `frames.csv` lists frame, step and time, and `analyze`
+/// finds the frame times and the density without `--scenario`.
+#[test]
+fn output_directories_describe_their_run() {
+    let t = tempfile::tempdir().unwrap();
+    let s = write(
+        t.path(),
+        "s.toml",
+        "[geometry]\nspawn_min = [0, 0, 0]\nspawn_max = [0.1, 0.1, 0.1]\n\
+         [material]\ndensity = 2000.0\n\
+         [simulation]\ntimestep = 2e-5\nmax_particles = 30\nframes = 3\nsteps_per_frame = 40\n",
+    );
+    let o = tinydem(&["run", "s.toml", "-q"], t.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = t.path().join("output");
+    let again = Scenario::load(&out.join("run.toml")).unwrap();
+    assert_eq!(again, Scenario::load(&s).unwrap().absolute());
+    let frames = std::fs::read_to_string(out.join("frames.csv")).unwrap();
+    let lines: Vec<&str> = frames.lines().collect();
+    assert_eq!(lines[0], "frame,step,time");
+    assert_eq!(lines.len(), 5, "{frames}");
+    assert!(lines[2].starts_with("1,40,0.0008"), "{frames}");
+    let a = tinydem(&["analyze", "output"], t.path());
+    assert!(a.status.success(), "{}", stderr(&a));
+    let table = String::from_utf8_lossy(&a.stdout).to_string();
+    let row = table.lines().nth(2).unwrap();
+    assert!(
+        row.contains("8.000000e-4"),
+        "frame 1 at t = 40 x 2e-5 s: {table}"
+    );
 }

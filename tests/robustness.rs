@@ -314,6 +314,14 @@ fn killed_run_leaves_only_complete_files() {
         if name.starts_with('.') {
             continue; // a temporary file, never read and removed by the next run
         }
+        if name == "run.toml" {
+            // Written whole (atomically) before the first frame.
+            tinydem::scenario::Scenario::load(&e.path()).unwrap();
+            continue;
+        }
+        if !name.starts_with("particles") {
+            continue; // logs: a line at a time, a torn last line is dropped on resume
+        }
         let p =
             load_particles(&e.path()).unwrap_or_else(|err| panic!("{name} incomplete: {err:#}"));
         let text = std::fs::read_to_string(e.path()).unwrap();
