@@ -26,6 +26,9 @@ struct Cli {
     /// Continue the interrupted default run from its checkpoint.
     #[arg(long)]
     resume: Option<PathBuf>,
+    /// Replace the output of an earlier default run in ./output.
+    #[arg(long)]
+    overwrite: bool,
 }
 
 #[derive(Subcommand)]
@@ -47,6 +50,10 @@ enum Command {
         /// and contact history; the rest from SCENARIO, whose clock starts at 0).
         #[arg(long)]
         from: Option<PathBuf>,
+        /// Replace the output of an earlier run in the output directory (its frames, logs
+        /// and checkpoint; other files stay).
+        #[arg(long)]
+        overwrite: bool,
     },
     /// Validate a scenario and print derived quantities.
     Check {
@@ -180,10 +187,14 @@ fn real_main(cli: Cli) -> Result<()> {
     // The time loop runs on a worker of the pool, so that small parallel loops run inline
     // instead of waking another thread for every stage.
     let pool = pool.build().context("cannot start the thread pool")?;
-    pool.install(|| execute(cli.command, cli.resume))
+    pool.install(|| execute(cli.command, cli.resume, cli.overwrite))
 }
 
-fn execute(command: Option<Command>, resume_default: Option<PathBuf>) -> Result<()> {
+fn execute(
+    command: Option<Command>,
+    resume_default: Option<PathBuf>,
+    overwrite_default: bool,
+) -> Result<()> {
     match command {
         None => {
             let s = Scenario::default();
@@ -193,6 +204,7 @@ fn execute(command: Option<Command>, resume_default: Option<PathBuf>) -> Result<
                 verbosity: Verbosity::Normal,
                 resume: resume_default.as_deref(),
                 from: None,
+                overwrite: overwrite_default,
                 stop: Some(&STOP),
             };
             let summary = run(s, &out, options)?;
@@ -204,6 +216,7 @@ fn execute(command: Option<Command>, resume_default: Option<PathBuf>) -> Result<
             quiet,
             resume,
             from,
+            overwrite,
         }) => {
             let s = Scenario::load(&scenario)?;
             let out = output.unwrap_or_else(|| s.output_dir.clone());
@@ -217,6 +230,7 @@ fn execute(command: Option<Command>, resume_default: Option<PathBuf>) -> Result<
                 verbosity,
                 resume: resume.as_deref(),
                 from: from.as_deref(),
+                overwrite,
                 stop: Some(&STOP),
             };
             let summary = run(s, &out, options)?;

@@ -47,6 +47,9 @@ pub struct Options<'a> {
     pub resume: Option<&'a Path>,
     /// Start from the particles and contacts of this checkpoint of another run (a stage).
     pub from: Option<&'a Path>,
+    /// Clear the output of an earlier run from the directory first (otherwise such a
+    /// directory is refused, unless resuming).
+    pub overwrite: bool,
     /// Set (by a signal handler) to stop after the current step with a checkpoint.
     pub stop: Option<&'a AtomicBool>,
 }
@@ -176,9 +179,116 @@ fn prepare_output(dir: &Path) -> Result<()> {
     Ok(())
 }
 
+/// The name of the lock file a running run keeps in its output directory.
+pub const LOCK: &str = ".tinydem.lock";
+
+/// A run's claim on its output directory: a lock file with its process id, removed when
+/// the run ends (a lock whose process is gone, after a kill, is taken over).
+struct Lock(PathBuf);
+
+impl Lock {
+    fn take(dir: &Path) -> Result<Lock> {
+        let path = dir.join(LOCK);
+        for _ in 0..2 {
+            match std::fs::OpenOptions::new()
+                .write(true)
+                .create_new(true)
+                .open(&path)
+            {
+                Ok(mut f) => {
+                    use std::io::Write;
+                    let _ = writeln!(f, "{}", std::process::id());
+                    return Ok(Lock(path));
+                }
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                    let pid = std::fs::read_to_string(&path).unwrap_or_default();
+                    let pid = pid.trim();
+                    let alive = !pid.is_empty() && Path::new("/proc").join(pid).exists();
+                    if alive && pid != std::process::id().to_string() {
+                        anyhow::bail!(
+                            "another tinydem run (process {pid}) is writing into {}: wait for it, or choose another directory with --output",
+                            dir.display()
+                        );
+                    }
+                    let _ = std::fs::remove_file(&path); // left by a run that was killed
+                }
+                Err(e) => {
+                    return Err(e).with_context(|| format!("cannot create {}", path.display()));
+                }
+            }
+        }
+        anyhow::bail!("cannot take the lock {}", path.display())
+    }
+}
+
+impl Drop for Lock {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.0);
+    }
+}
+
+/// Whether a file name is output a run writes (frames, logs, checkpoints, its scenario).
+fn is_run_output(name: &str) -> bool {
+    let frame = |prefix: &str| {
+        name.strip_prefix(prefix).is_some_and(|rest| {
+            let digits = rest.split('.').next().unwrap_or("");
+            !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit())
+        })
+    };
+    frame("particles")
+        || frame("contacts")
+        || frame("mesh")
+        || [
+            RUN_TOML,
+            FRAMES,
+            OUTLETS,
+            WALLS,
+            CHECKPOINT,
+            INTERRUPTED,
+            UNSTABLE,
+            "mesh.vtu",
+            "particles.pvd",
+            "mesh.pvd",
+            "contacts.pvd",
+        ]
+        .contains(&name)
+}
+
+/// Refuses a directory holding the output of an earlier run (frames would mix), unless
+/// `overwrite`, which removes that output first (and nothing else).
+fn claim_output(dir: &Path, overwrite: bool) -> Result<()> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Ok(());
+    };
+    let old: Vec<PathBuf> = entries
+        .flatten()
+        .filter(|e| is_run_output(&e.file_name().to_string_lossy()))
+        .map(|e| e.path())
+        .collect();
+    if old.is_empty() {
+        return Ok(());
+    }
+    if !overwrite {
+        anyhow::bail!(
+            "{} holds the output of an earlier run ({} files, e.g. {}): pass --overwrite to replace it, --resume to continue it, or --output another directory",
+            dir.display(),
+            old.len(),
+            old[0].file_name().unwrap_or_default().to_string_lossy()
+        );
+    }
+    for p in old {
+        std::fs::remove_file(&p).with_context(|| format!("cannot remove {}", p.display()))?;
+    }
+    Ok(())
+}
+
 /// Runs `scenario`, writing frames 0..=N_frames into `output_dir`.
 pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Summary> {
     prepare_output(output_dir)?;
+    let _lock = Lock::take(output_dir)?;
+    if options.resume.is_none() {
+        claim_output(output_dir, options.overwrite)?;
+    }
     let frames = scenario.simulation.frames;
     let steps_per_frame = scenario.simulation.steps_per_frame;
     let checkpoint_every = scenario.checkpoint_every;

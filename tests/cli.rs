@@ -517,3 +517,48 @@ fn output_directories_describe_their_run() {
         "frame 1 at t = 40 x 2e-5 s: {table}"
     );
 }
+
+/// A directory with the output of an earlier run is refused (frames of two runs would mix)
+/// unless `--overwrite`, which removes that output first; a second run into a directory that
+/// a live run holds is refused, a lock left by a killed run is taken over.
+#[test]
+fn output_of_another_run_is_not_mixed_in() {
+    let t = tempfile::tempdir().unwrap();
+    let scenario = |frames: u32| {
+        format!(
+            "[geometry]\nspawn_min = [0, 0, 0]\nspawn_max = [0.1, 0.1, 0.1]\n\
+             [simulation]\nmax_particles = 20\nframes = {frames}\nsteps_per_frame = 20\n"
+        )
+    };
+    write(t.path(), "long.toml", &scenario(3));
+    write(t.path(), "short.toml", &scenario(1));
+    let o = tinydem(&["run", "long.toml", "-q"], t.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = tinydem(&["run", "short.toml", "-q"], t.path());
+    fails_with(&o, &["holds the output of an earlier run", "--overwrite"]);
+    std::fs::write(t.path().join("output/notes.txt"), "mine").unwrap();
+    let o = tinydem(&["run", "short.toml", "-q", "--overwrite"], t.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = t.path().join("output");
+    assert!(out.join("particles000001.csv").exists());
+    assert!(
+        !out.join("particles000003.csv").exists(),
+        "frames of the first run are gone"
+    );
+    assert!(out.join("notes.txt").exists(), "other files stay");
+    assert!(
+        !out.join(".tinydem.lock").exists(),
+        "the lock goes with the run"
+    );
+    // A live process holds the directory (this test's own), then a dead one.
+    std::fs::write(
+        out.join(".tinydem.lock"),
+        format!("{}\n", std::process::id()),
+    )
+    .unwrap();
+    let o = tinydem(&["run", "short.toml", "-q", "--overwrite"], t.path());
+    fails_with(&o, &["another tinydem run", "is writing into"]);
+    std::fs::write(out.join(".tinydem.lock"), "999999999\n").unwrap();
+    let o = tinydem(&["run", "short.toml", "-q", "--overwrite"], t.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+}

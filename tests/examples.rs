@@ -41,6 +41,7 @@ fn every_example_runs_a_few_frames() {
                 verbosity: Verbosity::Quiet,
                 resume: None,
                 from: from.as_deref(),
+                overwrite: false,
                 stop: None,
             };
             let summary =
