@@ -431,8 +431,13 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
     while sim.steps < total_steps {
         if let Err(unstable) = sim.step() {
             let last = sim.steps.saturating_sub(1) / steps_per_frame.max(1);
-            let written =
-                crate::csv::write_frame_as(output_dir, UNSTABLE, &sim.particles, out.extra).is_ok();
+            let written = crate::csv::write_frame_as(
+                output_dir,
+                UNSTABLE,
+                &sim.particles_in_domain(),
+                out.extra,
+            )
+            .is_ok();
             anyhow::bail!(
                 "{unstable}.\nThe last complete frame is {}{}.",
                 output_dir.join(frame_name(last)).display(),
@@ -454,11 +459,7 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
             frames_written += 1;
             status(&mut sim, frame);
             if checkpoint_every > 0 && frame.is_multiple_of(checkpoint_every) {
-                checkpoint::save(
-                    &output_dir.join(CHECKPOINT),
-                    &sim.snapshot(),
-                    fingerprint(&sim),
-                )?;
+                save_checkpoint(output_dir, &sim)?;
             }
             output_seconds += t.elapsed().as_secs_f64();
         }
@@ -466,9 +467,9 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
             bar.set_position(sim.steps);
         }
         if options.stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
-            let path = output_dir.join(CHECKPOINT);
-            checkpoint::save(&path, &sim.snapshot(), fingerprint(&sim))?;
-            crate::csv::write_frame_as(output_dir, INTERRUPTED, &sim.particles, out.extra)?;
+            let path = save_checkpoint(output_dir, &sim)?;
+            let particles = sim.particles_in_domain();
+            crate::csv::write_frame_as(output_dir, INTERRUPTED, &particles, out.extra)?;
             if let Some(bar) = &bar {
                 bar.abandon();
             }
@@ -485,11 +486,7 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
     }
     // Every run ends with a checkpoint, so that it can be extended or staged.
     let t = Instant::now();
-    checkpoint::save(
-        &output_dir.join(CHECKPOINT),
-        &sim.snapshot(),
-        fingerprint(&sim),
-    )?;
+    save_checkpoint(output_dir, &sim)?;
     output_seconds += t.elapsed().as_secs_f64();
     let _ = std::fs::remove_file(output_dir.join(INTERRUPTED));
     Ok(Summary {
@@ -603,6 +600,13 @@ macro_rules! whole_log_values {
     )*};
 }
 whole_log_values!(u64, usize, i32);
+
+/// Writes the checkpoint of `sim` into `dir`, returning its path.
+fn save_checkpoint(dir: &Path, sim: &Simulation) -> Result<PathBuf> {
+    let path = dir.join(CHECKPOINT);
+    checkpoint::save(&path, &sim.snapshot(), fingerprint(sim))?;
+    Ok(path)
+}
 
 /// The fingerprint of a simulation's scenario and mesh, for checkpoints.
 fn fingerprint(sim: &Simulation) -> u64 {
