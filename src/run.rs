@@ -725,21 +725,17 @@ pub fn describe(s: &Scenario) -> Result<String> {
                 let how = if a == b {
                     "its own".to_string()
                 } else {
-                    let i = s.interactions.iter().find(|i| i.materials == (a, b));
-                    let mut given = Vec::new();
-                    if let Some(i) = i {
-                        for (name, x) in [
-                            ("e_n", i.restitution),
-                            ("mu_s", i.friction_sliding),
-                            ("mu_r", i.friction_rolling),
-                            ("mu_t", i.friction_twisting),
-                            ("k_c", i.cohesion),
-                        ] {
-                            if x.is_some() {
-                                given.push(name);
-                            }
-                        }
-                    }
+                    let given: Vec<&str> = s
+                        .interactions
+                        .iter()
+                        .find(|i| i.materials == (a, b))
+                        .map_or_else(Vec::new, |i| {
+                            i.coefficients()
+                                .iter()
+                                .filter(|c| c.2.is_some())
+                                .map(|c| c.1)
+                                .collect()
+                        });
                     match given.len() {
                         0 => "means of the two".to_string(),
                         5 => "[[interactions]]".to_string(),

@@ -135,6 +135,19 @@ pub struct Interaction {
     pub cohesion: Option<f64>,
 }
 
+impl Interaction {
+    /// Each coefficient with its key and symbol (given or not), in the order of the file.
+    pub fn coefficients(&self) -> [(&'static str, &'static str, Option<f64>); 5] {
+        [
+            ("restitution", "e_n", self.restitution),
+            ("friction_sliding", "mu_s", self.friction_sliding),
+            ("friction_rolling", "mu_r", self.friction_rolling),
+            ("friction_twisting", "mu_t", self.friction_twisting),
+            ("cohesion", "k_c", self.cohesion),
+        ]
+    }
+}
+
 /// The coefficients of the contact between two materials: e_n, μ_s, μ_r, μ_t, k_c.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PairCoefficients {
@@ -1398,13 +1411,7 @@ impl Scenario {
                     name(i.materials.0),
                     name(i.materials.1)
                 );
-                for (key, x) in [
-                    ("restitution", i.restitution),
-                    ("friction_sliding", i.friction_sliding),
-                    ("friction_rolling", i.friction_rolling),
-                    ("friction_twisting", i.friction_twisting),
-                    ("cohesion", i.cohesion),
-                ] {
+                for (key, _, x) in i.coefficients() {
                     if let Some(x) = x {
                         let _ = writeln!(o, "{key} = {}", f(x));
                     }

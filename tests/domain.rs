@@ -125,8 +125,8 @@ const BOX: &str = "OFF\n8 6 0\n\
     -0.03 -0.03 0.1\n0.03 -0.03 0.1\n0.03 0.03 0.1\n-0.03 0.03 0.1\n\
     3 0 1 2\n3 0 2 3\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n";
 
-#[test]
-fn the_load_on_the_walls_of_a_settled_bed_is_its_weight() {
+/// 150 grains poured into the open box, after `steps` steps (summing the wall loads).
+fn settled_bed(steps: u32) -> Simulation {
     let s = common::scenario(
         "[geometry]\nradius_min = 0.003\nradius_max = 0.004\nmesh_radii = [0.0]\n\
          spawn_min = [-0.025, -0.025, 0.01]\nspawn_max = [0.025, 0.025, 0.09]\n\
@@ -137,9 +137,15 @@ fn the_load_on_the_walls_of_a_settled_bed_is_its_weight() {
     );
     let mesh = Mesh::parse_off(BOX, "box", &s.geometry.mesh_radii).unwrap();
     let mut sim = Simulation::from_parts(s, mesh, Particles::default()).unwrap();
-    for _ in 0..12_000 {
+    for _ in 0..steps {
         sim.step().unwrap();
     }
+    sim
+}
+
+#[test]
+fn the_load_on_the_walls_of_a_settled_bed_is_its_weight() {
+    let mut sim = settled_bed(12_000);
     sim.take_wall_loads();
     let n = 2000;
     for _ in 0..n {
@@ -295,18 +301,7 @@ fn a_run_logs_outlets_and_wall_loads_and_resumes_them() {
 #[test]
 fn the_contact_network_of_a_settled_bed_balances_every_grain() {
     use tinydem::simulation::Partner;
-    let s = common::scenario(
-        "[geometry]\nradius_min = 0.003\nradius_max = 0.004\nmesh_radii = [0.0]\n\
-         spawn_min = [-0.025, -0.025, 0.01]\nspawn_max = [0.025, 0.025, 0.09]\n\
-         [material]\nrestitution = 0.2\n\
-         [kinetics]\ninitial_velocity = [0.0, 0.0, 0.0]\n\
-         [simulation]\nmax_particles = 150\n",
-    );
-    let mesh = Mesh::parse_off(BOX, "box", &s.geometry.mesh_radii).unwrap();
-    let mut sim = Simulation::from_parts(s, mesh, Particles::default()).unwrap();
-    for _ in 0..14_000 {
-        sim.step().unwrap();
-    }
+    let sim = settled_bed(14_000);
     let network = sim.contact_network();
     let p = &sim.particles;
     let at = |id: u32| p.id.iter().position(|&k| k == id).unwrap();
