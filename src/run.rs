@@ -14,7 +14,7 @@ use crate::csv::{Extra, frame_name, write_frame};
 use crate::integrate::Inertia;
 use crate::mesh::Contacts;
 use crate::scenario::{Formats, Scenario};
-use crate::simulation::{Simulation, StageTimes};
+use crate::simulation::{Simulation, StageTimes, Thermo};
 
 /// Name of the checkpoint file in the output directory.
 pub const CHECKPOINT: &str = "checkpoint.bin";
@@ -28,6 +28,11 @@ pub const OUTLETS: &str = "outlets.csv";
 pub const WALLS: &str = "walls.csv";
 /// Name of the list of frames written (`frame,step,time`).
 pub const FRAMES: &str = "frames.csv";
+/// Name of the log of the state at each frame (the columns of [`LOG_HEADER`]).
+pub const LOG: &str = "log.csv";
+/// The columns of `log.csv`: what the status line shows, as LAMMPS's thermo output.
+pub const LOG_HEADER: &str = "frame,step,time,particles,kinetic_energy,rotational_energy,\
+contacts_per_particle,pair_contacts,wall_contacts,max_overlap,removed";
 /// Name of the resolved scenario of the run in its output directory.
 pub const RUN_TOML: &str = "run.toml";
 
@@ -241,6 +246,7 @@ fn is_run_output(name: &str) -> bool {
         || [
             RUN_TOML,
             FRAMES,
+            LOG,
             OUTLETS,
             WALLS,
             CHECKPOINT,
@@ -352,9 +358,24 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
         })
         .transpose()?;
     let mut frame_log = Log::open(output_dir, FRAMES, "frame,step,time", resumed_at)?;
+    let mut thermo_log = Log::open(output_dir, LOG, LOG_HEADER, resumed_at)?;
     write_run_toml(output_dir, &sim.scenario)?;
-    let mut log = |sim: &mut Simulation, frame: u64| -> Result<()> {
+    let mut log = |sim: &mut Simulation, frame: u64| -> Result<Thermo> {
         frame_log.row(&[&frame, &sim.steps, &sim.time])?;
+        let th = sim.thermo();
+        thermo_log.row(&[
+            &frame,
+            &sim.steps,
+            &sim.time,
+            &th.particles,
+            &th.kinetic_energy,
+            &th.rotational_energy,
+            &th.contacts_per_particle(),
+            &th.pair_contacts,
+            &th.wall_contacts,
+            &th.max_overlap,
+            &th.removed,
+        ])?;
         if let Some(log) = &mut outlets {
             for (k, o) in sim.removed.outlets.iter().enumerate() {
                 log.row(&[&frame, &sim.time, &k, &o.count, &o.mass])?;
@@ -368,12 +389,13 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
                 log.row(&[&frame, &sim.time, &k, &f.x, &f.y, &f.z, &t.x, &t.y, &t.z])?;
             }
         }
-        Ok(())
+        Ok(th)
     };
+    let mut first = None;
     if options.resume.is_none() {
         out.write(0, &sim)?;
         frames_written += 1;
-        log(&mut sim, 0)?;
+        first = Some(log(&mut sim, 0)?);
     }
 
     let total_steps = frames * steps_per_frame;
@@ -390,11 +412,11 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
             bar
         });
     let mut warned = 0;
-    let mut status = |sim: &mut Simulation, frame: u64| {
+    let mut status = |sim: &mut Simulation, frame: u64, th: &Thermo| {
         let fresh = sim.take_new_warnings();
         if options.verbosity == Verbosity::Normal {
             let mut lines = Vec::new();
-            let removed = match sim.removed.count() {
+            let removed = match th.removed {
                 0 => String::new(),
                 n => format!("  removed {n}"),
             };
@@ -412,9 +434,12 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
                 n => format!("  deep overlaps {n}"),
             };
             lines.push(format!(
-                "frame {frame:>6}  t = {:.6e} s  particles {}{removed}{deep}",
+                "frame {frame:>6}  t = {:.6e} s  particles {}  E_k {:.4e} J  contacts/particle {:.2}  overlap/R {:.2e}{removed}{deep}",
                 sim.time,
-                sim.particles.len()
+                th.particles,
+                th.kinetic_energy,
+                th.contacts_per_particle(),
+                th.max_overlap,
             ));
             for line in lines {
                 match &bar {
@@ -424,8 +449,8 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
             }
         }
     };
-    if options.resume.is_none() {
-        status(&mut sim, 0);
+    if let Some(th) = first {
+        status(&mut sim, 0, &th);
     }
 
     while sim.steps < total_steps {
@@ -455,9 +480,9 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
             let t = Instant::now();
             let frame = sim.steps / steps_per_frame;
             out.write(frame, &sim)?;
-            log(&mut sim, frame)?;
+            let th = log(&mut sim, frame)?;
             frames_written += 1;
-            status(&mut sim, frame);
+            status(&mut sim, frame, &th);
             if checkpoint_every > 0 && frame.is_multiple_of(checkpoint_every) {
                 save_checkpoint(output_dir, &sim)?;
             }

@@ -405,6 +405,32 @@ pub struct ContactRecord {
     pub overlap: f64,
 }
 
+/// The state in numbers (`Simulation::thermo`), for the status line and `log.csv`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Thermo {
+    pub particles: usize,
+    /// Kinetic energy, translational and rotational [J], and its rotational part.
+    pub kinetic_energy: f64,
+    pub rotational_energy: f64,
+    /// Touching particle pairs and particle-face contacts in the last step.
+    pub pair_contacts: usize,
+    pub wall_contacts: usize,
+    /// The deepest overlap relative to the smaller radius (the particle's, against a face).
+    pub max_overlap: f64,
+    /// Particles removed so far by the outlets and the domain bounds.
+    pub removed: u64,
+}
+
+impl Thermo {
+    /// Contacts per particle: each pair counts for both, each face contact for its particle.
+    pub fn contacts_per_particle(&self) -> f64 {
+        match self.particles {
+            0 => 0.0,
+            n => (2 * self.pair_contacts + self.wall_contacts) as f64 / n as f64,
+        }
+    }
+}
+
 /// `face_part` of a face that does not move.
 const STATIC: u32 = u32::MAX;
 
@@ -1086,6 +1112,55 @@ impl Simulation {
             Partner::Face(f) => (1, r.id, f),
         });
         out
+    }
+
+    /// What the status line and `log.csv` report of the current state, as LAMMPS's thermo
+    /// output does: the energies (summed in id order, so the same for any storage order),
+    /// the contacts of the last step and the deepest of them relative to the smaller radius.
+    pub fn thermo(&self) -> Thermo {
+        let p = &self.particles;
+        let mut energies: Vec<(u32, f64, f64)> = (0..p.len())
+            .map(|k| {
+                let m = Inertia::mass_with(
+                    p.radius[k],
+                    self.densities[p.material[k] as usize].mass_per_r3,
+                );
+                let i = 0.4 * m * p.radius[k] * p.radius[k];
+                (
+                    p.id[k],
+                    0.5 * m * p.v[k].length_squared(),
+                    0.5 * i * p.w[k].length_squared(),
+                )
+            })
+            .collect();
+        energies.sort_unstable_by_key(|e| e.0);
+        let (translational, rotational) = energies
+            .iter()
+            .fold((0.0, 0.0), |(t, r), e| (t + e.1, r + e.2));
+        let radius_of: rustc_hash::FxHashMap<u32, f64> =
+            p.id.iter().copied().zip(p.radius.iter().copied()).collect();
+        let mut thermo = Thermo {
+            particles: p.len(),
+            kinetic_energy: translational + rotational,
+            rotational_energy: rotational,
+            removed: self.removed.count(),
+            ..Thermo::default()
+        };
+        for c in self.contact_network() {
+            let r = radius_of[&c.id];
+            let smaller = match c.with {
+                Partner::Particle(j) => {
+                    thermo.pair_contacts += 1;
+                    r.min(radius_of[&(j as u32)])
+                }
+                Partner::Face(_) => {
+                    thermo.wall_contacts += 1;
+                    r
+                }
+            };
+            thermo.max_overlap = thermo.max_overlap.max(c.overlap / smaller);
+        }
+        thermo
     }
 
     /// Starts summing the loads on each mesh file (`take_wall_loads`).

@@ -562,3 +562,55 @@ fn output_of_another_run_is_not_mixed_in() {
     let o = tinydem(&["run", "short.toml", "-q", "--overwrite"], t.path());
     assert!(o.status.success(), "{}", stderr(&o));
 }
+
+/// `log.csv` carries what the status line shows, frame by frame: the kinetic energy agrees
+/// with `analyze` of the frames, the contacts per particle with its coordination number
+/// (pairs and face contacts of the last step against pairs that overlap in the frame).
+#[test]
+fn the_log_follows_the_state_frame_by_frame() {
+    let t = tempfile::tempdir().unwrap();
+    hourglass_frames("2", t.path());
+    let log = std::fs::read_to_string(t.path().join("out/log.csv")).unwrap();
+    let mut lines = log.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(
+        header,
+        tinydem::run::LOG_HEADER.split(',').collect::<Vec<_>>()
+    );
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 5, "{log}");
+    let a = tinydem(&["analyze", "out", "--csv", "a.csv"], t.path());
+    assert!(a.status.success(), "{}", stderr(&a));
+    let table = std::fs::read_to_string(t.path().join("a.csv")).unwrap();
+    let columns: Vec<&str> = table.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| columns.iter().position(|c| *c == name).unwrap();
+    let of = |name: &str| header.iter().position(|c| *c == name).unwrap();
+    for (row, line) in rows.iter().zip(table.lines().skip(1)) {
+        let a: Vec<f64> = line.split(',').map(|v| v.parse().unwrap()).collect();
+        let e = row[of("kinetic_energy")];
+        assert!(
+            (e - a[col("kinetic_energy")]).abs() <= 1e-6 * e,
+            "{row:?} {a:?}"
+        );
+        assert!(row[of("rotational_energy")] <= e);
+        let pairs = row[of("pair_contacts")];
+        let n = row[of("particles")];
+        assert!(
+            (2.0 * pairs / n.max(1.0) - a[col("coordination")]).abs() < 0.05,
+            "{row:?} {a:?}"
+        );
+    }
+    let last = rows.last().unwrap();
+    assert!(last[of("pair_contacts")] > 100.0 && last[of("wall_contacts")] > 10.0);
+    assert!(last[of("max_overlap")] > 0.0 && last[of("max_overlap")] < 1.0);
+    // The status line shows the same.
+    let o = tinydem(&["run", "s.toml", "--output", "again"], t.path());
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    let line = err.lines().find(|l| l.starts_with("frame      4")).unwrap();
+    for part in ["E_k ", "contacts/particle ", "overlap/R "] {
+        assert!(line.contains(part), "{part} missing from {line}");
+    }
+}
