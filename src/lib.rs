@@ -5,6 +5,7 @@
 
 pub mod analyze;
 pub mod bench;
+pub mod check;
 pub mod checkpoint;
 pub mod contact;
 pub mod csv;

@@ -8,8 +8,9 @@ use clap::{Parser, Subcommand};
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
+use tinydem::check::{describe, describe_stage};
 use tinydem::render::{ColorBy, Style, View};
-use tinydem::run::{Interrupted, Options, Summary, Verbosity, describe, describe_stage, run};
+use tinydem::run::{Interrupted, Options, Summary, Verbosity, run};
 use tinydem::scenario::Scenario;
 use tinydem::simulation::Stage;
 
@@ -29,6 +30,9 @@ struct Cli {
     /// Replace the output of an earlier default run in ./output.
     #[arg(long)]
     overwrite: bool,
+    /// Run the default simulation even if `check` would refuse it.
+    #[arg(long)]
+    force: bool,
 }
 
 #[derive(Subcommand)]
@@ -54,6 +58,10 @@ enum Command {
         /// and checkpoint; other files stay).
         #[arg(long)]
         overwrite: bool,
+        /// Run even with a time step far past Eq. 50, or output that may not fit the free
+        /// space (see `tinydem check`).
+        #[arg(long)]
+        force: bool,
     },
     /// Validate a scenario and print derived quantities.
     Check {
@@ -61,6 +69,9 @@ enum Command {
         /// Also say what the scenario changes as a stage after this checkpoint.
         #[arg(long)]
         from: Option<PathBuf>,
+        /// The output directory the run would use (for its free space; default [output] dir).
+        #[arg(long, short)]
+        output: Option<PathBuf>,
     },
     /// Measure every frame of an output directory: kinetic energy, coordination number,
     /// packing fraction; optionally the angle of repose and the height of large particles.
@@ -187,13 +198,14 @@ fn real_main(cli: Cli) -> Result<()> {
     // The time loop runs on a worker of the pool, so that small parallel loops run inline
     // instead of waking another thread for every stage.
     let pool = pool.build().context("cannot start the thread pool")?;
-    pool.install(|| execute(cli.command, cli.resume, cli.overwrite))
+    pool.install(|| execute(cli.command, cli.resume, cli.overwrite, cli.force))
 }
 
 fn execute(
     command: Option<Command>,
     resume_default: Option<PathBuf>,
     overwrite_default: bool,
+    force_default: bool,
 ) -> Result<()> {
     match command {
         None => {
@@ -205,6 +217,7 @@ fn execute(
                 resume: resume_default.as_deref(),
                 from: None,
                 overwrite: overwrite_default,
+                force: force_default,
                 stop: Some(&STOP),
             };
             let summary = run(s, &out, options)?;
@@ -217,6 +230,7 @@ fn execute(
             resume,
             from,
             overwrite,
+            force,
         }) => {
             let s = Scenario::load(&scenario)?;
             let out = output.unwrap_or_else(|| s.output_dir.clone());
@@ -231,6 +245,7 @@ fn execute(
                 resume: resume.as_deref(),
                 from: from.as_deref(),
                 overwrite,
+                force,
                 stop: Some(&STOP),
             };
             let summary = run(s, &out, options)?;
@@ -301,11 +316,16 @@ fn execute(
             csv,
             plot.map(|p| (p, column)),
         )?,
-        Some(Command::Check { scenario, from }) => {
+        Some(Command::Check {
+            scenario,
+            from,
+            output,
+        }) => {
             let s = Scenario::load(&scenario)?;
+            let out = output.unwrap_or_else(|| s.output_dir.clone());
             match from {
-                None => print!("{}", describe(&s)?),
-                Some(from) => print!("{}", describe_stage(&s, &from)?),
+                None => print!("{}", describe(&s, &out)?),
+                Some(from) => print!("{}", describe_stage(&s, &from, &out)?),
             }
         }
     }

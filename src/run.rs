@@ -9,10 +9,7 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 
 use crate::checkpoint;
-use crate::contact::ContactLaw;
 use crate::csv::{Extra, frame_name, write_frame};
-use crate::integrate::Inertia;
-use crate::mesh::Contacts;
 use crate::scenario::{Formats, Scenario};
 use crate::simulation::{Simulation, StageTimes, Thermo};
 
@@ -55,6 +52,9 @@ pub struct Options<'a> {
     /// Clear the output of an earlier run from the directory first (otherwise such a
     /// directory is refused, unless resuming).
     pub overwrite: bool,
+    /// Run even when the scenario's time step is far past Eq. 50 or its output may not fit
+    /// the free space (`check::refusals`).
+    pub force: bool,
     /// Set (by a signal handler) to stop after the current step with a checkpoint.
     pub stop: Option<&'a AtomicBool>,
 }
@@ -290,36 +290,29 @@ fn claim_output(dir: &Path, overwrite: bool) -> Result<()> {
 
 /// Runs `scenario`, writing frames 0..=N_frames into `output_dir`.
 pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Summary> {
+    let frames = scenario.simulation.frames;
+    let steps_per_frame = scenario.simulation.steps_per_frame;
+    let checkpoint_every = scenario.checkpoint_every;
+    let (mut sim, notes) = open(scenario, options.resume, options.from)?;
+    if options.verbosity == Verbosity::Normal
+        && let Some(path) = options.from
+    {
+        eprintln!("stage from {}: {}", path.display(), notes.join("; "));
+    }
+    if !options.force {
+        let n = crate::check::most_particles(&sim.scenario, sim.particles.len());
+        let why = crate::check::refusals(&sim.scenario, n, output_dir);
+        anyhow::ensure!(
+            why.is_empty(),
+            "{}\n(run with --force to run it anyway)",
+            why.join("\n")
+        );
+    }
     prepare_output(output_dir)?;
     let _lock = Lock::take(output_dir)?;
     if options.resume.is_none() {
         claim_output(output_dir, options.overwrite)?;
     }
-    let frames = scenario.simulation.frames;
-    let steps_per_frame = scenario.simulation.steps_per_frame;
-    let checkpoint_every = scenario.checkpoint_every;
-    let mut sim = match options.resume {
-        None => match options.from {
-            None => Simulation::new(scenario)?,
-            Some(path) => {
-                let snapshot = checkpoint::load(path, None)?;
-                let (sim, notes) = Simulation::stage(scenario, snapshot)
-                    .with_context(|| format!("cannot start a stage from {}", path.display()))?;
-                if options.verbosity == Verbosity::Normal {
-                    eprintln!("stage from {}: {}", path.display(), notes.join("; "));
-                }
-                sim
-            }
-        },
-        Some(path) => {
-            let fresh = Simulation::new(Scenario {
-                particles: None,
-                ..scenario.clone()
-            })?;
-            let snapshot = checkpoint::load(path, Some(fingerprint(&fresh)))?;
-            Simulation::restore(scenario, snapshot)?
-        }
-    };
     let start = Instant::now();
     let out = Frames {
         dir: output_dir,
@@ -626,231 +619,46 @@ macro_rules! whole_log_values {
 }
 whole_log_values!(u64, usize, i32);
 
+/// The simulation of `scenario` from its start, continued from the checkpoint `resume`
+/// of an interrupted run of it, or as a stage after the checkpoint `from` of another run
+/// (with what the stage carries over from it).
+pub fn open(
+    scenario: Scenario,
+    resume: Option<&Path>,
+    from: Option<&Path>,
+) -> Result<(Simulation, Vec<String>)> {
+    match (resume, from) {
+        (Some(path), _) => {
+            let fresh = Simulation::new(Scenario {
+                particles: None,
+                ..scenario.clone()
+            })?;
+            let snapshot = checkpoint::load(path, Some(fingerprint(&fresh)))?;
+            Ok((Simulation::restore(scenario, snapshot)?, Vec::new()))
+        }
+        (None, Some(path)) => {
+            let snapshot = checkpoint::load(path, None)?;
+            Simulation::stage(scenario, snapshot)
+                .with_context(|| format!("cannot start a stage from {}", path.display()))
+        }
+        (None, None) => Ok((Simulation::new(scenario)?, Vec::new())),
+    }
+}
+
 /// Writes the checkpoint of `sim` into `dir`, returning its path.
 fn save_checkpoint(dir: &Path, sim: &Simulation) -> Result<PathBuf> {
     let path = dir.join(CHECKPOINT);
-    checkpoint::save(&path, &sim.snapshot(), fingerprint(sim))?;
+    write_checkpoint(&path, sim)?;
     Ok(path)
+}
+
+/// Writes the checkpoint of `sim` to `path` (`--resume` continues it exactly, `--from`
+/// starts a stage from it).
+pub fn write_checkpoint(path: &Path, sim: &Simulation) -> Result<()> {
+    checkpoint::save(path, &sim.snapshot(), fingerprint(sim))
 }
 
 /// The fingerprint of a simulation's scenario and mesh, for checkpoints.
 fn fingerprint(sim: &Simulation) -> u64 {
     checkpoint::fingerprint(&sim.scenario, &sim.rest_mesh())
-}
-
-/// The derived quantities `tinydem check` prints.
-pub fn describe(s: &Scenario) -> Result<String> {
-    let sim = Simulation::new(s.clone())?;
-    let g = &s.geometry;
-    let m = &s.material;
-    let dt = s.simulation.timestep;
-    let law = ContactLaw::new(m, dt);
-    let densities = s.materials.iter().map(|m| m.properties.density);
-    let m_min = Inertia::mass(
-        g.radius_min,
-        densities.clone().fold(f64::INFINITY, f64::min),
-    );
-    let m_max = Inertia::mass(g.radius_max, densities.fold(0.0, f64::max));
-    // Stiffness of two R_min particles at 10 % relative indentation δ / (2 R*) (Section 2.3).
-    let r = g.radius_min;
-    let k_10 = law.normal_stiffness(r, r, 0.1 * r);
-    let period = std::f64::consts::PI * (0.5 * m_min / k_10).sqrt();
-    let max_n = (s.simulation.max_particles as usize).max(sim.particles.len());
-    let frame_bytes = 40 + max_n * 14 * 22;
-    let mut meshes = String::new();
-    for (k, file) in sim.mesh_files.iter().enumerate() {
-        if file.faces.is_empty() && k == 0 {
-            meshes += "mesh                   none\n";
-            continue;
-        }
-        let faces = &sim.mesh.faces[file.faces.clone()];
-        let surfaces: std::collections::BTreeSet<u32> = faces.iter().map(|f| f.surface).collect();
-        let contacts = match file.contacts {
-            Contacts::Merged => format!(
-                "merged (one per touch of a connected surface; {} {})",
-                surfaces.len(),
-                if surfaces.len() == 1 {
-                    "surface"
-                } else {
-                    "surfaces"
-                }
-            ),
-            Contacts::PerFace => "per face (the original program's)".to_string(),
-        };
-        let contacts = if s.materials.len() > 1 {
-            format!(
-                "{contacts}, material \"{}\"",
-                s.materials[file.material as usize].name
-            )
-        } else {
-            contacts
-        };
-        meshes += &format!(
-            "{:<23}{}: {} faces, contacts {contacts}\n",
-            if k == 0 {
-                "mesh".to_string()
-            } else {
-                format!("mesh {k}")
-            },
-            file.name,
-            faces.len()
-        );
-    }
-    let mut bounds = String::new();
-    if let Some(d) = s.domain {
-        bounds += &format!(
-            "domain                 {} .. {} (particles leaving it are removed)\n",
-            d.min, d.max
-        );
-        let outside = sim.particles.x.iter().filter(|&&x| !d.contains(x)).count();
-        if outside > 0 {
-            bounds += &format!(
-                "                       warning: {outside} initial particles lie outside it and are removed at the first step\n"
-            );
-        }
-    }
-    for (k, o) in s.outlets.iter().enumerate() {
-        bounds += &format!(
-            "outlet {k:<16}{} .. {} (removes particles entering it; {OUTLETS})\n",
-            o.min, o.max
-        );
-    }
-    if s.wall_forces {
-        bounds += &format!(
-            "wall loads             force and torque on each mesh file, mean per frame ({WALLS})\n"
-        );
-    }
-    let mut materials = String::new();
-    if s.materials.len() > 1 || s.materials[0].name != "default" {
-        for (k, m) in s.materials.iter().enumerate() {
-            let p = &m.properties;
-            materials += &format!(
-                "{:<23}{k} \"{}\": density {}, E {:e}, nu {}, e_n {}, mu_s {}, mu_r {}, mu_t {}{}\n",
-                if k == 0 { "materials" } else { "" },
-                m.name,
-                num(p.density),
-                p.youngs_modulus,
-                num(p.poisson_ratio),
-                num(p.restitution),
-                num(p.friction_sliding),
-                num(p.friction_rolling),
-                num(p.friction_twisting),
-                if p.cohesion > 0.0 {
-                    format!(", cohesion {} J/m^3", num(p.cohesion))
-                } else {
-                    String::new()
-                }
-            );
-        }
-        let n = s.materials.len() as u16;
-        let mut first = true;
-        for a in 0..n {
-            for b in a..n {
-                let c = s.pair(a, b);
-                let how = if a == b {
-                    "its own".to_string()
-                } else {
-                    let given: Vec<&str> = s
-                        .interactions
-                        .iter()
-                        .find(|i| i.materials == (a, b))
-                        .map_or_else(Vec::new, |i| {
-                            i.coefficients()
-                                .iter()
-                                .filter(|c| c.2.is_some())
-                                .map(|c| c.1)
-                                .collect()
-                        });
-                    match given.len() {
-                        0 => "means of the two".to_string(),
-                        5 => "[[interactions]]".to_string(),
-                        _ => format!("{} from [[interactions]], the rest means", given.join(", ")),
-                    }
-                };
-                materials += &format!(
-                    "{:<23}{} - {}: e_n {}, mu_s {}, mu_r {}, mu_t {}, k_c {} ({how})\n",
-                    if first { "pairs" } else { "" },
-                    s.materials[a as usize].name,
-                    s.materials[b as usize].name,
-                    num(c.restitution),
-                    num(c.friction_sliding),
-                    num(c.friction_rolling),
-                    num(c.friction_twisting),
-                    num(c.cohesion)
-                );
-                first = false;
-            }
-        }
-    }
-    let default_dt = s.eq50_timestep();
-    Ok(format!(
-        "scenario is valid\n\
-         {meshes}\
-         {materials}\
-         {bounds}\
-         initial particles      {}\n\
-         time step              {dt:.6e} s ({:.3} x Eq. 50)\n\
-         particle mass          {m_min:.6e} .. {m_max:.6e} kg\n\
-         stiffness k_n at 10%   {k_10:.6e} N/m (two R_min particles, delta = 0.1 R_min)\n\
-         half contact period    {period:.6e} s = {:.1} time steps\n\
-         total simulated time   {:.6} s ({} frames x {} steps)\n\
-         output                 {} files, up to {} each, {} in all\n",
-        sim.particles.len(),
-        dt / default_dt,
-        period / dt,
-        s.total_time(),
-        s.simulation.frames,
-        s.simulation.steps_per_frame,
-        s.simulation.frames + 1,
-        human_bytes(frame_bytes as f64),
-        human_bytes(frame_bytes as f64 * (s.simulation.frames + 1) as f64),
-    ))
-}
-
-/// What `tinydem check SCENARIO --from CHECKPOINT` prints: the scenario's derived
-/// quantities, then what it changes as a stage after the checkpoint's run and what it
-/// carries over.
-pub fn describe_stage(s: &Scenario, from: &Path) -> Result<String> {
-    let mut out = describe(s)?;
-    let snapshot = checkpoint::load(from, None)?;
-    let old = snapshot.scenario.clone();
-    let steps = snapshot.steps;
-    let (_, notes) = Simulation::stage(s.clone(), snapshot)
-        .with_context(|| format!("cannot start a stage from {}", from.display()))?;
-    out += &format!(
-        "stage from             {} (step {steps} of its run); the clock starts at 0\n",
-        from.display()
-    );
-    if old.is_empty() {
-        out += "changes                unknown (the checkpoint predates format 3)\n";
-    } else {
-        let changes = crate::scenario::changes(&old, &s.to_toml());
-        if changes.is_empty() {
-            out += "changes                none\n";
-        }
-        for (k, c) in changes.iter().enumerate() {
-            out += &format!("{:<23}{c}\n", if k == 0 { "changes" } else { "" });
-        }
-    }
-    for (k, note) in notes.iter().enumerate() {
-        out += &format!("{:<23}{note}\n", if k == 0 { "carries" } else { "" });
-    }
-    Ok(out)
-}
-
-/// A coefficient for people: at most 10 significant digits, no trailing zeros.
-fn num(x: f64) -> String {
-    let s = format!("{:.10e}", x);
-    let (mantissa, exp) = s.split_once('e').unwrap_or((&s, "0"));
-    let value: f64 = format!("{mantissa}e{exp}").parse().unwrap_or(x);
-    format!("{value}")
-}
-
-/// A byte count in kB, MB or GB.
-fn human_bytes(b: f64) -> String {
-    match b {
-        b if b < 1e6 => format!("{:.1} kB", b / 1e3),
-        b if b < 1e9 => format!("{:.1} MB", b / 1e6),
-        b => format!("{:.2} GB", b / 1e9),
-    }
 }

@@ -463,11 +463,13 @@ fn analyze_prints_a_table_and_writes_csv_and_plot() {
 #[test]
 fn a_run_reports_where_its_time_went() {
     let dir = tempfile::tempdir().unwrap();
+    // Enough particles that each stage takes more than the 0.05 % of the run the line shows
+    // on a loaded machine too.
     write(
         dir.path(),
         "s.toml",
-        "[geometry]\nspawn_min = [0, 0, 0]\nspawn_max = [0.1, 0.1, 0.1]\n\
-         [simulation]\nmax_particles = 50\nframes = 2\nsteps_per_frame = 100\n",
+        "[geometry]\nspawn_min = [0, 0, 0]\nspawn_max = [0.2, 0.2, 0.2]\n\
+         [simulation]\nmax_particles = 1000\nframes = 2\nsteps_per_frame = 100\n",
     );
     let o = tinydem(&["run", "s.toml", "--output", "out"], dir.path());
     let err = stderr(&o);
@@ -613,4 +615,54 @@ fn the_log_follows_the_state_frame_by_frame() {
     for part in ["E_k ", "contacts/particle ", "overlap/R "] {
         assert!(line.contains(part), "{part} missing from {line}");
     }
+}
+
+/// `check` warns of a time step far past Eq. 50 and of output larger than the free space,
+/// and `run` refuses both unless `--force`; `check` estimates the wall time from a trial.
+#[test]
+fn check_warns_and_run_refuses_what_would_fail() {
+    let t = tempfile::tempdir().unwrap();
+    let base = "[geometry]\nspawn_min = [0, 0, 0]\nspawn_max = [0.1, 0.1, 0.1]\n\
+                [simulation]\nmax_particles = 30\nsteps_per_frame = 20\n";
+    // Eq. 50 for the defaults (R_min 2 mm, rho 1000, E 1e6, nu 0.3): 6.033e-5 s.
+    write(
+        t.path(),
+        "fast.toml",
+        &format!("{base}frames = 2\ntimestep = 3e-4\n"),
+    );
+    write(
+        t.path(),
+        "huge.toml",
+        &format!("{base}frames = 1000000000\n"),
+    );
+    write(t.path(), "fine.toml", &format!("{base}frames = 2\n"));
+    let check = |name: &str| {
+        let o = tinydem(&["check", name], t.path());
+        assert!(o.status.success(), "{}", stderr(&o));
+        String::from_utf8_lossy(&o.stdout).into_owned()
+    };
+    let fine = check("fine.toml");
+    assert!(!fine.contains("warning"), "{fine}");
+    let wall = fine.lines().find(|l| l.starts_with("wall time")).unwrap();
+    assert!(wall.contains("the whole run, timed"), "{wall}");
+    assert!(fine.contains(" free in "), "{fine}");
+    let fast = check("fast.toml");
+    assert!(
+        fast.contains("warning: time step 3.000e-4 s is 5.0 x Eq. 50"),
+        "{fast}"
+    );
+    let huge = check("huge.toml");
+    assert!(huge.contains("warning: the output may grow to"), "{huge}");
+    let wall = huge.lines().find(|l| l.starts_with("wall time")).unwrap();
+    assert!(wall.contains("a trial of"), "{wall}");
+    for name in ["fast.toml", "huge.toml"] {
+        let o = tinydem(&["run", name, "-q", "-o", "out"], t.path());
+        fails_with(&o, &["run with --force"]);
+        assert!(!t.path().join("out").exists(), "refused before writing");
+    }
+    let o = tinydem(
+        &["run", "fast.toml", "-q", "--force", "-o", "out"],
+        t.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
 }

@@ -42,6 +42,7 @@ fn every_example_runs_a_few_frames() {
                 resume: None,
                 from: from.as_deref(),
                 overwrite: false,
+                force: false,
                 stop: None,
             };
             let summary =

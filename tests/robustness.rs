@@ -53,7 +53,7 @@ fn too_large_timestep_is_warned_of_once_with_advice() {
             .replace("radius_min = 0.002", "radius_min = 0.005"),
     )
     .unwrap();
-    let o = tinydem(&["run", "s.toml"], t.path());
+    let o = tinydem(&["run", "s.toml", "--force"], t.path());
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{err}");
     assert_contains(
@@ -68,7 +68,7 @@ fn too_large_timestep_is_warned_of_once_with_advice() {
     );
     assert_eq!(err.matches("warning: step").count(), 1, "{err}");
     // Quiet runs still say it at the end.
-    let o = tinydem(&["run", "s.toml", "-q", "-o", "quiet"], t.path());
+    let o = tinydem(&["run", "s.toml", "-q", "--force", "-o", "quiet"], t.path());
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success());
     assert_contains(
@@ -87,7 +87,7 @@ fn an_overlap_past_the_smaller_diameter_stops_the_run() {
         "timestep = 1e-3",
         "",
     );
-    let o = tinydem(&["run", "s.toml", "-q"], t.path());
+    let o = tinydem(&["run", "s.toml", "-q", "--force"], t.path());
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success());
     assert!(!err.contains("panicked"), "{err}");
@@ -122,7 +122,7 @@ fn a_non_finite_state_stops_the_run() {
             .replace("gravity = [0.0, 0.0, 0.0]", "gravity = [0.0, 0.0, -1e308]"),
     )
     .unwrap();
-    let o = tinydem(&["run", "s.toml", "-q"], t.path());
+    let o = tinydem(&["run", "s.toml", "-q", "--force"], t.path());
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success());
     assert_contains(
