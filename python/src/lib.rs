@@ -1,0 +1,385 @@
+//! The Python module `tinydem._tinydem`: the engine itself, stepped from Python. Arrays are
+//! numpy copies in id order (the order of the frames); `tinydem/__init__.py` adds the
+//! readers of output directories on top.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use glam::{DQuat, DVec3};
+use numpy::ndarray::{Array1, Array2};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use tinydem::csv::Extra;
+use tinydem::run::{Options, Verbosity};
+use tinydem::scenario::Scenario;
+
+/// An error of the engine as a Python exception, with its whole chain of causes.
+fn error(e: anyhow::Error) -> PyErr {
+    PyRuntimeError::new_err(format!("{e:#}"))
+}
+
+/// A thread pool of `threads` workers (None: all cores).
+fn pool(threads: Option<usize>) -> PyResult<Arc<rayon::ThreadPool>> {
+    if threads == Some(0) {
+        return Err(PyValueError::new_err("threads must be at least 1"));
+    }
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()
+        .map(Arc::new)
+        .map_err(|e| PyRuntimeError::new_err(format!("cannot start the thread pool: {e}")))
+}
+
+/// Steps between checks for Ctrl-C while stepping.
+const SIGNAL_CHECK_STEPS: u64 = 200;
+
+/// A simulation of a scenario file, stepped from Python.
+///
+/// Simulation(scenario, threads=None, resume=None, from_checkpoint=None)
+///
+/// `scenario` is a scenario TOML file (or a `run.toml` of an output directory). `threads`
+/// is the number of worker threads (default: all cores; results are the same for any
+/// number). `resume` continues an interrupted run of the same scenario from its checkpoint;
+/// `from_checkpoint` starts a new stage from another run's checkpoint. Stepping gives
+/// bitwise the states of `tinydem run`.
+#[pyclass(module = "tinydem")]
+struct Simulation {
+    sim: tinydem::simulation::Simulation,
+    pool: Arc<rayon::ThreadPool>,
+}
+
+impl Simulation {
+    /// Particle indices in id order.
+    fn order(&self) -> Vec<usize> {
+        self.sim.particles.id_order()
+    }
+
+    /// An (N, 3) array of `field` in id order.
+    fn vectors<'py>(
+        &self,
+        py: Python<'py>,
+        field: impl Fn(usize) -> DVec3,
+    ) -> Bound<'py, PyArray2<f64>> {
+        let order = self.order();
+        let flat: Vec<f64> = order.iter().flat_map(|&i| field(i).to_array()).collect();
+        Array2::from_shape_vec((order.len(), 3), flat)
+            .expect("three per particle")
+            .into_pyarray(py)
+    }
+
+    /// The rows of an (N, 3) array in id order, checked against the particle count.
+    fn rows(&self, name: &str, a: PyReadonlyArray2<f64>) -> PyResult<Vec<(usize, DVec3)>> {
+        let a = a.as_array();
+        let n = self.sim.particles.len();
+        if a.shape() != [n, 3] {
+            return Err(PyValueError::new_err(format!(
+                "{name} must have shape ({n}, 3), not {:?}",
+                a.shape()
+            )));
+        }
+        let rows: Vec<(usize, DVec3)> = self
+            .order()
+            .into_iter()
+            .enumerate()
+            .map(|(k, i)| (i, DVec3::new(a[[k, 0]], a[[k, 1]], a[[k, 2]])))
+            .collect();
+        if rows.iter().any(|(_, v)| !v.is_finite()) {
+            return Err(PyValueError::new_err(format!("{name} must be finite")));
+        }
+        Ok(rows)
+    }
+}
+
+#[pymethods]
+impl Simulation {
+    #[new]
+    #[pyo3(signature = (scenario, threads=None, resume=None, from_checkpoint=None))]
+    fn new(
+        scenario: PathBuf,
+        threads: Option<usize>,
+        resume: Option<PathBuf>,
+        from_checkpoint: Option<PathBuf>,
+    ) -> PyResult<Simulation> {
+        if resume.is_some() && from_checkpoint.is_some() {
+            return Err(PyValueError::new_err(
+                "give resume (the same run) or from_checkpoint (a new stage), not both",
+            ));
+        }
+        let pool = pool(threads)?;
+        let s = Scenario::load(&scenario).map_err(error)?;
+        let (sim, _) = pool
+            .install(|| tinydem::run::open(s, resume.as_deref(), from_checkpoint.as_deref()))
+            .map_err(error)?;
+        Ok(Simulation { sim, pool })
+    }
+
+    /// Advances the simulation by `n` time steps (the GIL is released meanwhile; Ctrl-C
+    /// stops it between steps). Raises RuntimeError when the run becomes unstable.
+    #[pyo3(signature = (n=1))]
+    fn step(&mut self, py: Python<'_>, n: u64) -> PyResult<()> {
+        let mut left = n;
+        while left > 0 {
+            let chunk = left.min(SIGNAL_CHECK_STEPS);
+            let (sim, pool) = (&mut self.sim, &self.pool);
+            py.detach(|| {
+                pool.install(|| {
+                    for _ in 0..chunk {
+                        sim.step()?;
+                    }
+                    Ok::<(), tinydem::simulation::Unstable>(())
+                })
+            })
+            .map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
+            left -= chunk;
+            py.check_signals()?;
+        }
+        Ok(())
+    }
+
+    /// Simulated time [s].
+    #[getter]
+    fn time(&self) -> f64 {
+        self.sim.time
+    }
+
+    /// Time steps taken.
+    #[getter]
+    fn steps(&self) -> u64 {
+        self.sim.steps
+    }
+
+    /// The time step Δt [s].
+    #[getter]
+    fn timestep(&self) -> f64 {
+        self.sim.scenario.simulation.timestep
+    }
+
+    /// Number of particles.
+    fn __len__(&self) -> usize {
+        self.sim.particles.len()
+    }
+
+    /// Particle centres [m], (N, 3), in id order.
+    #[getter]
+    fn positions<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        self.vectors(py, |i| self.sim.particles.x[i])
+    }
+
+    /// Velocities [m/s], (N, 3), in id order.
+    #[getter]
+    fn velocities<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        self.vectors(py, |i| self.sim.particles.v[i])
+    }
+
+    #[setter]
+    fn set_velocities(&mut self, v: PyReadonlyArray2<f64>) -> PyResult<()> {
+        for (i, v) in self.rows("velocities", v)? {
+            self.sim.particles.v[i] = v;
+        }
+        Ok(())
+    }
+
+    /// Angular velocities [rad/s], (N, 3), in id order.
+    #[getter]
+    fn angular_velocities<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        self.vectors(py, |i| self.sim.particles.w[i])
+    }
+
+    #[setter]
+    fn set_angular_velocities(&mut self, w: PyReadonlyArray2<f64>) -> PyResult<()> {
+        for (i, w) in self.rows("angular_velocities", w)? {
+            self.sim.particles.w[i] = w;
+        }
+        Ok(())
+    }
+
+    /// Orientations as unit quaternions (q0, q1, q2, q3) = (w, x, y, z), (N, 4), id order.
+    #[getter]
+    fn orientations<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let order = self.order();
+        let q: &[DQuat] = &self.sim.particles.q;
+        let flat: Vec<f64> = order
+            .iter()
+            .flat_map(|&i| [q[i].w, q[i].x, q[i].y, q[i].z])
+            .collect();
+        Array2::from_shape_vec((order.len(), 4), flat)
+            .expect("four per particle")
+            .into_pyarray(py)
+    }
+
+    /// Radii [m], (N,), in id order.
+    #[getter]
+    fn radii<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let p = &self.sim.particles;
+        Array1::from_iter(self.order().into_iter().map(|i| p.radius[i])).into_pyarray(py)
+    }
+
+    /// Particle ids, (N,), ascending: the order of every array.
+    #[getter]
+    fn ids<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
+        let p = &self.sim.particles;
+        Array1::from_iter(self.order().into_iter().map(|i| p.id[i] as i64)).into_pyarray(py)
+    }
+
+    /// Tags, (N,), in id order.
+    #[getter]
+    fn tags<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
+        let p = &self.sim.particles;
+        Array1::from_iter(self.order().into_iter().map(|i| p.tag[i] as i64)).into_pyarray(py)
+    }
+
+    /// Material indices (into the scenario's [[materials]]), (N,), in id order.
+    #[getter]
+    fn materials<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
+        let p = &self.sim.particles;
+        Array1::from_iter(self.order().into_iter().map(|i| p.material[i] as i64)).into_pyarray(py)
+    }
+
+    /// What `log.csv` records of the current state: particles, kinetic_energy and
+    /// rotational_energy [J], contacts_per_particle, pair_contacts, wall_contacts,
+    /// max_overlap (relative to the smaller radius), removed.
+    fn thermo<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let th = self.sim.thermo();
+        let d = PyDict::new(py);
+        d.set_item("particles", th.particles)?;
+        d.set_item("kinetic_energy", th.kinetic_energy)?;
+        d.set_item("rotational_energy", th.rotational_energy)?;
+        d.set_item("contacts_per_particle", th.contacts_per_particle())?;
+        d.set_item("pair_contacts", th.pair_contacts)?;
+        d.set_item("wall_contacts", th.wall_contacts)?;
+        d.set_item("max_overlap", th.max_overlap)?;
+        d.set_item("removed", th.removed)?;
+        Ok(d)
+    }
+
+    /// Writes the particles as a CSV frame (the format of `particlesNNNNNN.csv`, the same
+    /// columns as the run's frames).
+    fn write_frame(&self, path: PathBuf) -> PyResult<()> {
+        let extra = Extra {
+            tag: self.sim.has_tags(),
+            ids: self.sim.frames_carry_ids(),
+        };
+        let dir = path.parent().filter(|d| !d.as_os_str().is_empty());
+        let name = path
+            .file_name()
+            .ok_or_else(|| PyValueError::new_err("write_frame needs a file name"))?;
+        tinydem::csv::write_frame_as(
+            dir.unwrap_or(std::path::Path::new(".")),
+            &name.to_string_lossy(),
+            &self.sim.particles_in_domain(),
+            extra,
+        )
+        .map(|_| ())
+        .map_err(error)
+    }
+
+    /// Writes a checkpoint: `tinydem run --resume` (or `Simulation(..., resume=path)`)
+    /// continues it exactly; `--from` starts a new stage from it.
+    fn checkpoint(&self, path: PathBuf) -> PyResult<()> {
+        tinydem::run::write_checkpoint(&path, &self.sim).map_err(error)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "<tinydem.Simulation: {} particles, step {}, t = {:.6e} s>",
+            self.sim.particles.len(),
+            self.sim.steps,
+            self.sim.time
+        )
+    }
+}
+
+/// Runs a scenario file as `tinydem run` does, writing its output directory (frames,
+/// run.toml, frames.csv, log.csv, the checkpoint); returns that directory.
+#[pyfunction]
+#[pyo3(signature = (scenario, output=None, threads=None, overwrite=false, force=false, resume=None, from_checkpoint=None, quiet=true))]
+#[allow(clippy::too_many_arguments)]
+fn run(
+    py: Python<'_>,
+    scenario: PathBuf,
+    output: Option<PathBuf>,
+    threads: Option<usize>,
+    overwrite: bool,
+    force: bool,
+    resume: Option<PathBuf>,
+    from_checkpoint: Option<PathBuf>,
+    quiet: bool,
+) -> PyResult<PathBuf> {
+    let s = Scenario::load(&scenario).map_err(error)?;
+    let out = output.unwrap_or_else(|| s.output_dir.clone());
+    let pool = pool(threads)?;
+    let options = Options {
+        verbosity: if quiet {
+            Verbosity::Quiet
+        } else {
+            Verbosity::Normal
+        },
+        resume: resume.as_deref(),
+        from: from_checkpoint.as_deref(),
+        overwrite,
+        force,
+        stop: None,
+    };
+    py.detach(|| pool.install(|| tinydem::run::run(s, &out, options)))
+        .map_err(error)?;
+    Ok(out)
+}
+
+/// Reads a numeric CSV file with a header line (a frame, `log.csv`, `frames.csv`):
+/// the column names and the values, row by row, as an (rows, columns) array.
+#[pyfunction]
+fn read_csv<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+) -> PyResult<(Vec<String>, Bound<'py, PyArray2<f64>>)> {
+    let text = std::fs::read_to_string(&path)
+        .map_err(|e| PyRuntimeError::new_err(format!("cannot read {}: {e}", path.display())))?;
+    let mut lines = text.lines();
+    let header: Vec<String> = lines
+        .next()
+        .ok_or_else(|| PyValueError::new_err(format!("{}: empty file", path.display())))?
+        .split(',')
+        .map(|c| c.trim().to_string())
+        .collect();
+    let mut values = Vec::new();
+    let mut rows = 0;
+    for (k, line) in lines.enumerate() {
+        if line.trim().is_empty() {
+            continue;
+        }
+        let before = values.len();
+        for v in line.split(',') {
+            values.push(v.trim().parse::<f64>().map_err(|_| {
+                PyValueError::new_err(format!(
+                    "{} line {}: {v:?} is not a number",
+                    path.display(),
+                    k + 2
+                ))
+            })?);
+        }
+        if values.len() - before != header.len() {
+            return Err(PyValueError::new_err(format!(
+                "{} line {}: {} values for {} columns",
+                path.display(),
+                k + 2,
+                values.len() - before,
+                header.len()
+            )));
+        }
+        rows += 1;
+    }
+    let array = Array2::from_shape_vec((rows, header.len()), values).expect("checked per row");
+    Ok((header, array.into_pyarray(py)))
+}
+
+#[pymodule]
+fn _tinydem(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Simulation>()?;
+    m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add_function(wrap_pyfunction!(read_csv, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

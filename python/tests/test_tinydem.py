@@ -1,0 +1,203 @@
+"""The Python package against the engine: stepping from Python gives bitwise the frames of
+`tinydem run`, the arrays are numpy in id order, the readers read what runs write."""
+
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import tinydem
+
+ROOT = Path(__file__).resolve().parents[2]
+MESH = ROOT / "assets" / "hourglass.off"
+STEPS_PER_FRAME = 150
+FRAMES = 4
+
+
+def scenario(directory: Path, extra: str = "") -> Path:
+    """A short hourglass run: 300 grains spawned and falling on the funnel."""
+    path = directory / "s.toml"
+    path.write_text(
+        f'[geometry]\nmesh = "{MESH}"\n'
+        f"[simulation]\nmax_particles = 300\nframes = {FRAMES}\n"
+        f"steps_per_frame = {STEPS_PER_FRAME}\n{extra}"
+    )
+    return path
+
+
+@pytest.fixture(scope="module")
+def study(tmp_path_factory):
+    """A scenario and the output directory tinydem.run wrote for it."""
+    d = tmp_path_factory.mktemp("study")
+    s = scenario(d)
+    out = tinydem.run(s, output=d / "out")
+    return s, Path(out)
+
+
+def test_stepping_gives_the_frames_of_a_run(study, tmp_path):
+    s, out = study
+    sim = tinydem.Simulation(s, threads=2)
+    for k in range(1, FRAMES + 1):
+        sim.step(STEPS_PER_FRAME)
+        sim.write_frame(tmp_path / f"f{k}.csv")
+        assert (tmp_path / f"f{k}.csv").read_bytes() == (
+            out / f"particles{k:06d}.csv"
+        ).read_bytes(), f"frame {k}"
+    assert sim.steps == FRAMES * STEPS_PER_FRAME
+    assert sim.time == pytest.approx(sim.steps * sim.timestep, rel=1e-15)
+
+
+def test_the_command_line_writes_the_same_frames(study, tmp_path):
+    """Against the tinydem binary, where CI names it (TINYDEM_BIN) or it is built."""
+    binary = os.environ.get("TINYDEM_BIN") or shutil.which("tinydem")
+    built = ROOT / "target" / "release" / "tinydem"
+    if not binary and built.exists():
+        binary = str(built)
+    if not binary:
+        pytest.skip("no tinydem binary (set TINYDEM_BIN)")
+    s, out = study
+    subprocess.run(
+        [binary, "run", str(s), "-q", "--output", str(tmp_path / "cli")], check=True
+    )
+    for k in range(FRAMES + 1):
+        name = f"particles{k:06d}.csv"
+        assert (tmp_path / "cli" / name).read_bytes() == (out / name).read_bytes()
+
+
+def test_arrays_are_numpy_in_id_order(study):
+    s, _ = study
+    sim = tinydem.Simulation(s)
+    sim.step(300)
+    n = len(sim)
+    assert n > 0
+    for name, shape in [
+        ("positions", (n, 3)),
+        ("velocities", (n, 3)),
+        ("angular_velocities", (n, 3)),
+        ("orientations", (n, 4)),
+        ("radii", (n,)),
+    ]:
+        a = getattr(sim, name)
+        assert isinstance(a, np.ndarray) and a.dtype == np.float64, name
+        assert a.shape == shape, name
+    assert sim.ids.dtype == np.int64
+    assert np.all(np.diff(sim.ids) > 0)
+    assert np.allclose(np.linalg.norm(sim.orientations, axis=1), 1.0)
+    assert np.all((sim.radii >= 0.002) & (sim.radii <= 0.01))
+
+
+def test_velocities_can_be_set(study):
+    s, _ = study
+    sim = tinydem.Simulation(s)
+    sim.step(100)
+    v = np.zeros_like(sim.velocities)
+    v[:, 0] = 1.5
+    sim.velocities = v
+    assert np.array_equal(sim.velocities, v)
+    sim.angular_velocities = np.ones_like(v)
+    assert np.array_equal(sim.angular_velocities, np.ones_like(v))
+    x0 = sim.positions
+    sim.step(1)
+    # Semi-implicit Euler: the new velocity (1.5 m/s plus gravity and contacts) moves x.
+    assert np.median(sim.positions[:, 0] - x0[:, 0]) == pytest.approx(
+        1.5 * sim.timestep, rel=1e-2
+    )
+    with pytest.raises(ValueError, match="shape"):
+        sim.velocities = np.zeros((len(sim) + 1, 3))
+    with pytest.raises(ValueError, match="finite"):
+        sim.velocities = np.full_like(v, np.nan)
+
+
+def test_threads_do_not_change_the_result(study):
+    s, _ = study
+    one, two = tinydem.Simulation(s, threads=1), tinydem.Simulation(s, threads=2)
+    one.step(400)
+    two.step(400)
+    assert np.array_equal(one.positions, two.positions)
+    assert np.array_equal(one.angular_velocities, two.angular_velocities)
+    with pytest.raises(ValueError):
+        tinydem.Simulation(s, threads=0)
+
+
+def test_a_checkpoint_resumes_exactly(study, tmp_path):
+    s, _ = study
+    straight = tinydem.Simulation(s)
+    straight.step(500)
+    half = tinydem.Simulation(s)
+    half.step(250)
+    half.checkpoint(tmp_path / "c.bin")
+    resumed = tinydem.Simulation(s, resume=tmp_path / "c.bin")
+    assert resumed.steps == 250
+    resumed.step(250)
+    assert np.array_equal(resumed.positions, straight.positions)
+    assert np.array_equal(resumed.velocities, straight.velocities)
+
+
+def test_read_output_knows_times_frames_and_log(study):
+    _, out = study
+    o = tinydem.read_output(out)
+    assert len(o) == FRAMES + 1
+    assert list(o.steps) == [k * STEPS_PER_FRAME for k in range(FRAMES + 1)]
+    dt = tinydem.Simulation(o.scenario).timestep
+    assert np.allclose(o.times, o.steps * dt, rtol=1e-15)
+    last = o[-1]
+    assert set("x y z R vx vy vz q0 q1 q2 q3 wx wy wz".split()) <= set(last)
+    assert len(o.frames[1:3]) == 2
+    # log.csv: the kinetic energy of each frame, from its velocities and radii.
+    log = o.log
+    assert list(log["frame"]) == list(o.numbers)
+    f = o[FRAMES]
+    m = 4.0 / 3.0 * np.pi * 1000.0 * f["R"] ** 3
+    v2 = f["vx"] ** 2 + f["vy"] ** 2 + f["vz"] ** 2
+    w2 = f["wx"] ** 2 + f["wy"] ** 2 + f["wz"] ** 2
+    energy = np.sum(0.5 * m * v2 + 0.5 * 0.4 * m * f["R"] ** 2 * w2)
+    assert log["kinetic_energy"][-1] == pytest.approx(energy, rel=1e-12)
+    assert log["particles"].dtype == np.int64
+    assert o.checkpoint.is_file()
+
+
+def test_read_frame_reads_tags_and_ids(tmp_path):
+    frame = tmp_path / "f.csv"
+    frame.write_text(
+        "x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz,tag,id,material\n"
+        "0,0,0,0.01,1,0,0,1,0,0,0,0,0,0,3,7,1\n"
+    )
+    f = tinydem.read_frame(frame)
+    assert f["tag"].dtype == np.int64 and f["id"][0] == 7 and f["R"][0] == 0.01
+    frame.write_text("x,y\n1,oops\n")
+    with pytest.raises(ValueError, match="not a number"):
+        tinydem.read_frame(frame)
+    with pytest.raises(FileNotFoundError):
+        tinydem.read_output(tmp_path)
+
+
+def test_errors_are_python_exceptions(tmp_path):
+    with pytest.raises(RuntimeError, match="cannot read scenario"):
+        tinydem.Simulation(tmp_path / "missing.toml")
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[simulation]\nframes = -1\n")
+    with pytest.raises(RuntimeError):
+        tinydem.Simulation(bad)
+
+
+def test_an_unstable_run_raises(tmp_path):
+    (tmp_path / "p.csv").write_text(
+        "x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz\n"
+        "-0.0125,0,0,0.002,5,0,0,1,0,0,0,0,0,0\n0,0,0,0.01,0,0,0,1,0,0,0,0,0,0\n"
+    )
+    s = tmp_path / "s.toml"
+    s.write_text(
+        "[geometry]\nradius_min = 0.002\nradius_max = 0.01\n"
+        "[kinetics]\ngravity = [0.0, 0.0, 0.0]\n"
+        "[simulation]\ntimestep = 1e-3\nmax_particles = 0\n"
+        '[input]\nparticles = "p.csv"\n'
+    )
+    sim = tinydem.Simulation(s)
+    with pytest.raises(RuntimeError, match="unstable"):
+        sim.step(10)
+    # run() refuses that time step unless forced.
+    with pytest.raises(RuntimeError, match="--force"):
+        tinydem.run(s, output=tmp_path / "out")

@@ -1,0 +1,84 @@
+"""Type stubs of the engine module (Rust, pyo3): see tinydem/__init__.py for the readers."""
+
+import os
+from pathlib import Path
+from typing import Dict, List, Optional, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+_Path = Union[str, "os.PathLike[str]"]
+
+__version__: str
+
+class Simulation:
+    """A simulation of a scenario file, stepped from Python; arrays are copies in id order.
+
+    Stepping gives bitwise the states of `tinydem run` for any number of threads."""
+
+    def __init__(
+        self,
+        scenario: _Path,
+        threads: Optional[int] = None,
+        resume: Optional[_Path] = None,
+        from_checkpoint: Optional[_Path] = None,
+    ) -> None: ...
+    def step(self, n: int = 1) -> None:
+        """Advances by n time steps; RuntimeError when the run becomes unstable."""
+    @property
+    def time(self) -> float:
+        """Simulated time [s]."""
+    @property
+    def steps(self) -> int:
+        """Time steps taken."""
+    @property
+    def timestep(self) -> float:
+        """The time step [s]."""
+    def __len__(self) -> int: ...
+    @property
+    def positions(self) -> npt.NDArray[np.float64]:
+        """(N, 3) centres [m]."""
+    @property
+    def velocities(self) -> npt.NDArray[np.float64]:
+        """(N, 3) velocities [m/s]; settable with an (N, 3) array."""
+    @velocities.setter
+    def velocities(self, v: npt.ArrayLike) -> None: ...
+    @property
+    def angular_velocities(self) -> npt.NDArray[np.float64]:
+        """(N, 3) angular velocities [rad/s]; settable with an (N, 3) array."""
+    @angular_velocities.setter
+    def angular_velocities(self, w: npt.ArrayLike) -> None: ...
+    @property
+    def orientations(self) -> npt.NDArray[np.float64]:
+        """(N, 4) unit quaternions (w, x, y, z)."""
+    @property
+    def radii(self) -> npt.NDArray[np.float64]:
+        """(N,) radii [m]."""
+    @property
+    def ids(self) -> npt.NDArray[np.int64]:
+        """(N,) particle ids, ascending."""
+    @property
+    def tags(self) -> npt.NDArray[np.int64]: ...
+    @property
+    def materials(self) -> npt.NDArray[np.int64]: ...
+    def thermo(self) -> Dict[str, float]:
+        """The columns of log.csv for the current state."""
+    def write_frame(self, path: _Path) -> None:
+        """Writes a CSV frame in the format of the run's particlesNNNNNN.csv."""
+    def checkpoint(self, path: _Path) -> None:
+        """Writes a checkpoint (resume=path continues it exactly)."""
+
+def run(
+    scenario: _Path,
+    output: Optional[_Path] = None,
+    threads: Optional[int] = None,
+    overwrite: bool = False,
+    force: bool = False,
+    resume: Optional[_Path] = None,
+    from_checkpoint: Optional[_Path] = None,
+    quiet: bool = True,
+) -> Path:
+    """Runs a scenario as `tinydem run` does; returns the output directory."""
+
+def read_csv(path: _Path) -> Tuple[List[str], npt.NDArray[np.float64]]:
+    """A numeric CSV file: its column names and an (rows, columns) array."""
