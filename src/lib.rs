@@ -23,4 +23,5 @@ pub mod scenario;
 pub mod simulation;
 pub mod spawn;
 pub mod surface;
+pub mod text;
 pub mod vtk;

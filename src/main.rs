@@ -8,8 +8,9 @@ use clap::{Parser, Subcommand};
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
+use glam::DVec3;
 use tinydem::check::{describe, describe_stage};
-use tinydem::render::{ColorBy, Style, View};
+use tinydem::render::{Animation, ColorBy, Fixed, Style, View};
 use tinydem::run::{Interrupted, Options, Summary, Verbosity, run};
 use tinydem::scenario::Scenario;
 use tinydem::simulation::Stage;
@@ -126,6 +127,19 @@ enum Command {
         /// For a directory, also write an animated GIF `animation.gif`.
         #[arg(long)]
         gif: bool,
+        /// For a directory, also write a movie `animation.mp4` (with the system's ffmpeg;
+        /// an animated GIF where there is none).
+        #[arg(long, conflicts_with = "gif")]
+        movie: bool,
+        /// The values at the ends of the colour bar, LO,HI (default: fitted to all frames).
+        #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+        range: Option<Vec<f64>>,
+        /// The box to show, X0,Y0,Z0,X1,Y1,Z1 [m] (default: fitted to all frames).
+        #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+        bounds: Option<Vec<f64>>,
+        /// Draw a scale bar.
+        #[arg(long)]
+        scale_bar: bool,
     },
     /// The dense-packing benchmark of the paper's Section 5: timed steps in settled
     /// packings; each size and thread count runs in its own process.
@@ -289,14 +303,68 @@ fn execute(
             color,
             view,
             gif,
+            movie,
+            range,
+            bounds,
+            scale_bar,
         }) => {
             let style = Style {
                 width,
                 height,
                 color,
                 view,
+                scale_bar,
             };
-            render_command(&path, output, scenario, &mesh, &style, gif)?;
+            if let Some(r) = range.as_ref().filter(|r| r.len() != 2) {
+                anyhow::bail!("--range takes two numbers LO,HI, not {}", r.len());
+            }
+            if let Some(b) = bounds.as_ref().filter(|b| b.len() != 6) {
+                anyhow::bail!(
+                    "--bounds takes six numbers X0,Y0,Z0,X1,Y1,Z1, not {}",
+                    b.len()
+                );
+            }
+            let fixed = Fixed {
+                range: range.map(|r| (r[0], r[1])),
+                bounds: bounds
+                    .map(|b| (DVec3::new(b[0], b[1], b[2]), DVec3::new(b[3], b[4], b[5]))),
+            };
+            if let Some((lo, hi)) = fixed.range {
+                anyhow::ensure!(
+                    lo < hi && lo.is_finite() && hi.is_finite(),
+                    "--range {lo},{hi}: LO must be below HI"
+                );
+            }
+            let animation = match (gif, movie) {
+                (_, true) => Animation::Movie,
+                (true, _) => Animation::Gif,
+                _ => Animation::None,
+            };
+            let done = tinydem::render::render_path(
+                &path,
+                output.as_deref(),
+                scenario.as_deref(),
+                &mesh,
+                &style,
+                &fixed,
+                animation,
+            )?;
+            for note in &done.notes {
+                eprintln!("note: {note}");
+            }
+            match done.pictures.as_slice() {
+                [one] => eprintln!("picture in {}", one.display()),
+                all => eprintln!(
+                    "{} pictures in {}",
+                    all.len(),
+                    all[0]
+                        .parent()
+                        .map_or(".".into(), |d| d.display().to_string())
+                ),
+            }
+            if let Some(a) = done.animation {
+                eprintln!("animation in {}", a.display());
+            }
         }
         Some(Command::Analyze {
             dir,
@@ -439,104 +507,6 @@ fn run_toml(dir: &std::path::Path) -> Option<PathBuf> {
     p.is_file().then_some(p)
 }
 
-/// `tinydem render`: one frame, or every frame of a directory.
-fn render_command(
-    path: &std::path::Path,
-    output: Option<PathBuf>,
-    scenario: Option<PathBuf>,
-    meshes: &[PathBuf],
-    style: &Style,
-    gif: bool,
-) -> Result<()> {
-    let scenario = scenario.or_else(|| {
-        if path.is_dir() {
-            run_toml(path)
-        } else {
-            path.parent().and_then(run_toml)
-        }
-    });
-    let mut sim = match &scenario {
-        Some(s) => {
-            let s = Scenario::load(s)?;
-            Some(tinydem::simulation::Simulation::new(Scenario {
-                particles: None,
-                ..s
-            })?)
-        }
-        None => None,
-    };
-    let mut extra = tinydem::mesh::Mesh::default();
-    for m in meshes {
-        // Radii do not show in pictures; accept any radius index of an OFF file.
-        let part = tinydem::mesh::Mesh::load(m, &[0.0; 1024])?;
-        extra.faces.extend(part.faces);
-    }
-    let frame_number = |p: &std::path::Path| -> Option<u64> {
-        let name = p.file_stem()?.to_str()?;
-        name.strip_prefix("particles")?.parse().ok()
-    };
-    let mut draw = |frame: &std::path::Path, png: &std::path::Path| -> Result<image::RgbImage> {
-        let particles = tinydem::csv::load_particles(frame)?;
-        let mut mesh = extra.clone();
-        if let Some(sim) = sim.as_mut() {
-            let s = &sim.scenario.simulation;
-            let t = frame_number(frame).unwrap_or(0) as f64 * s.steps_per_frame as f64 * s.timestep;
-            mesh.faces.extend(sim.mesh_at(t).faces.iter().copied());
-        }
-        let img = tinydem::render::render(&particles, &mesh, style)?;
-        img.save(png)
-            .with_context(|| format!("cannot write {}", png.display()))?;
-        Ok(img)
-    };
-    if path.is_dir() {
-        let mut frames: Vec<PathBuf> = std::fs::read_dir(path)
-            .with_context(|| format!("cannot read directory {}", path.display()))?
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| frame_number(p).is_some() && p.extension().is_some_and(|e| e == "csv"))
-            .collect();
-        frames.sort();
-        anyhow::ensure!(
-            !frames.is_empty(),
-            "{}: no frames particlesNNNNNN.csv",
-            path.display()
-        );
-        let out_dir = output.unwrap_or_else(|| path.to_path_buf());
-        std::fs::create_dir_all(&out_dir)
-            .with_context(|| format!("cannot create {}", out_dir.display()))?;
-        let mut images = Vec::new();
-        for f in &frames {
-            let png = out_dir.join(f.with_extension("png").file_name().expect("a file name"));
-            let img = draw(f, &png)?;
-            if gif {
-                images.push(img);
-            }
-        }
-        eprintln!("{} pictures in {}", frames.len(), out_dir.display());
-        if gif {
-            let path = out_dir.join("animation.gif");
-            let file = std::fs::File::create(&path)
-                .with_context(|| format!("cannot write {}", path.display()))?;
-            let mut enc = image::codecs::gif::GifEncoder::new_with_speed(file, 10);
-            enc.set_repeat(image::codecs::gif::Repeat::Infinite)?;
-            for img in images {
-                let rgba = image::DynamicImage::ImageRgb8(img).to_rgba8();
-                enc.encode_frame(image::Frame::from_parts(
-                    rgba,
-                    0,
-                    0,
-                    image::Delay::from_numer_denom_ms(100, 1),
-                ))?;
-            }
-            eprintln!("animation in {}", path.display());
-        }
-    } else {
-        let png = output.unwrap_or_else(|| path.with_extension("png"));
-        draw(path, &png)?;
-        eprintln!("picture in {}", png.display());
-    }
-    Ok(())
-}
-
 /// `tinydem analyze`: a table of measurements, one row per frame.
 fn analyze_command(
     dir: &std::path::Path,
@@ -660,7 +630,20 @@ fn analyze_command(
                 )
             })
             .collect();
-        tinydem::plot::line_plot(&points, 640, 400)?
+        let unit = match column.as_str() {
+            "time" => " [s]",
+            "kinetic_energy" => " [J]",
+            "large_mean_height" | "tagged_mean_height" => " [m]",
+            "repose_left_deg" | "repose_right_deg" => " [°]",
+            "coordination" => " [contacts per particle]",
+            _ => "",
+        };
+        let y = format!("{column}{unit}");
+        let axes = tinydem::plot::Axes {
+            x: "time [s]",
+            y: &y,
+        };
+        tinydem::plot::line_plot(&points, 800, 500, &axes)?
             .save(&path)
             .with_context(|| format!("cannot write {}", path.display()))?;
         eprintln!("plot of {column} against time in {}", path.display());

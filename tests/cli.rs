@@ -352,9 +352,9 @@ fn render_draws_frames_and_directories() {
             "s.toml",
             "--gif",
             "--width",
-            "64",
+            "160",
             "--height",
-            "48",
+            "120",
         ],
         t.path(),
     );
@@ -364,6 +364,70 @@ fn render_draws_frames_and_directories() {
     }
     let gif = std::fs::read(t.path().join("out/animation.gif")).unwrap();
     assert!(gif.starts_with(b"GIF89a"));
+    // One view for all frames: the static mesh's edges are the same pixels in each picture
+    // (the run.toml of the directory supplies the mesh), and so is the colour bar.
+    let pictures: Vec<image::RgbImage> = (0..=4)
+        .map(|k| {
+            image::open(t.path().join(format!("out/particles{k:06}.png")))
+                .unwrap()
+                .to_rgb8()
+        })
+        .collect();
+    let edge = |img: &image::RgbImage| {
+        img.enumerate_pixels()
+            .filter(|(_, _, p)| p.0 == [60, 60, 60])
+            .map(|(x, y, _)| (x, y))
+            .collect::<std::collections::BTreeSet<_>>()
+    };
+    let first = edge(&pictures[0]);
+    assert!(first.len() > 100, "{}", first.len());
+    let last = edge(&pictures[4]);
+    assert!(last.is_subset(&first), "the view moved");
+    // --range and --bounds, and a movie (an animated GIF where ffmpeg is missing).
+    let o = common::tinydem_with_env(
+        &[
+            "render",
+            "out",
+            "-o",
+            "pics",
+            "--movie",
+            "--range",
+            "0,5",
+            "--bounds",
+            "-0.2,-0.2,-0.3,0.2,0.2,0.3",
+            "--scale-bar",
+            "--width",
+            "200",
+            "--height",
+            "150",
+        ],
+        t.path(),
+        &[("PATH", "/nonexistent")],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("an animated GIF instead"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(t.path().join("pics/animation.gif").exists());
+    fails_with(
+        &tinydem(&["render", "out", "--range", "5,1"], t.path()),
+        &["--range 5,1"],
+    );
+    // With the system's ffmpeg (CI installs it), an MP4.
+    let ffmpeg = std::process::Command::new("ffmpeg")
+        .arg("-version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if ffmpeg {
+        let o = tinydem(&["render", "out", "-o", "movie", "--movie"], t.path());
+        assert!(o.status.success(), "{}", stderr(&o));
+        let mp4 = std::fs::read(t.path().join("movie/animation.mp4")).unwrap();
+        assert_eq!(&mp4[4..8], b"ftyp", "an MP4 file");
+    } else {
+        eprintln!("no ffmpeg: the MP4 path is not tested here");
+    }
     fails_with(
         &tinydem(&["render", "nope.csv"], t.path()),
         &["cannot read particle file nope.csv"],

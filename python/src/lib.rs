@@ -328,6 +328,96 @@ fn run(
     Ok(out)
 }
 
+/// Renders a frame `particlesNNNNNN.csv` to a PNG, or every frame of an output directory
+/// in one view and colour range (as `tinydem render`); returns a dict with the `pictures`
+/// written and the `animation` (GIF, or MP4 with the system's ffmpeg), if any.
+///
+/// color: "speed", "height", "radius", "tag" or "material"; view: "front", "side", "top"
+/// or "iso"; range: (lo, hi) of the colour bar; bounds: ((x0, y0, z0), (x1, y1, z1)), the
+/// box to show; scenario: whose meshes to draw (default: the directory's run.toml).
+#[pyfunction]
+#[pyo3(signature = (path, output=None, color="speed", view="iso", width=800, height=600, gif=false, movie=false, range=None, bounds=None, scale_bar=false, scenario=None))]
+#[allow(clippy::too_many_arguments)]
+fn render<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    output: Option<PathBuf>,
+    color: &str,
+    view: &str,
+    width: u32,
+    height: u32,
+    gif: bool,
+    movie: bool,
+    range: Option<(f64, f64)>,
+    bounds: Option<([f64; 3], [f64; 3])>,
+    scale_bar: bool,
+    scenario: Option<PathBuf>,
+) -> PyResult<Bound<'py, PyDict>> {
+    use tinydem::render::{Animation, ColorBy, Fixed, Style, View};
+    let color = match color {
+        "speed" => ColorBy::Speed,
+        "height" => ColorBy::Height,
+        "radius" => ColorBy::Radius,
+        "tag" => ColorBy::Tag,
+        "material" => ColorBy::Material,
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "color {other:?}: one of speed, height, radius, tag, material"
+            )));
+        }
+    };
+    let view = match view {
+        "front" => View::Front,
+        "side" => View::Side,
+        "top" => View::Top,
+        "iso" => View::Iso,
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "view {other:?}: one of front, side, top, iso"
+            )));
+        }
+    };
+    if let Some((lo, hi)) = range
+        && !(lo < hi && lo.is_finite() && hi.is_finite())
+    {
+        return Err(PyValueError::new_err("range (lo, hi) needs lo < hi"));
+    }
+    let style = Style {
+        width,
+        height,
+        color,
+        view,
+        scale_bar,
+    };
+    let fixed = Fixed {
+        range,
+        bounds: bounds.map(|(a, b)| (DVec3::from_array(a), DVec3::from_array(b))),
+    };
+    let animation = match (gif, movie) {
+        (_, true) => tinydem::render::Animation::Movie,
+        (true, _) => Animation::Gif,
+        _ => Animation::None,
+    };
+    let done = py
+        .detach(|| {
+            tinydem::render::render_path(
+                &path,
+                output.as_deref(),
+                scenario.as_deref(),
+                &[],
+                &style,
+                &fixed,
+                animation,
+            )
+        })
+        .map_err(error)?;
+    let d = PyDict::new(py);
+    d.set_item("pictures", done.pictures)?;
+    d.set_item("animation", done.animation)?;
+    d.set_item("notes", done.notes)?;
+    Ok(d)
+}
+
 /// Reads a numeric CSV file with a header line (a frame, `log.csv`, `frames.csv`):
 /// the column names and the values, row by row, as an (rows, columns) array.
 #[pyfunction]
@@ -380,6 +470,7 @@ fn _tinydem(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Simulation>()?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(read_csv, m)?)?;
+    m.add_function(wrap_pyfunction!(render, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -4,6 +4,7 @@
 import os
 import shutil
 import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -201,3 +202,39 @@ def test_an_unstable_run_raises(tmp_path):
     # run() refuses that time step unless forced.
     with pytest.raises(RuntimeError, match="--force"):
         tinydem.run(s, output=tmp_path / "out")
+
+
+def test_render_draws_a_directory_and_an_animation(study, tmp_path):
+    _, out = study
+    done = tinydem.render(out, output=tmp_path / "pics", gif=True, width=320, height=240)
+    assert len(done["pictures"]) == FRAMES + 1
+    assert all(Path(p).is_file() for p in done["pictures"])
+    assert Path(done["animation"]).read_bytes().startswith(b"GIF89a")
+    one = tinydem.render(
+        out / "particles000002.csv",
+        output=tmp_path / "one.png",
+        color="height",
+        view="front",
+        range=(0.0, 0.1),
+        scale_bar=True,
+    )
+    assert [Path(p) for p in one["pictures"]] == [tmp_path / "one.png"]
+    with pytest.raises(ValueError, match="color"):
+        tinydem.render(out, color="colour")
+    with pytest.raises(ValueError, match="range"):
+        tinydem.render(out, range=(1.0, 0.0))
+
+
+def test_the_example_study_runs():
+    """examples/python/study.py, the notebook-style example, runs start to end."""
+    script = ROOT / "examples" / "python" / "study.py"
+    done = subprocess.run(
+        [sys.executable, str(script)],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert done.returncode == 0, done.stderr
+    assert "animation in" in done.stdout
+    out = ROOT / "examples" / "python" / "output"
+    assert (out / "log.csv").is_file() and (out / "kicked.bin").is_file()

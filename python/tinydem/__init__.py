@@ -22,7 +22,7 @@ from typing import Dict, Iterator, List, Optional, Sequence, Union, overload
 
 import numpy as np
 
-from ._tinydem import Simulation, __version__, read_csv, run
+from ._tinydem import Simulation, __version__, read_csv, render, run
 
 __all__ = [
     "Simulation",

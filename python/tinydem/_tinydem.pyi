@@ -82,3 +82,20 @@ def run(
 
 def read_csv(path: _Path) -> Tuple[List[str], npt.NDArray[np.float64]]:
     """A numeric CSV file: its column names and an (rows, columns) array."""
+
+def render(
+    path: _Path,
+    output: Optional[_Path] = None,
+    color: str = "speed",
+    view: str = "iso",
+    width: int = 800,
+    height: int = 600,
+    gif: bool = False,
+    movie: bool = False,
+    range: Optional[Tuple[float, float]] = None,
+    bounds: Optional[Tuple[Tuple[float, float, float], Tuple[float, float, float]]] = None,
+    scale_bar: bool = False,
+    scenario: Optional[_Path] = None,
+) -> Dict[str, object]:
+    """Pictures of a frame or of every frame of a directory in one view and colour range;
+    returns {"pictures": [paths], "animation": path or None, "notes": [str]}."""

@@ -35,3 +35,13 @@ pub fn tinydem(args: &[&str], dir: &Path) -> Output {
         .output()
         .expect("binary runs")
 }
+
+/// Runs the `tinydem` binary with `args` in `dir`, with the environment variables `env` set.
+pub fn tinydem_with_env(args: &[&str], dir: &Path, env: &[(&str, &str)]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_tinydem"))
+        .args(args)
+        .envs(env.iter().copied())
+        .current_dir(dir)
+        .output()
+        .expect("binary runs")
+}
