@@ -562,6 +562,7 @@ fn analyze_command(
     }
     let densities: Vec<f64> = s.materials.iter().map(|m| m.properties.density).collect();
     let mut rows = Vec::new();
+    let mut no_pile = 0;
     println!(
         "{}",
         header
@@ -569,6 +570,7 @@ fn analyze_command(
             .map(|h| format!("{h:>17}"))
             .collect::<String>()
     );
+    let count = frames.len();
     for (k, path) in frames {
         let p = tinydem::csv::load_particles(&path)?;
         let mut row = vec![
@@ -582,7 +584,10 @@ fn analyze_command(
         if repose {
             match angle_of_repose(&p) {
                 Some((l, r)) => row.extend([format!("{l:.2}"), format!("{r:.2}")]),
-                None => row.extend(["nan".into(), "nan".into()]),
+                None => {
+                    no_pile += 1;
+                    row.extend(["nan".into(), "nan".into()])
+                }
             }
         }
         if let Some(r) = large {
@@ -605,6 +610,14 @@ fn analyze_command(
             row.iter().map(|v| format!("{v:>17}")).collect::<String>()
         );
         rows.push(row.join(","));
+    }
+    if no_pile > 0 {
+        eprintln!(
+            "note: --repose found no pile to fit in {no_pile} of {} frames (nan): it fits the two \
+             flanks of a heap in the x-z plane, each over at least 3 bins between 25 % and 85 % of \
+             its height",
+            count
+        );
     }
     if let Some(path) = csv {
         std::fs::write(

@@ -38,6 +38,18 @@ use crate::motion::Motion;
 /// runs with no files.
 pub const HOURGLASS_OFF: &str = include_str!("../assets/hourglass.off");
 
+/// The value of `[geometry] mesh` that names the built-in hourglass (as `run.toml` of a
+/// default run does).
+pub const BUILTIN_HOURGLASS: &str = "builtin:hourglass";
+
+/// The built-in hourglass as a mesh source.
+fn builtin_hourglass() -> MeshSource {
+    MeshSource::Embedded {
+        name: "hourglass.off (built in)",
+        text: HOURGLASS_OFF,
+    }
+}
+
 /// Where the static mesh comes from.
 #[derive(Clone, Debug, PartialEq)]
 pub enum MeshSource {
@@ -951,10 +963,7 @@ impl Default for Scenario {
     fn default() -> Self {
         let mut s = Scenario::from_raw(RawScenario::default(), Path::new("."))
             .expect("Table 2 defaults are valid");
-        s.geometry.mesh = MeshSource::Embedded {
-            name: "hourglass.off (built in)",
-            text: HOURGLASS_OFF,
-        };
+        s.geometry.mesh = builtin_hourglass();
         s
     }
 }
@@ -1020,9 +1029,11 @@ impl Scenario {
         let geometry = Geometry {
             radius_min,
             radius_max,
-            mesh: g
-                .mesh
-                .map_or(MeshSource::None, |p| MeshSource::File(base.join(p))),
+            mesh: match g.mesh {
+                None => MeshSource::None,
+                Some(p) if p.as_os_str() == BUILTIN_HOURGLASS => builtin_hourglass(),
+                Some(p) => MeshSource::File(base.join(p)),
+            },
             mesh_radii,
             mesh_contacts: contacts("[geometry] mesh_contacts", g.mesh_contacts)?,
             mesh_material: 0,
@@ -1373,7 +1384,7 @@ impl Scenario {
                 let _ = writeln!(o, "mesh = {}", path(p));
             }
             MeshSource::Embedded { name, .. } => {
-                let _ = writeln!(o, "# mesh: {name}");
+                let _ = writeln!(o, "mesh = {}  # {name}", text(BUILTIN_HOURGLASS));
             }
         }
         let _ = writeln!(o, "mesh_radii = {}", list(&g.mesh_radii));
@@ -1744,10 +1755,13 @@ mod tests {
         .unwrap();
         let again = Scenario::parse(&moving.to_toml(), Path::new("run.toml")).unwrap();
         assert_eq!(again, moving, "{}", moving.to_toml());
+        // The default run's names the built-in mesh, and reads back as it.
         let d = Scenario::default();
-        let mut again = Scenario::parse(&d.to_toml(), Path::new("run.toml")).unwrap();
-        assert!(d.to_toml().contains("# mesh: hourglass.off (built in)"));
-        again.geometry.mesh = d.geometry.mesh.clone();
+        assert!(
+            d.to_toml()
+                .contains("mesh = \"builtin:hourglass\"  # hourglass.off (built in)")
+        );
+        let again = Scenario::parse(&d.to_toml(), Path::new("run.toml")).unwrap();
         assert_eq!(again, d);
     }
 

@@ -1,0 +1,147 @@
+#!/usr/bin/env python3
+"""Remakes the README's pictures: runs the default simulation and every example (about 10
+minutes on 2 cores), then draws them with the renderer. Needs the Python package
+(`python3 -m pip install ./python`), the built binary (`cargo build --release`, for
+`analyze --plot`) and, for the pictures of two panels, ffmpeg (its hstack filter).
+
+    python3 docs/pictures.py [NAME ...]      # all, or some of: hourglass b c d e f g h
+
+Runs go to /tmp/tinydem-pictures/NAME; pictures to docs/.
+"""
+
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+import tinydem
+
+ROOT = Path(__file__).resolve().parents[1]
+DOCS = ROOT / "docs"
+EXAMPLES = ROOT / "examples"
+WORK = Path("/tmp/tinydem-pictures")
+BINARY = ROOT / "target" / "release" / "tinydem"
+
+
+def run(name, scenario, **kw):
+    out = WORK / name
+    print(f"running {scenario} into {out}", flush=True)
+    return Path(tinydem.run(scenario, output=out, overwrite=True, **kw))
+
+
+def frame_at(out, t):
+    """The number of the frame of `out` nearest the time t [s]."""
+    o = tinydem.read_output(out)
+    return int(o.numbers[int(np.argmin(np.abs(o.times - t)))])
+
+
+def frame(out, k):
+    return out / f"particles{k:06d}.csv"
+
+
+def cut(out, k, half, into):
+    """The slab |y| < half of frame k of `out`, as frame k of the directory `into` (so that
+    it keeps its frame number and so its time)."""
+    into.mkdir(parents=True, exist_ok=True)
+    src = frame(out, k)
+    dst = into / src.name
+    with open(src) as f, open(dst, "w") as g:
+        header = f.readline()
+        g.write(header)
+        y = header.strip().split(",").index("y")
+        for line in f:
+            if abs(float(line.split(",")[y])) < half:
+                g.write(line)
+    return dst
+
+
+def side_by_side(left, right, target):
+    subprocess.run(
+        ["ffmpeg", "-y", "-loglevel", "error", "-i", str(left), "-i", str(right),
+         "-filter_complex", "hstack", str(target)],
+        check=True,
+    )
+
+
+def picture(src, target, **kw):
+    tinydem.render(src, output=target, **kw)
+    print(f"  {target}")
+
+
+def hourglass():
+    out = run("hourglass", EXAMPLES / "a_hourglass" / "scenario.toml")
+    picture(frame(out, 100), DOCS / "hourglass.png", color="height", scale_bar=True)
+
+
+def b():
+    out = run("b", EXAMPLES / "b_mixture" / "scenario.toml")
+    picture(frame(out, 30), DOCS / "b_mixture.png", color="tag", view="front",
+            width=400, height=600, scale_bar=True)
+
+
+def c():
+    out = run("c", EXAMPLES / "c_marble_run" / "scenario.toml")
+    picture(frame(out, frame_at(out, 7.6)), DOCS / "c_marble_run.png", width=640,
+            height=540, scale_bar=True)
+
+
+def d():
+    out = run("d", EXAMPLES / "d_pile" / "scenario.toml")
+    picture(frame(out, 40), DOCS / "d_pile.png", color="radius", view="front",
+            width=720, height=420, scale_bar=True)
+
+
+def e():
+    out = run("e", EXAMPLES / "e_jamming" / "scenario.toml")
+    picture(frame(out, 30), DOCS / "e_jamming.png", view="front", width=420,
+            height=720, range=(0.0, 1.0), scale_bar=True)
+
+
+def f():
+    out = run("f", EXAMPLES / "f_segregation" / "scenario.toml")
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        style = dict(color="radius", view="front", width=400, height=480, scale_bar=True)
+        picture(frame(out, 2), tmp / "l.png", **style)
+        picture(frame(out, 50), tmp / "r.png", **style)
+        side_by_side(tmp / "l.png", tmp / "r.png", DOCS / "f_segregation.png")
+    subprocess.run(
+        [str(BINARY), "analyze", str(out), "--large", "0.02", "--plot",
+         str(DOCS / "f_heights.png"), "--column", "large_mean_height"],
+        check=True, stdout=subprocess.DEVNULL,
+    )
+
+
+def g():
+    fill = run("g1", EXAMPLES / "g_silo" / "1_fill.toml")
+    out = run("g2", EXAMPLES / "g_silo" / "2_discharge.toml",
+              from_checkpoint=fill / "checkpoint.bin")
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        style = dict(color="tag", view="front", width=420, height=600,
+                     scenario=out / "run.toml", scale_bar=True)
+        for side, t in (("l", 0.95), ("r", 2.4)):
+            k = frame_at(out, t)
+            picture(cut(out, k, 0.006, tmp / side), tmp / f"{side}.png", **style)
+        side_by_side(tmp / "l.png", tmp / "r.png", DOCS / "g_silo.png")
+
+
+def h():
+    out = run("h", EXAMPLES / "h_shear_cell" / "scenario.toml")
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        k = int(tinydem.read_output(out).numbers[-1])
+        src = cut(out, k, 0.006, tmp / "cut")
+        style = dict(view="front", width=480, height=420, scenario=out / "run.toml")
+        picture(src, tmp / "l.png", color="material", **style)
+        picture(src, tmp / "r.png", color="speed", **style)
+        side_by_side(tmp / "l.png", tmp / "r.png", DOCS / "h_shear_cell.png")
+
+
+ALL = {"hourglass": hourglass, "b": b, "c": c, "d": d, "e": e, "f": f, "g": g, "h": h}
+
+if __name__ == "__main__":
+    for name in sys.argv[1:] or ALL:
+        ALL[name]()
