@@ -4,6 +4,7 @@
 
 use std::path::PathBuf;
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use glam::{DQuat, DVec3};
 use numpy::ndarray::{Array1, Array2};
@@ -311,6 +312,7 @@ fn run(
     let s = Scenario::load(&scenario).map_err(error)?;
     let out = output.unwrap_or_else(|| s.output_dir.clone());
     let pool = pool(threads)?;
+    let stop = AtomicBool::new(false);
     let options = Options {
         verbosity: if quiet {
             Verbosity::Quiet
@@ -321,11 +323,30 @@ fn run(
         from: from_checkpoint.as_deref(),
         overwrite,
         force,
-        stop: None,
+        stop: Some(&stop),
     };
-    py.detach(|| pool.install(|| tinydem::run::run(s, &out, options)))
-        .map_err(error)?;
-    Ok(out)
+    // The run on a thread of its own; this one watches for Ctrl-C, which stops the run
+    // after its current step with a checkpoint (as on the command line).
+    let mut interrupt = None;
+    let result = std::thread::scope(|scope| {
+        let running = scope.spawn(|| pool.install(|| tinydem::run::run(s, &out, options)));
+        while !running.is_finished() {
+            py.detach(|| std::thread::sleep(std::time::Duration::from_millis(20)));
+            if let Err(e) = py.check_signals() {
+                stop.store(true, Ordering::Relaxed);
+                interrupt.get_or_insert(e);
+            }
+        }
+        running.join().expect("the run does not panic")
+    });
+    match (result, interrupt) {
+        (Ok(_), _) => Ok(out),
+        (Err(e), Some(signal)) => {
+            eprintln!("{e:#}");
+            Err(signal)
+        }
+        (Err(e), None) => Err(error(e)),
+    }
 }
 
 /// Renders a frame `particlesNNNNNN.csv` to a PNG, or every frame of an output directory

@@ -238,3 +238,20 @@ def test_the_example_study_runs():
     assert "animation in" in done.stdout
     out = ROOT / "examples" / "python" / "output"
     assert (out / "log.csv").is_file() and (out / "kicked.bin").is_file()
+
+
+def test_ctrl_c_stops_a_run_with_a_checkpoint_that_resumes(tmp_path):
+    import signal
+    import threading
+
+    s = scenario(tmp_path).read_text().replace(f"frames = {FRAMES}", "frames = 400")
+    (tmp_path / "long.toml").write_text(s)
+    out = tmp_path / "out"
+    timer = threading.Timer(1.0, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        tinydem.run(tmp_path / "long.toml", output=out)
+    timer.join()
+    assert (out / "checkpoint.bin").is_file() and (out / "interrupted.csv").is_file()
+    steps = tinydem.Simulation(tmp_path / "long.toml", resume=out / "checkpoint.bin").steps
+    assert 0 < steps < 400 * STEPS_PER_FRAME
