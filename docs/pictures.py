@@ -4,7 +4,9 @@ minutes on 2 cores), then draws them with the renderer. Needs the Python package
 (`python3 -m pip install ./python`), the built binary (`cargo build --release`, for
 `analyze --plot`) and, for the pictures of two panels, ffmpeg (its hstack filter).
 
-    python3 docs/pictures.py [NAME ...]      # all, or some of: hourglass b c d e f g h
+    python3 docs/pictures.py [--reuse] [NAME ...]   # all, or some of: hourglass b c d e f g h
+
+(--reuse: draw from the runs already in /tmp/tinydem-pictures.)
 
 Runs go to /tmp/tinydem-pictures/NAME; pictures to docs/.
 """
@@ -25,8 +27,13 @@ WORK = Path("/tmp/tinydem-pictures")
 BINARY = ROOT / "target" / "release" / "tinydem"
 
 
+REUSE = "--reuse" in sys.argv
+
+
 def run(name, scenario, **kw):
     out = WORK / name
+    if REUSE and (out / "checkpoint.bin").is_file():
+        return out
     print(f"running {scenario} into {out}", flush=True)
     return Path(tinydem.run(scenario, output=out, overwrite=True, **kw))
 
@@ -89,7 +96,7 @@ def c():
 
 def d():
     out = run("d", EXAMPLES / "d_pile" / "scenario.toml")
-    picture(frame(out, 40), DOCS / "d_pile.png", color="radius", view="front",
+    picture(frame(out, 40), DOCS / "d_pile.png", color="height", view="front",
             width=720, height=420, scale_bar=True)
 
 
@@ -143,5 +150,5 @@ def h():
 ALL = {"hourglass": hourglass, "b": b, "c": c, "d": d, "e": e, "f": f, "g": g, "h": h}
 
 if __name__ == "__main__":
-    for name in sys.argv[1:] or ALL:
+    for name in [a for a in sys.argv[1:] if a != "--reuse"] or ALL:
         ALL[name]()

@@ -334,7 +334,13 @@ pub fn render_in(
     let (w, h) = (style.width as f64, style.height as f64);
     let top = 14.0 * s as f64;
     let scene_w = (w - panel as f64).max(16.0);
-    let scene_h = (h - top).max(16.0);
+    // A band below the scene for the scale bar, so that it never covers the particles.
+    let bottom = if style.scale_bar {
+        14.0 * s as f64
+    } else {
+        0.0
+    };
+    let scene_h = (h - top - bottom).max(16.0);
     let (mut lo, mut hi) = (layout.lo, layout.hi);
     if !lo.is_finite() || !hi.is_finite() {
         lo = DVec3::splat(-1.0);
@@ -531,7 +537,7 @@ pub fn render_in(
             .find(|l| *l <= want)
             .unwrap_or(power);
         let px_len = (length * scale).round() as i64;
-        let (x, y) = (8 * s, h as i64 - 8 * s);
+        let (x, y) = (8 * s, h as i64 - 4 * s);
         for dx in 0..=px_len {
             for dy in 0..2 * s {
                 put(&mut img, x + dx, y - dy, INK);
@@ -548,7 +554,7 @@ pub fn render_in(
         } else {
             format!("{} mm", text::number(length * 1000.0))
         };
-        text::draw(&mut img, x + px_len + 4 * s, y - 7 * s, &label, k, INK);
+        text::draw(&mut img, x + px_len + 4 * s, y - 8 * s, &label, k, INK);
     }
     Ok(img)
 }
