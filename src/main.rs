@@ -335,11 +335,7 @@ fn execute(
                     "--range {lo},{hi}: LO must be below HI"
                 );
             }
-            let animation = match (gif, movie) {
-                (_, true) => Animation::Movie,
-                (true, _) => Animation::Gif,
-                _ => Animation::None,
-            };
+            let animation = Animation::of(gif, movie);
             let done = tinydem::render::render_path(
                 &path,
                 output.as_deref(),

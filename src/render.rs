@@ -569,6 +569,17 @@ pub enum Animation {
     Movie,
 }
 
+impl Animation {
+    /// The animation the flags `gif` and `movie` ask for (a movie if both).
+    pub fn of(gif: bool, movie: bool) -> Animation {
+        match (gif, movie) {
+            (_, true) => Animation::Movie,
+            (true, _) => Animation::Gif,
+            _ => Animation::None,
+        }
+    }
+}
+
 /// What `render_path` made.
 #[derive(Clone, Debug)]
 pub struct Rendered {

@@ -414,11 +414,7 @@ fn render<'py>(
         range,
         bounds: bounds.map(|(a, b)| (DVec3::from_array(a), DVec3::from_array(b))),
     };
-    let animation = match (gif, movie) {
-        (_, true) => tinydem::render::Animation::Movie,
-        (true, _) => Animation::Gif,
-        _ => Animation::None,
-    };
+    let animation = Animation::of(gif, movie);
     let done = py
         .detach(|| {
             tinydem::render::render_path(
