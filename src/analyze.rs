@@ -77,47 +77,158 @@ pub fn packing_fraction(p: &Particles) -> f64 {
     fractions[fractions.len() / 2]
 }
 
-/// The angle of repose of a pile in the x-z plane, left and right flank [degrees].
+/// How [`angle_of_repose`] reads a pile: which grains rest, and which part of each flank it
+/// fits.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReposeWindow {
+    /// Grains slower than this rest [m/s]; the others (the feed, avalanches) are left out.
+    pub rest_speed: f64,
+    /// The fitted part of each flank, as the drop below the apex in mean grain diameters:
+    /// from `from` (below the rounded apex) to `to` (above the foot, where a pile's flank
+    /// curves out: the paper's "logarithmic deviation at the bottom ends").
+    pub from: f64,
+    pub to: f64,
+}
+
+impl Default for ReposeWindow {
+    fn default() -> Self {
+        ReposeWindow {
+            rest_speed: 0.01,
+            from: 3.0,
+            to: 40.0,
+        }
+    }
+}
+
+/// One flank's angle of repose [degrees], with the standard error of the least-squares
+/// slope, over `bins` surface columns one grain diameter wide.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Flank {
+    pub angle: f64,
+    pub error: f64,
+    pub bins: usize,
+}
+
+/// The angles of a pile's two flanks, its height above the floor [m] and the grains at rest.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Repose {
+    pub left: Flank,
+    pub right: Flank,
+    pub height: f64,
+    pub resting: usize,
+}
+
+/// Why a frame holds no pile to measure.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum NoPile {
+    /// Fewer than 20 grains at rest.
+    TooFewResting(usize),
+    /// A flank has fewer than 3 surface columns in the window (the pile is too small, or the
+    /// apex sits at the end of the bed).
+    ShortFlank { side: &'static str, bins: usize },
+}
+
+impl std::fmt::Display for NoPile {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        match self {
+            NoPile::TooFewResting(n) => write!(f, "{n} grains at rest, fewer than 20"),
+            NoPile::ShortFlank { side, bins } => write!(
+                f,
+                "the {side} flank has {bins} columns in the window, fewer than 3"
+            ),
+        }
+    }
+}
+
+/// The angle of repose of a pile in the x-z plane (a quasi-2D heap between plates normal to
+/// y), left and right flank, as the paper measures it: the straight part of each flank of the
+/// resting pile.
 ///
-/// The surface is the highest particle top in bins of two mean diameters along x; each flank
-/// is fitted by least squares over the bins between 25 % and 85 % of the pile's height
-/// (leaving out the rounded apex and the foot).
-pub fn angle_of_repose(p: &Particles) -> Option<(f64, f64)> {
-    if p.len() < 20 {
+/// The surface is the highest top of a resting grain in columns one mean diameter d wide
+/// along x; the apex is the highest column. From there each flank is followed outwards, column
+/// by column, until a column is empty, reaches the floor (its top within d of the lowest
+/// resting grain's bottom) or lies more than `window.to` diameters below the apex; the columns
+/// between `window.from` and `window.to` diameters below the apex are fitted by least squares,
+/// z against x. The error is the standard error of that slope, as an angle.
+pub fn angle_of_repose(p: &Particles, window: ReposeWindow) -> Result<Repose, NoPile> {
+    let resting: Vec<usize> = (0..p.len())
+        .filter(|&k| p.v[k].length() < window.rest_speed)
+        .collect();
+    if resting.len() < 20 {
+        return Err(NoPile::TooFewResting(resting.len()));
+    }
+    let d = 2.0 * resting.iter().map(|&k| p.radius[k]).sum::<f64>() / resting.len() as f64;
+    let floor = resting
+        .iter()
+        .map(|&k| p.x[k].z - p.radius[k])
+        .fold(f64::INFINITY, f64::min);
+    let (xmin, xmax) = resting
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &k| {
+            (a.min(p.x[k].x), b.max(p.x[k].x))
+        });
+    let columns = (((xmax - xmin) / d).floor() as usize) + 1;
+    let mut top = vec![f64::NEG_INFINITY; columns];
+    for &k in &resting {
+        let c = (((p.x[k].x - xmin) / d) as usize).min(columns - 1);
+        top[c] = top[c].max(p.x[k].z + p.radius[k] - floor);
+    }
+    let apex = (0..columns)
+        .max_by(|&a, &b| top[a].total_cmp(&top[b]))
+        .expect("at least one column");
+    let height = top[apex];
+    let flank = |side: &'static str, columns: &mut dyn Iterator<Item = usize>| {
+        let mut points = Vec::new();
+        for c in columns {
+            let drop = height - top[c];
+            if !top[c].is_finite() || top[c] < d || drop > window.to * d {
+                break;
+            }
+            if drop >= window.from * d {
+                points.push((xmin + (c as f64 + 0.5) * d, top[c]));
+            }
+        }
+        fit_slope(&points)
+            .map(|(slope, error)| Flank {
+                angle: slope.abs().atan().to_degrees(),
+                error: (error / (1.0 + slope * slope)).to_degrees(),
+                bins: points.len(),
+            })
+            .ok_or(NoPile::ShortFlank {
+                side,
+                bins: points.len(),
+            })
+    };
+    Ok(Repose {
+        left: flank("left", &mut (0..apex).rev())?,
+        right: flank("right", &mut (apex + 1..columns))?,
+        height,
+        resting: resting.len(),
+    })
+}
+
+/// The least-squares slope of z against x and its standard error; None for fewer than 3
+/// points (or all at one x).
+fn fit_slope(points: &[(f64, f64)]) -> Option<(f64, f64)> {
+    if points.len() < 3 {
         return None;
     }
-    let r_mean = p.radius.iter().sum::<f64>() / p.len() as f64;
-    let w = 4.0 * r_mean;
-    let floor = p.x.iter().map(|x| x.z).fold(f64::INFINITY, f64::min) - r_mean;
-    let (xmin, xmax) =
-        p.x.iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
-                (a.min(x.x), b.max(x.x))
-            });
-    let nbins = (((xmax - xmin) / w).ceil() as usize).max(1);
-    let mut top = vec![f64::NEG_INFINITY; nbins];
-    for (x, r) in p.x.iter().zip(&p.radius) {
-        let b = (((x.x - xmin) / w) as usize).min(nbins - 1);
-        top[b] = top[b].max(x.z + r - floor);
+    let n = points.len() as f64;
+    let (sx, sz) = points
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (x, z)| (a + x, b + z));
+    let (mx, mz) = (sx / n, sz / n);
+    let sxx: f64 = points.iter().map(|(x, _)| (x - mx).powi(2)).sum();
+    let sxz: f64 = points.iter().map(|(x, z)| (x - mx) * (z - mz)).sum();
+    if sxx <= 0.0 {
+        return None;
     }
-    let apex = (0..nbins).max_by(|&a, &b| top[a].total_cmp(&top[b]))?;
-    let h = top[apex];
-    let fit = |bins: &mut dyn Iterator<Item = usize>| -> Option<f64> {
-        let pts: Vec<(f64, f64)> = bins
-            .filter(|&b| top[b] > 0.25 * h && top[b] < 0.85 * h)
-            .map(|b| (xmin + (b as f64 + 0.5) * w, top[b]))
-            .collect();
-        if pts.len() < 3 {
-            return None;
-        }
-        let n = pts.len() as f64;
-        let (sx, sz) = pts.iter().fold((0.0, 0.0), |(a, b), (x, z)| (a + x, b + z));
-        let (mx, mz) = (sx / n, sz / n);
-        let sxx: f64 = pts.iter().map(|(x, _)| (x - mx).powi(2)).sum();
-        let sxz: f64 = pts.iter().map(|(x, z)| (x - mx) * (z - mz)).sum();
-        Some((sxz / sxx).abs().atan().to_degrees())
-    };
-    Some((fit(&mut (0..apex))?, fit(&mut (apex + 1..nbins))?))
+    let slope = sxz / sxx;
+    let residuals: f64 = points
+        .iter()
+        .map(|(x, z)| (z - mz - slope * (x - mx)).powi(2))
+        .sum();
+    Some((slope, (residuals / (n - 2.0) / sxx).sqrt()))
 }
 
 /// Mean height of the particles with radius at least `r` (None if there are none).
@@ -147,27 +258,98 @@ mod tests {
         }
     }
 
-    #[test]
-    fn a_triangular_heap_has_its_angles() {
-        // Particles filling a triangle with flanks of 40° (left) and 50° (right).
-        let r = 0.001;
+    /// Columns of touching grains (radius r, one diameter apart) up to the surface `top(x)`.
+    fn heap(r: f64, xs: std::ops::Range<f64>, top: impl Fn(f64) -> f64) -> Particles {
         let mut p = Particles::default();
-        let (tl, tr) = (40f64.to_radians().tan(), 50f64.to_radians().tan());
-        let mut x = -0.2;
-        while x < 0.2 {
-            let top = if x < 0.0 { 0.1 + x * tl } else { 0.1 - x * tr };
+        let mut x = xs.start;
+        while x < xs.end {
             let mut z = r;
-            while z + r <= top {
+            while z + r <= top(x) {
                 p.push(at(x, z, r));
                 z += 2.0 * r;
             }
             x += 2.0 * r;
         }
-        let (left, right) = angle_of_repose(&p).unwrap();
+        p
+    }
+
+    #[test]
+    fn a_triangular_heap_has_its_angles() {
+        // Flanks of 40° (left) and 50° (right), 50 diameters tall.
+        let r = 0.001;
+        let (tl, tr) = (40f64.to_radians().tan(), 50f64.to_radians().tan());
+        let p = heap(r, -0.2..0.2, |x| {
+            if x < 0.0 { 0.1 + x * tl } else { 0.1 - x * tr }
+        });
+        let a = angle_of_repose(&p, ReposeWindow::default()).unwrap();
         assert!(
-            (left - 40.0).abs() < 1.5 && (right - 50.0).abs() < 1.5,
-            "{left} {right}"
+            (a.left.angle - 40.0).abs() < 1.0 && (a.right.angle - 50.0).abs() < 1.0,
+            "{a:?}"
         );
+        // The staircase of grains is a rough surface: the error is small but not zero, and
+        // the true angle lies within a few of it.
+        assert!(a.left.error > 0.0 && a.left.error < 0.5, "{a:?}");
+        assert!(
+            (a.left.angle - 40.0).abs() < 4.0 * a.left.error + 0.2,
+            "{a:?}"
+        );
+        assert!((a.height - 0.1).abs() < 2.0 * r, "{a:?}");
+    }
+
+    #[test]
+    fn moving_grains_and_the_foot_are_left_out() {
+        // A 45° flank whose foot, the last 10 diameters above the floor, curves out to 20°;
+        // the window (3 to 25 diameters below the apex of a 40-diameter heap) sees the
+        // straight part only.
+        let r = 0.001;
+        let (d, foot) = (2.0 * r, 10.0 * 2.0 * r);
+        let (t45, t20) = (1.0, 20f64.to_radians().tan());
+        let p0 = heap(r, -0.2..0.2, |x| {
+            let z = 0.08 - x.abs() * t45;
+            if z > foot {
+                z
+            } else {
+                foot - (foot - z) * t20 / t45
+            }
+        });
+        let window = ReposeWindow {
+            to: 25.0,
+            ..ReposeWindow::default()
+        };
+        let a = angle_of_repose(&p0, window).unwrap();
+        assert!((a.left.angle - 45.0).abs() < 1.0, "{a:?}");
+        assert!((a.right.angle - 45.0).abs() < 1.0, "{a:?}");
+        // Reaching down to the foot, the fit tilts.
+        let all = angle_of_repose(&p0, ReposeWindow { to: 40.0, ..window }).unwrap();
+        assert!(all.left.angle < a.left.angle - 3.0, "{all:?} {a:?}");
+        // Grains of the feed falling above the apex and sliding down a flank are not the pile.
+        let mut p = p0.clone();
+        for k in 0..30 {
+            let mut q = at(0.001 * k as f64, 0.1 + 0.01 * k as f64, r);
+            q.v = DVec3::new(0.0, 0.0, -1.0);
+            p.push(q);
+            let mut s = at(0.02 + 0.002 * k as f64, 0.07, r);
+            s.v = DVec3::new(0.5, 0.0, -0.5);
+            p.push(s);
+        }
+        assert_eq!(angle_of_repose(&p, window).unwrap(), a);
+        assert!(a.height > 40.0 * d - 2.0 * d, "{a:?}");
+    }
+
+    #[test]
+    fn no_pile_says_why() {
+        let mut gas = heap(0.001, -0.1..0.1, |_| 0.1);
+        for k in 0..gas.len() {
+            gas.v[k] = DVec3::new(1.0, 0.0, 0.0);
+        }
+        assert_eq!(
+            angle_of_repose(&gas, ReposeWindow::default()),
+            Err(NoPile::TooFewResting(0))
+        );
+        let flat = heap(0.001, -0.1..0.1, |_| 0.01);
+        let e = angle_of_repose(&flat, ReposeWindow::default()).unwrap_err();
+        assert!(matches!(e, NoPile::ShortFlank { bins: 0, .. }), "{e:?}");
+        assert!(e.to_string().contains("flank has 0 columns"), "{e}");
     }
 
     #[test]

@@ -82,9 +82,22 @@ enum Command {
         /// The run's scenario, for frame times and the density.
         #[arg(long)]
         scenario: Option<PathBuf>,
-        /// Fit the angle of repose of a pile in the x-z plane (both flanks).
+        /// Fit the angle of repose of a pile in the x-z plane (both flanks, with errors): the
+        /// resting grains' surface, from 3 to 40 diameters below the apex (see --window).
         #[arg(long)]
         repose: bool,
+        /// With --repose: grains slower than this rest [m/s]; only they make the pile.
+        #[arg(long, default_value_t = 0.01, requires = "repose")]
+        rest_speed: f64,
+        /// With --repose: the fitted part of each flank, FROM,TO grain diameters below the apex
+        /// (leaving out the rounded apex and the curved foot).
+        #[arg(
+            long,
+            value_name = "FROM,TO",
+            value_delimiter = ',',
+            requires = "repose"
+        )]
+        window: Option<Vec<f64>>,
         /// Report the mean height of the particles with at least this radius.
         #[arg(long)]
         large: Option<f64>,
@@ -366,6 +379,8 @@ fn execute(
             dir,
             scenario,
             repose,
+            rest_speed,
+            window,
             large,
             tag,
             csv,
@@ -374,7 +389,20 @@ fn execute(
         }) => analyze_command(
             &dir,
             scenario,
-            repose,
+            repose.then(|| {
+                let mut w = tinydem::analyze::ReposeWindow {
+                    rest_speed,
+                    ..Default::default()
+                };
+                if let Some(v) = window {
+                    // Two numbers; anything else fails the check of the window below.
+                    (w.from, w.to) = match v[..] {
+                        [from, to] => (from, to),
+                        _ => (f64::NAN, f64::NAN),
+                    };
+                }
+                w
+            }),
             large,
             tag,
             csv,
@@ -507,7 +535,7 @@ fn run_toml(dir: &std::path::Path) -> Option<PathBuf> {
 fn analyze_command(
     dir: &std::path::Path,
     scenario: Option<PathBuf>,
-    repose: bool,
+    repose: Option<tinydem::analyze::ReposeWindow>,
     large: Option<f64>,
     tag: Option<u32>,
     csv: Option<PathBuf>,
@@ -547,8 +575,21 @@ fn analyze_command(
         "coordination",
         "packing_fraction",
     ];
-    if repose {
-        header.extend(["repose_left_deg", "repose_right_deg"]);
+    if let Some(w) = repose {
+        anyhow::ensure!(
+            w.rest_speed > 0.0 && w.from >= 0.0 && w.to > w.from,
+            "--rest-speed must be positive and --window FROM,TO two numbers with 0 <= FROM < TO \
+             (got {}, {},{})",
+            w.rest_speed,
+            w.from,
+            w.to
+        );
+        header.extend([
+            "repose_left_deg",
+            "repose_left_err_deg",
+            "repose_right_deg",
+            "repose_right_err_deg",
+        ]);
     }
     if large.is_some() {
         header.push("large_mean_height");
@@ -558,7 +599,7 @@ fn analyze_command(
     }
     let densities: Vec<f64> = s.materials.iter().map(|m| m.properties.density).collect();
     let mut rows = Vec::new();
-    let mut no_pile = 0;
+    let mut no_pile = Vec::new();
     println!(
         "{}",
         header
@@ -577,12 +618,15 @@ fn analyze_command(
             format!("{:.4}", coordination_number(&p)),
             format!("{:.4}", packing_fraction(&p)),
         ];
-        if repose {
-            match angle_of_repose(&p) {
-                Some((l, r)) => row.extend([format!("{l:.2}"), format!("{r:.2}")]),
-                None => {
-                    no_pile += 1;
-                    row.extend(["nan".into(), "nan".into()])
+        if let Some(w) = repose {
+            match angle_of_repose(&p, w) {
+                Ok(a) => row.extend(
+                    [a.left.angle, a.left.error, a.right.angle, a.right.error]
+                        .map(|v| format!("{v:.2}")),
+                ),
+                Err(why) => {
+                    no_pile.push((k, why));
+                    row.extend(["nan"; 4].map(String::from))
                 }
             }
         }
@@ -607,12 +651,16 @@ fn analyze_command(
         );
         rows.push(row.join(","));
     }
-    if no_pile > 0 {
+    if let (Some(w), false) = (repose, no_pile.is_empty()) {
+        let (k, why) = &no_pile[no_pile.len() - 1];
         eprintln!(
-            "note: --repose found no pile to fit in {no_pile} of {} frames (nan): it fits the two \
-             flanks of a heap in the x-z plane, each over at least 3 bins between 25 % and 85 % of \
-             its height",
-            count
+            "note: --repose found no pile in {} of {count} frames (nan), e.g. frame {k}: {why}. It \
+             fits the surface of the grains slower than {} m/s, {} to {} diameters below the \
+             highest, on both sides (--rest-speed, --window)",
+            no_pile.len(),
+            w.rest_speed,
+            w.from,
+            w.to
         );
     }
     if let Some(path) = csv {
@@ -643,7 +691,7 @@ fn analyze_command(
             "time" => " [s]",
             "kinetic_energy" => " [J]",
             "large_mean_height" | "tagged_mean_height" => " [m]",
-            "repose_left_deg" | "repose_right_deg" => " [°]",
+            c if c.starts_with("repose_") => " [°]",
             "coordination" => " [contacts per particle]",
             _ => "",
         };

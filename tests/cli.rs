@@ -524,6 +524,80 @@ fn analyze_prints_a_table_and_writes_csv_and_plot() {
     );
 }
 
+/// `analyze --repose`: both flanks with their errors from the resting grains; frames without
+/// a pile give nan and one note that says why; a window that cannot be is refused.
+#[test]
+fn analyze_repose_fits_resting_flanks_and_says_when_there_is_no_pile() {
+    let t = tempfile::tempdir().unwrap();
+    std::fs::create_dir(t.path().join("out")).unwrap();
+    // Frame 0: grains in the air. Frame 1: a resting 45° heap 40 diameters tall.
+    let (r, mut gas, mut heap) = (0.001, String::from(HEADER), String::from(HEADER));
+    for k in 0..100 {
+        gas += &format!("{},0,0.5,{r},0,0,-1,1,0,0,0,0,0,0\n", 0.003 * k as f64);
+    }
+    for c in -40i32..=40 {
+        let x = 2.0 * r * c as f64;
+        let mut z = r;
+        while z + r <= 0.08 - x.abs() {
+            heap += &format!("{x},0,{z},{r},0,0,0,1,0,0,0,0,0,0\n");
+            z += 2.0 * r;
+        }
+    }
+    write(t.path(), "out/particles000000.csv", &gas);
+    write(t.path(), "out/particles000001.csv", &heap);
+    let o = tinydem(&["analyze", "out", "--repose", "--csv", "a.csv"], t.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("no pile in 1 of 2 frames (nan), e.g. frame 0: 0 grains at rest"),
+        "{}",
+        stderr(&o)
+    );
+    let csv = std::fs::read_to_string(t.path().join("a.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert!(
+        lines
+            .next()
+            .unwrap()
+            .ends_with("repose_left_deg,repose_left_err_deg,repose_right_deg,repose_right_err_deg"),
+        "{csv}"
+    );
+    assert!(lines.next().unwrap().ends_with("nan,nan,nan,nan"), "{csv}");
+    let v: Vec<f64> = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    let n = v.len();
+    assert!(
+        (v[n - 4] - 45.0).abs() < 1.0 && (v[n - 2] - 45.0).abs() < 1.0,
+        "{v:?}"
+    );
+    assert!(v[n - 3] < 0.5 && v[n - 1] < 0.5, "{v:?}");
+    // A window reaching further down than the pile changes nothing; one that cannot be is
+    // refused.
+    let o = tinydem(
+        &["analyze", "out", "--repose", "--window", "3,30"],
+        t.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    fails_with(
+        &tinydem(
+            &["analyze", "out", "--repose", "--window", "30,3"],
+            t.path(),
+        ),
+        &["--window FROM,TO two numbers with 0 <= FROM < TO"],
+    );
+    fails_with(
+        &tinydem(&["analyze", "out", "--repose", "--window", "3"], t.path()),
+        &["--window FROM,TO two numbers"],
+    );
+    fails_with(
+        &tinydem(&["analyze", "out", "--window", "3,30"], t.path()),
+        &["--repose"],
+    );
+}
+
 #[test]
 fn a_run_reports_where_its_time_went() {
     let dir = tempfile::tempdir().unwrap();
