@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
-"""Remakes the README's pictures: runs the default simulation and every example (about 10
-minutes on 2 cores), then draws them with the renderer. Needs the Python package
+"""Remakes the README's pictures: runs the default simulation and every example (about an hour
+on 2 cores, most of it D's 20,000-grain pile and F at the paper's size), then draws them with
+the renderer. Needs the Python package
 (`python3 -m pip install ./python`), the built binary (`cargo build --release`, for
 `analyze --plot`) and, for the pictures of two panels, ffmpeg (its hstack filter).
 
@@ -95,15 +96,19 @@ def c():
 
 
 def d():
-    out = run("d", EXAMPLES / "d_pile" / "scenario.toml")
-    picture(frame(out, 40), DOCS / "d_pile.png", color="height", view="front",
-            width=720, height=420, scale_bar=True)
+    out = run("d", EXAMPLES / "d_pile" / "pile_20000.toml")
+    picture(frame(out, int(tinydem.read_output(out).numbers[-1])), DOCS / "d_pile.png",
+            color="height", view="front", width=720, height=420, scale_bar=True)
 
 
 def e():
     out = run("e", EXAMPLES / "e_jamming" / "scenario.toml")
-    picture(frame(out, 30), DOCS / "e_jamming.png", view="front", width=420,
-            height=720, range=(0.0, 1.0), scale_bar=True)
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        style = dict(view="front", width=400, height=720, range=(0.0, 1.0), scale_bar=True)
+        picture(frame(out, frame_at(out, 0.6)), tmp / "l.png", **style)
+        picture(frame(out, int(tinydem.read_output(out).numbers[-1])), tmp / "r.png", **style)
+        side_by_side(tmp / "l.png", tmp / "r.png", DOCS / "e_jamming.png")
 
 
 def f():
@@ -111,8 +116,8 @@ def f():
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         style = dict(color="radius", view="front", width=400, height=480, scale_bar=True)
-        picture(frame(out, 2), tmp / "l.png", **style)
-        picture(frame(out, 50), tmp / "r.png", **style)
+        picture(frame(out, 1), tmp / "l.png", **style)
+        picture(frame(out, int(tinydem.read_output(out).numbers[-1])), tmp / "r.png", **style)
         side_by_side(tmp / "l.png", tmp / "r.png", DOCS / "f_segregation.png")
     subprocess.run(
         [str(BINARY), "analyze", str(out), "--large", "0.02", "--plot",

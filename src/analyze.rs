@@ -95,7 +95,7 @@ impl Default for ReposeWindow {
         ReposeWindow {
             rest_speed: 0.01,
             from: 3.0,
-            to: 40.0,
+            to: 30.0,
         }
     }
 }

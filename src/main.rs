@@ -83,7 +83,7 @@ enum Command {
         #[arg(long)]
         scenario: Option<PathBuf>,
         /// Fit the angle of repose of a pile in the x-z plane (both flanks, with errors): the
-        /// resting grains' surface, from 3 to 40 diameters below the apex (see --window).
+        /// resting grains' surface, from 3 to 30 diameters below the apex (see --window).
         #[arg(long)]
         repose: bool,
         /// With --repose: grains slower than this rest [m/s]; only they make the pile.
