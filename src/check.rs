@@ -18,7 +18,12 @@ use crate::simulation::Simulation;
 
 /// The derived quantities `tinydem check` prints.
 pub fn describe(s: &Scenario, out: &Path) -> Result<String> {
-    let sim = Simulation::new(s.clone())?;
+    describe_start(s, out, Simulation::new(s.clone())?)
+}
+
+/// The derived quantities of a run of `s` that starts as `sim` (fresh, or a stage after a
+/// checkpoint): its particles, the most it can hold and the timed trial are `sim`'s.
+fn describe_start(s: &Scenario, out: &Path, sim: Simulation) -> Result<String> {
     let g = &s.geometry;
     let m = &s.material;
     let dt = s.simulation.timestep;
@@ -189,7 +194,7 @@ pub fn describe(s: &Scenario, out: &Path) -> Result<String> {
             Some(free) => format!("; {} free in {}", human_bytes(free as f64), out.display()),
             None => String::new(),
         },
-        Trial::run(s, TRIAL)?.describe(s, max_n),
+        Trial::run(s, sim, TRIAL).describe(s, max_n),
         refusals(s, max_n, out)
             .iter()
             .map(|r| format!("warning: {r} (run refuses it unless --force)\n"))
@@ -201,12 +206,12 @@ pub fn describe(s: &Scenario, out: &Path) -> Result<String> {
 /// quantities, then what it changes as a stage after the checkpoint's run and what it
 /// carries over.
 pub fn describe_stage(s: &Scenario, from: &Path, dir: &Path) -> Result<String> {
-    let mut out = describe(s, dir)?;
     let snapshot = checkpoint::load(from, None)?;
     let old = snapshot.scenario.clone();
     let steps = snapshot.steps;
-    let (_, notes) = Simulation::stage(s.clone(), snapshot)
+    let (sim, notes) = Simulation::stage(s.clone(), snapshot)
         .with_context(|| format!("cannot start a stage from {}", from.display()))?;
+    let mut out = describe_start(s, dir, sim)?;
     out += &format!(
         "stage from             {} (step {steps} of its run); the clock starts at 0\n",
         from.display()
@@ -372,12 +377,17 @@ pub fn free_space(dir: &Path) -> Option<u64> {
     Some(stat.f_bavail as u64 * stat.f_frsize as u64)
 }
 
-/// A short timed run of the scenario from its start, to estimate the wall time.
+/// A short timed run from the start of a run, to estimate the wall time. Its first step
+/// (which builds the neighbour lists from nothing) is timed apart, so that a trial of a few
+/// steps of a large system does not take that build for the cost of every step.
 #[derive(Clone, Debug)]
 pub struct Trial {
+    /// Steps taken, the first included.
     pub steps: u64,
+    /// Wall time of the first step and of the steps after it [s].
+    pub first: f64,
     pub seconds: f64,
-    /// Sum over the steps of the particles stepped.
+    /// Sum over the steps after the first of the particles stepped.
     pub particle_steps: f64,
     /// Particles at its end.
     pub particles: usize,
@@ -386,39 +396,40 @@ pub struct Trial {
 }
 
 impl Trial {
-    /// Steps a fresh simulation of `s` for `budget` of wall time (or to its end).
-    pub fn run(s: &Scenario, budget: Duration) -> Result<Trial> {
-        let mut sim = Simulation::new(s.clone())?;
+    /// Steps `sim`, the start of a run of `s`, for `budget` of wall time (or to its end).
+    pub fn run(s: &Scenario, mut sim: Simulation, budget: Duration) -> Trial {
         let total = s.simulation.frames * s.simulation.steps_per_frame;
+        let begin = Instant::now();
+        let mut failure = sim.step().err().map(|unstable| unstable.to_string());
+        let first = begin.elapsed().as_secs_f64();
         let start = Instant::now();
         let mut particle_steps = 0.0;
-        let mut failure = None;
-        while sim.steps < total && start.elapsed() < budget {
+        while failure.is_none() && sim.steps < total && begin.elapsed() < budget {
             particle_steps += sim.particles.len().max(1) as f64;
             if let Err(unstable) = sim.step() {
                 failure = Some(unstable.to_string());
-                break;
             }
         }
-        Ok(Trial {
+        Trial {
             steps: sim.steps,
+            first,
             seconds: start.elapsed().as_secs_f64(),
             particle_steps,
             particles: sim.particles.len(),
             failure,
-        })
+        }
     }
 
     /// The estimated wall time of the whole run of `s`, with at most `n` particles: the
-    /// trial's cost per particle-step for every step with `n` particles (an upper bound
-    /// when the run spawns or removes particles).
+    /// first step, then the trial's cost per particle-step for every further step with `n`
+    /// particles (an upper bound when the run spawns or removes particles).
     pub fn estimate(&self, s: &Scenario, n: usize) -> f64 {
         let total = s.simulation.frames * s.simulation.steps_per_frame;
         if self.steps >= total || self.particle_steps == 0.0 {
-            return self.seconds;
+            return self.first + self.seconds;
         }
         let per = self.seconds / self.particle_steps;
-        per * total as f64 * n.max(1) as f64
+        self.first + per * (total - 1) as f64 * n.max(1) as f64
     }
 
     /// The `wall time` line of `check`.
@@ -433,15 +444,16 @@ impl Trial {
         if self.steps >= total {
             return format!(
                 "{} (the whole run, timed, {threads} threads)",
-                human_seconds(self.seconds)
+                human_seconds(self.first + self.seconds)
             );
         }
         format!(
-            "about {} on {threads} threads, without output (a trial of {} steps in {:.2} s: \
-             {:.2e} s per particle-step, for {n} particles{})",
+            "about {} on {threads} threads, without output (a trial of {} steps in {:.2} s, \
+             the first {:.2} s: {:.2e} s per particle-step after it, for {n} particles{})",
             human_seconds(self.estimate(s, n)),
             self.steps,
-            self.seconds,
+            self.first + self.seconds,
+            self.first,
             self.seconds / self.particle_steps.max(1.0),
             if n != self.particles {
                 format!(

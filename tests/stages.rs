@@ -117,6 +117,12 @@ fn removing_the_plug_of_a_filled_silo_starts_its_discharge() {
         check.contains("with mesh files this scenario lacks were dropped"),
         "{check}"
     );
+    // Its particles, and the trial that times the stage, are the fill's, not a fresh start's.
+    let grains = read(d.join("fill/particles000004.csv")).lines().count() - 1;
+    assert!(
+        check.contains(&format!("initial particles      {grains}\n")),
+        "{grains}: {check}"
+    );
     run(
         d,
         &[
