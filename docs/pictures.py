@@ -111,13 +111,33 @@ def e():
         side_by_side(tmp / "l.png", tmp / "r.png", DOCS / "e_jamming.png")
 
 
+def cutaway(out, k, into):
+    """Frame k of `out` with the large beads and only the small beads in the back half of
+    the cylinder (y > 30 mm), so that the front view shows the large beads inside the bed."""
+    into.mkdir(parents=True, exist_ok=True)
+    src = frame(out, k)
+    dst = into / src.name
+    with open(src) as f, open(dst, "w") as g:
+        header = f.readline()
+        g.write(header)
+        names = header.strip().split(",")
+        y, r = names.index("y"), names.index("R")
+        for line in f:
+            v = line.split(",")
+            if float(v[r]) > 0.01 or float(v[y]) > 0.03:
+                g.write(line)
+    return dst
+
+
 def f():
     out = run("f", EXAMPLES / "f_segregation" / "scenario.toml")
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
-        style = dict(color="radius", view="front", width=400, height=480, scale_bar=True)
-        picture(frame(out, 1), tmp / "l.png", **style)
-        picture(frame(out, int(tinydem.read_output(out).numbers[-1])), tmp / "r.png", **style)
+        style = dict(color="radius", view="front", width=400, height=480, scale_bar=True,
+                     bounds=((-0.08, -0.08, -0.005), (0.08, 0.08, 0.16)), scenario=out / "run.toml")
+        last = int(tinydem.read_output(out).numbers[-1])
+        picture(cutaway(out, 1, tmp / "l"), tmp / "l.png", **style)
+        picture(cutaway(out, last, tmp / "r"), tmp / "r.png", **style)
         side_by_side(tmp / "l.png", tmp / "r.png", DOCS / "f_segregation.png")
     subprocess.run(
         [str(BINARY), "analyze", str(out), "--large", "0.02", "--plot",
