@@ -49,20 +49,25 @@ def frame(out, k):
     return out / f"particles{k:06d}.csv"
 
 
-def cut(out, k, half, into):
-    """The slab |y| < half of frame k of `out`, as frame k of the directory `into` (so that
-    it keeps its frame number and so its time)."""
+def select(out, k, into, keep):
+    """The particles of frame k of `out` for which keep(column -> value) holds, as frame k of
+    the directory `into` (so that it keeps its frame number and so its time)."""
     into.mkdir(parents=True, exist_ok=True)
     src = frame(out, k)
     dst = into / src.name
     with open(src) as f, open(dst, "w") as g:
         header = f.readline()
         g.write(header)
-        y = header.strip().split(",").index("y")
+        names = header.strip().split(",")
         for line in f:
-            if abs(float(line.split(",")[y])) < half:
+            if keep(dict(zip(names, map(float, line.split(","))))):
                 g.write(line)
     return dst
+
+
+def cut(out, k, half, into):
+    """The slab |y| < half of frame k of `out`."""
+    return select(out, k, into, lambda p: abs(p["y"]) < half)
 
 
 def side_by_side(left, right, target):
@@ -114,19 +119,7 @@ def e():
 def cutaway(out, k, into):
     """Frame k of `out` with the large beads and only the small beads in the back half of
     the cylinder (y > 30 mm), so that the front view shows the large beads inside the bed."""
-    into.mkdir(parents=True, exist_ok=True)
-    src = frame(out, k)
-    dst = into / src.name
-    with open(src) as f, open(dst, "w") as g:
-        header = f.readline()
-        g.write(header)
-        names = header.strip().split(",")
-        y, r = names.index("y"), names.index("R")
-        for line in f:
-            v = line.split(",")
-            if float(v[r]) > 0.01 or float(v[y]) > 0.03:
-                g.write(line)
-    return dst
+    return select(out, k, into, lambda p: p["R"] > 0.01 or p["y"] > 0.03)
 
 
 def f():
