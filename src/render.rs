@@ -440,7 +440,7 @@ pub fn render_in(
             &mut img,
             4 * s,
             3 * s,
-            &format!("t = {} s", text::number(t)),
+            &format!("t = {} s", text::number(text::rounded(t, 3))),
             k,
             INK,
         );

@@ -76,6 +76,17 @@ pub fn number(v: f64) -> String {
     }
 }
 
+/// `v` rounded to `digits` significant digits (for labels such as a time stamp, where a
+/// frame's 0.59994 s reads as 0.6 s).
+pub fn rounded(v: f64, digits: usize) -> f64 {
+    if v == 0.0 || !v.is_finite() {
+        return v;
+    }
+    format!("{v:.*e}", digits.saturating_sub(1))
+        .parse()
+        .unwrap_or(v)
+}
+
 /// Round tick values covering [lo, hi]: about `count` steps of 1, 2 or 5 times a power of
 /// ten, the ticks that lie within the range.
 pub fn ticks(lo: f64, hi: f64, count: usize) -> Vec<f64> {
@@ -100,6 +111,14 @@ pub fn ticks(lo: f64, hi: f64, count: usize) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn labels_round_to_significant_digits() {
+        assert_eq!(number(rounded(0.59994638, 3)), "0.6");
+        assert_eq!(number(rounded(9.064373, 3)), "9.06");
+        assert_eq!(number(rounded(0.2589821, 3)), "0.259");
+        assert_eq!(rounded(0.0, 3), 0.0);
+    }
 
     #[test]
     fn numbers_read_as_people_write_them() {
