@@ -257,11 +257,18 @@ def test_ctrl_c_stops_a_run_with_a_checkpoint_that_resumes(tmp_path):
             time.sleep(0.01)
         os.kill(os.getpid(), signal.SIGINT)
 
+    # Python turns SIGINT into KeyboardInterrupt only if it was not ignored when it started
+    # (a job started in the background by a non-interactive shell ignores it): install the
+    # handler here, as an interactive session has it.
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     timer = threading.Thread(target=interrupt)
     timer.start()
-    with pytest.raises(KeyboardInterrupt):
-        tinydem.run(tmp_path / "long.toml", output=out)
-    timer.join()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            tinydem.run(tmp_path / "long.toml", output=out)
+    finally:
+        timer.join()
+        signal.signal(signal.SIGINT, previous)
     assert (out / "checkpoint.bin").is_file() and (out / "interrupted.csv").is_file()
     steps = tinydem.Simulation(tmp_path / "long.toml", resume=out / "checkpoint.bin").steps
     assert STEPS_PER_FRAME <= steps < 10000 * STEPS_PER_FRAME
