@@ -90,6 +90,35 @@ pub struct ReposeWindow {
     pub to: f64,
 }
 
+impl ReposeWindow {
+    /// The window of `--rest-speed V` and `--window FROM,TO` (None: 3 to 30 diameters),
+    /// checked: a positive speed and two numbers with 0 <= FROM < TO.
+    pub fn of(rest_speed: f64, window: Option<&[f64]>) -> anyhow::Result<ReposeWindow> {
+        let mut w = ReposeWindow {
+            rest_speed,
+            ..ReposeWindow::default()
+        };
+        if let Some(v) = window {
+            let [from, to] = v[..] else {
+                anyhow::bail!("--window FROM,TO takes two numbers, got {}", v.len());
+            };
+            (w.from, w.to) = (from, to);
+        }
+        anyhow::ensure!(
+            w.rest_speed > 0.0,
+            "--rest-speed must be positive, got {}",
+            w.rest_speed
+        );
+        anyhow::ensure!(
+            w.from >= 0.0 && w.to > w.from,
+            "--window FROM,TO needs 0 <= FROM < TO, got {},{}",
+            w.from,
+            w.to
+        );
+        Ok(w)
+    }
+}
+
 impl Default for ReposeWindow {
     fn default() -> Self {
         ReposeWindow {

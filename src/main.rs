@@ -389,20 +389,9 @@ fn execute(
         }) => analyze_command(
             &dir,
             scenario,
-            repose.then(|| {
-                let mut w = tinydem::analyze::ReposeWindow {
-                    rest_speed,
-                    ..Default::default()
-                };
-                if let Some(v) = window {
-                    // Two numbers; anything else fails the check of the window below.
-                    (w.from, w.to) = match v[..] {
-                        [from, to] => (from, to),
-                        _ => (f64::NAN, f64::NAN),
-                    };
-                }
-                w
-            }),
+            repose
+                .then(|| tinydem::analyze::ReposeWindow::of(rest_speed, window.as_deref()))
+                .transpose()?,
             large,
             tag,
             csv,
@@ -575,15 +564,7 @@ fn analyze_command(
         "coordination",
         "packing_fraction",
     ];
-    if let Some(w) = repose {
-        anyhow::ensure!(
-            w.rest_speed > 0.0 && w.from >= 0.0 && w.to > w.from,
-            "--rest-speed must be positive and --window FROM,TO two numbers with 0 <= FROM < TO \
-             (got {}, {},{})",
-            w.rest_speed,
-            w.from,
-            w.to
-        );
+    if repose.is_some() {
         header.extend([
             "repose_left_deg",
             "repose_left_err_deg",

@@ -586,11 +586,18 @@ fn analyze_repose_fits_resting_flanks_and_says_when_there_is_no_pile() {
             &["analyze", "out", "--repose", "--window", "30,3"],
             t.path(),
         ),
-        &["--window FROM,TO two numbers with 0 <= FROM < TO"],
+        &["--window FROM,TO needs 0 <= FROM < TO, got 30,3"],
     );
     fails_with(
         &tinydem(&["analyze", "out", "--repose", "--window", "3"], t.path()),
-        &["--window FROM,TO two numbers"],
+        &["--window FROM,TO takes two numbers, got 1"],
+    );
+    fails_with(
+        &tinydem(
+            &["analyze", "out", "--repose", "--rest-speed", "0"],
+            t.path(),
+        ),
+        &["--rest-speed must be positive, got 0"],
     );
     fails_with(
         &tinydem(&["analyze", "out", "--window", "3,30"], t.path()),
