@@ -130,12 +130,12 @@ impl Default for ReposeWindow {
 }
 
 /// One flank's angle of repose [degrees], with the standard error of the least-squares
-/// slope, over `bins` surface columns one grain diameter wide.
+/// slope, over `columns` surface columns one grain diameter wide.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Flank {
     pub angle: f64,
     pub error: f64,
-    pub bins: usize,
+    pub columns: usize,
 }
 
 /// The angles of a pile's two flanks, its height above the floor [m] and the grains at rest.
@@ -154,16 +154,16 @@ pub enum NoPile {
     TooFewResting(usize),
     /// A flank has fewer than 3 surface columns in the window (the pile is too small, or the
     /// apex sits at the end of the bed).
-    ShortFlank { side: &'static str, bins: usize },
+    ShortFlank { side: &'static str, columns: usize },
 }
 
 impl std::fmt::Display for NoPile {
     fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
         match self {
             NoPile::TooFewResting(n) => write!(f, "{n} grains at rest, fewer than 20"),
-            NoPile::ShortFlank { side, bins } => write!(
+            NoPile::ShortFlank { side, columns } => write!(
                 f,
-                "the {side} flank has {bins} columns in the window, fewer than 3"
+                "the {side} flank has {columns} columns in the window, fewer than 3"
             ),
         }
     }
@@ -221,11 +221,11 @@ pub fn angle_of_repose(p: &Particles, window: ReposeWindow) -> Result<Repose, No
             .map(|(slope, error)| Flank {
                 angle: slope.abs().atan().to_degrees(),
                 error: (error / (1.0 + slope * slope)).to_degrees(),
-                bins: points.len(),
+                columns: points.len(),
             })
             .ok_or(NoPile::ShortFlank {
                 side,
-                bins: points.len(),
+                columns: points.len(),
             })
     };
     Ok(Repose {
@@ -377,7 +377,7 @@ mod tests {
         );
         let flat = heap(0.001, -0.1..0.1, |_| 0.01);
         let e = angle_of_repose(&flat, ReposeWindow::default()).unwrap_err();
-        assert!(matches!(e, NoPile::ShortFlank { bins: 0, .. }), "{e:?}");
+        assert!(matches!(e, NoPile::ShortFlank { columns: 0, .. }), "{e:?}");
         assert!(e.to_string().contains("flank has 0 columns"), "{e}");
     }
 
