@@ -9,6 +9,7 @@ pub mod check;
 pub mod checkpoint;
 pub mod contact;
 pub mod csv;
+pub mod exact;
 pub mod geometry;
 pub mod integrate;
 pub mod lanes;

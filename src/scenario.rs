@@ -7,7 +7,7 @@
 //! [material]   density, youngs_modulus, poisson_ratio, restitution, friction_sliding,
 //!              friction_rolling, friction_twisting, cohesion, viscosity
 //! [kinetics]   initial_velocity, initial_angular_velocity, gravity
-//! [simulation] timestep, max_particles, frames, steps_per_frame, spawn_attempts, seed
+//! [simulation] timestep, max_particles, frames, steps_per_frame, spawn_attempts, seed, skin
 //! [[meshes]]   file, radii, contacts, motion = { type = "harmonic", amplitude, frequency, direction,
 //!              phase } | { type = "velocity", velocity } | { type = "rotation", center, axis,
 //!              angular_velocity }   (any number of these)
@@ -125,6 +125,10 @@ pub struct Simulation {
     pub spawn_attempts: u64,
     /// Seed of the random stream used for spawning.
     pub seed: u64,
+    /// Verlet skin as a fraction of R_max: the lists hold the pairs within R_i + R_j +
+    /// skin and are rebuilt when a particle has moved half of it. It sets how often the
+    /// lists are rebuilt, and so the speed, not the result.
+    pub skin: f64,
 }
 
 /// A material of `[[materials]]` (or the one `[material]`).
@@ -205,6 +209,18 @@ pub enum RadiusDistribution {
     },
     /// One of `radii`, each with its share of the number of particles (`weights`, relative).
     Table { radii: Vec<f64>, weights: Vec<f64> },
+}
+
+impl RadiusDistribution {
+    /// The largest radius it draws.
+    pub fn largest(&self) -> f64 {
+        match self {
+            RadiusDistribution::Uniform { max, .. }
+            | RadiusDistribution::Normal { max, .. }
+            | RadiusDistribution::LogNormal { max, .. } => *max,
+            RadiusDistribution::Table { radii, .. } => radii.iter().copied().fold(0.0, f64::max),
+        }
+    }
 }
 
 /// A region that inserts particles (`[[spawn]]`).
@@ -610,6 +626,7 @@ struct RawSimulation {
     steps_per_frame: Option<u64>,
     spawn_attempts: Option<u64>,
     seed: Option<u64>,
+    skin: Option<f64>,
 }
 
 #[derive(Deserialize, Default)]
@@ -1156,6 +1173,7 @@ impl Scenario {
             steps_per_frame: s.steps_per_frame.unwrap_or(500),
             spawn_attempts: s.spawn_attempts.unwrap_or(100),
             seed: s.seed.unwrap_or(1),
+            skin: check("[simulation] skin", s.skin.unwrap_or(0.5), Range::Positive)?,
         };
         if simulation.spawn_attempts > 1_000_000_000 {
             bail!(
@@ -1271,14 +1289,15 @@ impl Scenario {
             })
             .transpose()?;
         if let Some(d) = domain {
-            // A period must hold twice the reach of the widest pair (2 R_max and the skin
-            // R_max / 2), so that a pair sees one image of the other.
-            let shortest = 6.0 * radius_max;
+            // A period must hold twice the reach of the widest pair (2 R_max and the skin),
+            // with R_max to spare, so that a pair sees one image of the other.
+            let periods = 5.0 + 2.0 * simulation.skin;
+            let shortest = periods * radius_max;
             for (a, name) in ["x", "y", "z"].iter().enumerate() {
                 let length = d.max[a] - d.min[a];
                 if periodic[a] && length < shortest {
                     bail!(
-                        "[domain] is periodic along {name} with a period of {length}: it must be at least 6 radius_max = {shortest}"
+                        "[domain] is periodic along {name} with a period of {length}: it must be at least {periods} radius_max = {shortest}"
                     );
                 }
             }
@@ -1455,6 +1474,7 @@ impl Scenario {
         ] {
             let _ = writeln!(o, "{key} = {n}");
         }
+        let _ = writeln!(o, "skin = {}", f(s.skin));
         for mesh in &self.meshes {
             o += "\n[[meshes]]\n";
             let _ = writeln!(o, "file = {}", path(&mesh.file));

@@ -6,6 +6,7 @@
 //! ```
 
 use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use anyhow::{Result, bail};
@@ -13,6 +14,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::contact::{Body, Coefficients, ContactLaw, Kinematics, Other, Springs};
+use crate::exact::{Scale, Scales8, Sum6, pack};
 use crate::integrate::{Density, Inertia, Response, State, advance};
 use crate::lanes::{Gather, Lanes};
 use crate::mesh::{Contacts, Face, Mesh};
@@ -30,18 +32,52 @@ use crate::surface::{self, Candidate, Fate};
 const WIDTH: usize = 8;
 type Group = wide::f64x8;
 
-/// Force and torque on one particle, summed over its contacts during a step (Eqs. 1-2).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-struct Load {
-    f: DVec3,
-    tau: DVec3,
+/// Force (components 0-2) and torque (3-5) on one particle, summed over its contacts during
+/// a step (Eqs. 1-2), exactly (`exact.rs`): the same bits in whatever order the contacts add
+/// to it.
+type Load = Sum6;
+
+/// The resolutions of the force and torque sums, from the largest force and torque the
+/// scenario's materials and radii can produce (see [`LoadScales::of`]).
+#[derive(Clone, Copy, Debug)]
+pub struct LoadScales {
+    pub force: Scale,
+    pub torque: Scale,
+    /// Of a load's components.
+    lanes: Scales8,
 }
 
-impl Load {
-    #[inline(always)]
-    fn add(&mut self, f: DVec3, tau: DVec3) {
-        self.f += f;
-        self.tau += tau;
+impl LoadScales {
+    /// Room above the largest force of a contact, E* R_max^2 (Hertz at an overlap of R_max,
+    /// or the cohesion k_c pi R_max^2): 2^12, which also holds particles up to 64 R_max.
+    const ROOM: f64 = 4096.0;
+
+    /// The scales of a scenario: from its parameters only (not from the particles of the
+    /// moment), so that a resumed run and every process of a run use the same ones.
+    pub fn of(s: &Scenario) -> LoadScales {
+        let mut r_max = s.geometry.radius_max;
+        for region in &s.spawn {
+            r_max = r_max.max(region.radius.largest());
+        }
+        let mut stiffest: f64 = 0.0;
+        for m in &s.materials {
+            let m = &m.properties;
+            let e_star = m.youngs_modulus / (1.0 - m.poisson_ratio * m.poisson_ratio);
+            stiffest = stiffest.max(e_star).max(std::f64::consts::PI * m.cohesion);
+        }
+        for i in &s.interactions {
+            stiffest = stiffest.max(std::f64::consts::PI * i.cohesion.unwrap_or(0.0));
+        }
+        let largest = (LoadScales::ROOM * stiffest * r_max * r_max).max(f64::MIN_POSITIVE);
+        let (force, torque) = (
+            Scale::for_largest(largest),
+            Scale::for_largest((largest * r_max).max(f64::MIN_POSITIVE)),
+        );
+        LoadScales {
+            force,
+            torque,
+            lanes: Scales8::new([force, force, force, torque, torque, torque, force, force]),
+        }
     }
 }
 
@@ -79,6 +115,18 @@ fn pieces<'a>(
             store,
         })
         .collect()
+}
+
+/// Two distinct elements of a slice, mutably.
+fn pair_mut<T>(v: &mut [T], a: usize, b: usize) -> (&mut T, &mut T) {
+    assert_ne!(a, b);
+    if a < b {
+        let (lo, hi) = v.split_at_mut(b);
+        (&mut lo[a], &mut hi[0])
+    } else {
+        let (lo, hi) = v.split_at_mut(a);
+        (&mut hi[0], &mut lo[b])
+    }
 }
 
 /// The springs of store entries `c` in the lanes of a group.
@@ -203,9 +251,6 @@ impl StageTimes {
         self.seconds.iter().sum()
     }
 }
-
-/// Verlet skin as a fraction of R_max.
-const SKIN_PER_RADIUS: f64 = 0.5;
 
 /// Everything needed to continue a run bit for bit: particles (in storage order, with their
 /// ids), step count, the spawner's place in its random stream, the contact history (the
@@ -474,6 +519,11 @@ pub struct Simulation {
     /// Force and torque on each particle (storage order), summed by stages 3 and 4 and used
     /// up by stage 5.
     loads: Vec<Load>,
+    /// The resolutions of the loads' sums.
+    scales: LoadScales,
+    /// Some force or torque of the last step was beyond the range of the sums, or not
+    /// finite (the run is unstable).
+    beyond_range: bool,
     /// The mesh as read (at t = 0).
     rest_faces: Vec<Face>,
     /// Parts of the mesh that follow a prescribed motion.
@@ -793,17 +843,18 @@ impl Simulation {
         }
         check_materials(&particles, &scenario)?;
         if let Some(periodic) = scenario.periodicity() {
-            let shortest = 6.0 * max_radius;
+            let periods = 5.0 + 2.0 * scenario.simulation.skin;
+            let shortest = periods * max_radius;
             for a in 0..3 {
                 if periodic.axes[a] && periodic.length[a] < shortest {
                     bail!(
-                        "the period {} of the domain along axis {a} is shorter than 6 times the largest radius ({shortest})",
+                        "the period {} of the domain along axis {a} is shorter than {periods} times the largest radius ({shortest})",
                         periodic.length[a]
                     );
                 }
             }
         }
-        let skin = SKIN_PER_RADIUS * g.radius_max;
+        let skin = scenario.simulation.skin * g.radius_max;
         let face_grid = face_grid(&mesh.faces, max_radius, skin);
         let mut sim = Simulation {
             law: ContactLaw::of(&scenario),
@@ -811,6 +862,8 @@ impl Simulation {
             face_grid,
             spawner: Spawner::new(scenario.simulation.seed),
             loads: Vec::new(),
+            scales: LoadScales::of(&scenario),
+            beyond_range: false,
             rest_faces: mesh.faces.clone(),
             moving: Vec::new(),
             face_part: vec![STATIC; mesh.faces.len()],
@@ -922,7 +975,7 @@ impl Simulation {
         let t = self.stage_times.add(Stage::Tag, t);
         self.steps += 1;
         self.time = self.steps as f64 * self.scenario.simulation.timestep;
-        self.check_stability(deep, non_finite)?;
+        self.check_stability(deep, non_finite || self.beyond_range)?;
         let t = self.stage_times.add(Stage::Stability, t);
         self.remove();
         self.stage_times.add(Stage::Remove, t);
@@ -1229,6 +1282,13 @@ impl Simulation {
             return Ok(());
         }
         let mut what = Vec::new();
+        if self.beyond_range {
+            what.push(format!(
+                "a contact force or torque was not finite or beyond the range of the sums ({:.3e} N, {:.3e} N m: 4096 times the largest a contact of these materials and radii should give)",
+                self.scales.force.largest(),
+                self.scales.torque.largest()
+            ));
+        }
         for k in p.id_order().into_iter().filter(|&k| non_finite(k)).take(5) {
             what.push(format!(
                 "particle {} has a non-finite state (x = {}, v = {}, w = {})",
@@ -1417,6 +1477,8 @@ impl Simulation {
     #[inline(never)] // a stage of its own in profiles
     fn particle_contacts(&mut self) -> Vec<Deep> {
         let deep = Mutex::new(Vec::new());
+        let beyond = AtomicBool::new(false);
+        let scales = &self.scales;
         let p = &self.particles;
         let law = &self.law;
         let densities = &self.densities;
@@ -1488,16 +1550,22 @@ impl Simulation {
                             }
                         }
                     }
-                    let mut add = |idx: usize, f: DVec3, tau: DVec3| {
-                        if idx < owners.end {
-                            loads[idx - owners.start].add(f, tau);
+                    let (base, owned) = (owners.start, owners.end);
+                    // The load of a particle of this slab or of the next one.
+                    fn load<'l>(
+                        idx: usize,
+                        (base, owned): (usize, usize),
+                        loads: &'l mut [Load],
+                        next: &'l mut Option<(usize, &mut [Load])>,
+                    ) -> &'l mut Load {
+                        if idx < owned {
+                            &mut loads[idx - base]
                         } else {
-                            let (base, next) = next_loads
-                                .as_mut()
-                                .expect("partners reach the next slab only");
-                            next[idx - *base].add(f, tau);
+                            let (start, next) =
+                                next.as_mut().expect("partners reach the next slab only");
+                            &mut next[idx - *start]
                         }
-                    };
+                    }
                     for group in touching.chunks(WIDTH) {
                         // A short last group repeats its last pair in the spare lanes.
                         let (mut i, mut j, mut c) = ([0; WIDTH], [0; WIDTH], [0; WIDTH]);
@@ -1540,9 +1608,15 @@ impl Simulation {
                             Group::scatter_vec(force.tau_i),
                             Group::scatter_vec(force.tau_j),
                         );
+                        let (at, lanes, mut fine) = ((base, owned), &scales.lanes, true);
                         for l in 0..group.len() {
-                            add(i[l], f[l], tau_i[l]);
-                            add(j[l], -f[l], tau_j[l]); // Eqs. (56)-(60)
+                            let load_i = load(i[l], at, loads, &mut next_loads);
+                            fine &= load_i.add(pack(f[l], tau_i[l]), lanes);
+                            let load_j = load(j[l], at, loads, &mut next_loads);
+                            fine &= load_j.add(pack(-f[l], tau_j[l]), lanes); // Eqs. (56)-(60)
+                        }
+                        if !fine {
+                            beyond.store(true, Ordering::Relaxed);
                         }
                         if kin.delta.simd_gt(body_i.radius.min(body_j.radius)).any() {
                             let delta = kin.delta.scatter();
@@ -1563,6 +1637,7 @@ impl Simulation {
             });
         }
         let mut deep = deep.into_inner().expect("not poisoned");
+        self.beyond_range |= beyond.into_inner();
         self.wrapped_contacts(&mut deep);
         deep
     }
@@ -1625,8 +1700,11 @@ impl Simulation {
                     };
                     let coef = law.pair(p.material[i], p.material[j]);
                     let force = law.evaluate(coef, p.radius[i], mass(i), other, &kin, springs);
-                    self.loads[i].add(force.f, force.tau_i);
-                    self.loads[j].add(-force.f, force.tau_j); // Eqs. (56)-(60)
+                    let scales = &self.scales;
+                    let (load_i, load_j) = pair_mut(&mut self.loads, i, j);
+                    let fine = load_i.add(pack(force.f, force.tau_i), &scales.lanes)
+                        & load_j.add(pack(-force.f, force.tau_j), &scales.lanes); // Eqs. (56)-(60)
+                    self.beyond_range |= !fine;
                     let limit = p.radius[i].min(p.radius[j]);
                     if kin.delta > limit {
                         deep.push(Deep {
@@ -1653,6 +1731,8 @@ impl Simulation {
     #[inline(never)] // a stage of its own in profiles
     fn mesh_contacts(&mut self) -> Vec<Deep> {
         let deep = Mutex::new(Vec::new());
+        let beyond = AtomicBool::new(false);
+        let scales = &self.scales;
         let p = &self.particles;
         let law = &self.law;
         let faces = &self.mesh.faces;
@@ -1848,8 +1928,13 @@ impl Simulation {
                         scatter_springs(lanes, store, &e[..group.len()]);
                         let (f, tau) =
                             (Group::scatter_vec(force.f), Group::scatter_vec(force.tau_i));
+                        let mut fine = true;
                         for l in 0..group.len() {
-                            loads[i[l] - owners.start].add(f[l], tau[l]);
+                            let load = &mut loads[i[l] - owners.start];
+                            fine &= load.add(pack(f[l], tau[l]), &scales.lanes);
+                        }
+                        if !fine {
+                            beyond.store(true, Ordering::Relaxed);
                         }
                         if files > 0 {
                             // The reaction on the mesh file (Newton's third law for the
@@ -1873,6 +1958,7 @@ impl Simulation {
                 *sum += w;
             }
         }
+        self.beyond_range |= beyond.into_inner();
         deep.into_inner().expect("not poisoned")
     }
 
@@ -1883,6 +1969,7 @@ impl Simulation {
     #[inline(never)] // a stage of its own in profiles
     fn integrate(&mut self) -> bool {
         let s = &self.scenario;
+        let scales = &self.scales;
         let (dt, g) = (s.simulation.timestep, s.kinetics.gravity);
         let densities = &self.densities;
         let uniform = densities.len() == 1;
@@ -1907,7 +1994,8 @@ impl Simulation {
                 let lane: [usize; WIDTH] = std::array::from_fn(|l| l.min(n - 1));
                 let (mut f, mut tau) = ([DVec3::ZERO; WIDTH], [DVec3::ZERO; WIDTH]);
                 for l in 0..WIDTH {
-                    (f[l], tau[l]) = (load[lane[l]].f, load[lane[l]].tau);
+                    let v = load[lane[l]].value(&scales.lanes);
+                    (f[l], tau[l]) = (DVec3::new(v[0], v[1], v[2]), DVec3::new(v[3], v[4], v[5]));
                 }
                 load.fill(Load::default());
                 let state = State::<Group> {

@@ -1,0 +1,193 @@
+//! Sums whose result does not depend on the order of their terms.
+//!
+//! Floating-point addition is not associative: a particle's force summed over its contacts in
+//! another order differs in the last bits, and a granular flow amplifies such differences
+//! until the runs part. The order of the terms is the storage order, the slabs of the pair
+//! stage, the times of the neighbour-list rebuilds, and (split over processes) which process
+//! holds which particle. Rather than fix an order, the loads are summed exactly: each term
+//! is cut to a fixed point (a multiple of the resolution 2^-s of its [`Scale`]) and kept as
+//! two 64-bit integers, which add exactly and in any order. The sum is turned back into a
+//! float once, when the load is used.
+//!
+//! A scale covers magnitudes up to `2^104` resolutions per term (each of its integers then
+//! stays below 2^52, so they hold the sum of 2048 terms of the largest size); the scale is
+//! set from the largest force (or torque) the scenario can produce, with room to spare (see
+//! `Simulation`), so the resolution lies some 90 binary orders below it: far below the
+//! rounding of a float sum of the small forces.
+
+use wide::{f64x8, i64x8};
+
+/// Terms up to this many resolutions (2^104).
+const RANGE: f64 = 20282409603651670423947251286016.0;
+/// Where a term is split: `hi` counts units of 2^52 resolutions, `lo` the rest.
+const SPLIT: f64 = 4503599627370496.0;
+const INV_SPLIT: f64 = 1.0 / SPLIT;
+
+/// The resolution of the sums of one quantity: terms are multiples of `2^-s`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Scale {
+    /// 2^s: a term in resolutions is `x * up`.
+    up: f64,
+    /// 2^-s.
+    down: f64,
+}
+
+impl Scale {
+    /// The scale whose range (2^104 resolutions) is the smallest power of two at least
+    /// `largest`.
+    pub fn for_largest(largest: f64) -> Scale {
+        assert!(
+            largest.is_finite() && largest > 0.0,
+            "largest term {largest}"
+        );
+        let s = 104 - largest.log2().ceil() as i32;
+        Scale {
+            up: 2f64.powi(s),
+            down: 2f64.powi(-s),
+        }
+    }
+
+    /// The largest term this scale holds.
+    pub fn largest(self) -> f64 {
+        RANGE * self.down
+    }
+}
+
+/// The scales of the up to 8 components of a [`Sum6`] (unused components: any).
+#[derive(Clone, Copy, Debug)]
+pub struct Scales8 {
+    up: f64x8,
+    down: f64x8,
+}
+
+impl Scales8 {
+    pub fn new(scales: [Scale; 8]) -> Scales8 {
+        Scales8 {
+            up: f64x8::from(scales.map(|s| s.up)),
+            down: f64x8::from(scales.map(|s| s.down)),
+        }
+    }
+}
+
+/// An exact sum of 6 components (a force and a torque in lanes 0-2 and 3-5 of the terms):
+/// each term `x` becomes `a = x 2^s` cut towards zero to whole resolutions, kept as `hi`
+/// units of 2^52 resolutions (words 0-5) and `lo` resolutions (words 6-11), two integers
+/// that add exactly in any order.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Sum6 {
+    words: [i64; 12],
+}
+
+impl Sum6 {
+    /// Adds components 0-5 of `x`, each in its scale; false if some component was beyond
+    /// its range or not finite (the sum is then meaningless).
+    #[inline(always)]
+    pub fn add(&mut self, x: f64x8, scales: &Scales8) -> bool {
+        let (hi, lo, beyond) = split(x, scales.up);
+        let (hi, lo) = (hi.to_array(), lo.to_array());
+        for c in 0..6 {
+            self.words[c] = self.words[c].wrapping_add(hi[c]);
+            self.words[6 + c] = self.words[6 + c].wrapping_add(lo[c]);
+        }
+        !beyond
+    }
+
+    /// Adds another sum.
+    #[inline(always)]
+    pub fn add_sum(&mut self, o: &Sum6) {
+        for (w, o) in self.words.iter_mut().zip(o.words) {
+            *w = w.wrapping_add(o);
+        }
+    }
+
+    /// The value of each component.
+    #[inline]
+    pub fn value(&self, scales: &Scales8) -> [f64; 6] {
+        let down = scales.down.to_array();
+        let w = &self.words;
+        std::array::from_fn(|c| (w[c] as f64 * SPLIT + w[6 + c] as f64) * down[c])
+    }
+}
+
+/// `x up` as (units of 2^52 resolutions, resolutions), cut towards zero, and whether some
+/// lane was beyond the range or not finite. Each lane on its own: the same bits for a term
+/// in any lane.
+#[inline(always)]
+fn split(x: f64x8, up: f64x8) -> (i64x8, i64x8, bool) {
+    let a = x * up; // exact: powers of two
+    let beyond = !(a.abs().simd_lt(f64x8::splat(RANGE))).all();
+    let hi = (a * f64x8::splat(INV_SPLIT)).trunc();
+    // Exact: hi 2^52 is a multiple of the last bit of `a`, and |a - hi 2^52| < 2^52.
+    let lo = a - hi * f64x8::splat(SPLIT);
+    (hi.trunc_int(), lo.trunc_int(), beyond)
+}
+
+/// A force and a torque in the lanes of one vector (components 0-2 and 3-5).
+#[inline(always)]
+pub fn pack(f: glam::DVec3, tau: glam::DVec3) -> f64x8 {
+    f64x8::from([f.x, f.y, f.z, tau.x, tau.y, tau.z, 0.0, 0.0])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+    use proptest::prelude::*;
+
+    fn scales(largest: f64) -> Scales8 {
+        Scales8::new([Scale::for_largest(largest); 8])
+    }
+
+    #[test]
+    fn a_scale_holds_its_largest_term_and_not_twice_it() {
+        let s = Scale::for_largest(3.0);
+        assert!(s.largest() >= 3.0 && s.largest() < 6.0 + 1e-9);
+        let all = scales(3.0);
+        let mut sum = Sum6::default();
+        assert!(sum.add(f64x8::splat(3.0), &all) && sum.add(f64x8::splat(-3.0), &all));
+        assert_eq!(sum, Sum6::default());
+        for bad in [2.0 * s.largest(), f64::NAN, f64::INFINITY] {
+            assert!(!Sum6::default().add(pack(DVec3::new(0.0, bad, 0.0), DVec3::ZERO), &all));
+        }
+    }
+
+    proptest! {
+        /// A sum of many terms is the same integers in any order, each term is exact to the
+        /// resolution, and the value is close to the float sum.
+        #[test]
+        fn a_sum_does_not_depend_on_the_order_of_its_terms(
+            terms in prop::collection::vec((-1e2f64..1e2, -30i32..3), 1..40),
+            seed in any::<u64>(),
+        ) {
+            let s = scales(1e3);
+            let down = Scale::for_largest(1e3).largest() / RANGE;
+            let v: Vec<f64x8> = terms
+                .iter()
+                .map(|&(x, e)| {
+                    let x = x * 2f64.powi(e);
+                    pack(DVec3::new(x, -x * 0.3, x * 1e-7), DVec3::new(-x, 1.0, x * x * 1e-3))
+                })
+                .collect();
+            let mut forward = Sum6::default();
+            for t in &v {
+                prop_assert!(forward.add(*t, &s));
+            }
+            let mut order: Vec<usize> = (0..v.len()).collect();
+            let mut r = seed;
+            for k in (1..order.len()).rev() {
+                r = r.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                order.swap(k, (r >> 33) as usize % (k + 1));
+            }
+            let mut shuffled = Sum6::default();
+            for &k in &order {
+                shuffled.add(v[k], &s);
+            }
+            prop_assert_eq!(forward, shuffled);
+            let float = v.iter().fold(f64x8::ZERO, |a, b| a + *b).to_array();
+            let exact = forward.value(&s);
+            for c in 0..6 {
+                prop_assert!((exact[c] - float[c]).abs() <= 1e-12 * float[c].abs().max(1.0) + 40.0 * down);
+            }
+        }
+    }
+}
