@@ -92,14 +92,6 @@ impl Sum6 {
         !beyond
     }
 
-    /// Adds another sum.
-    #[inline(always)]
-    pub fn add_sum(&mut self, o: &Sum6) {
-        for (w, o) in self.words.iter_mut().zip(o.words) {
-            *w = w.wrapping_add(o);
-        }
-    }
-
     /// The value of each component.
     #[inline]
     pub fn value(&self, scales: &Scales8) -> [f64; 6] {

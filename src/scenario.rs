@@ -131,6 +131,15 @@ pub struct Simulation {
     pub skin: f64,
 }
 
+impl Simulation {
+    /// The shortest period of a periodic domain, in largest radii: twice the reach of the
+    /// widest pair (2 R_max and the skin), with R_max to spare, so that a pair sees one
+    /// image of the other.
+    pub fn shortest_period(&self) -> f64 {
+        5.0 + 2.0 * self.skin
+    }
+}
+
 /// A material of `[[materials]]` (or the one `[material]`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct MaterialSpec {
@@ -1289,9 +1298,7 @@ impl Scenario {
             })
             .transpose()?;
         if let Some(d) = domain {
-            // A period must hold twice the reach of the widest pair (2 R_max and the skin),
-            // with R_max to spare, so that a pair sees one image of the other.
-            let periods = 5.0 + 2.0 * simulation.skin;
+            let periods = simulation.shortest_period();
             let shortest = periods * radius_max;
             for (a, name) in ["x", "y", "z"].iter().enumerate() {
                 let length = d.max[a] - d.min[a];

@@ -843,7 +843,7 @@ impl Simulation {
         }
         check_materials(&particles, &scenario)?;
         if let Some(periodic) = scenario.periodicity() {
-            let periods = 5.0 + 2.0 * scenario.simulation.skin;
+            let periods = scenario.simulation.shortest_period();
             let shortest = periods * max_radius;
             for a in 0..3 {
                 if periodic.axes[a] && periodic.length[a] < shortest {
