@@ -92,6 +92,36 @@ impl Sum6 {
         !beyond
     }
 
+    /// Adds another sum (exactly) and carries the low words into the high ones, so that
+    /// any number of sums can be merged one after another (each term adds less than 2^52
+    /// to a low word: a sum of up to 2048 terms may be merged).
+    pub fn merge(&mut self, other: &Sum6) {
+        for (w, o) in self.words.iter_mut().zip(other.words) {
+            *w = w.wrapping_add(o);
+        }
+        self.carry();
+    }
+
+    /// The same value with each low word in [0, 2^52): one representation per value, so
+    /// that merged sums turn into the same float whatever their grouping.
+    pub fn carry(&mut self) {
+        for c in 0..6 {
+            let lo = self.words[6 + c];
+            let up = lo >> 52;
+            self.words[c] = self.words[c].wrapping_add(up);
+            self.words[6 + c] = lo - (up << 52);
+        }
+    }
+
+    /// The integers of the sum (to send them to another process).
+    pub fn words(&self) -> [i64; 12] {
+        self.words
+    }
+
+    pub fn from_words(words: [i64; 12]) -> Sum6 {
+        Sum6 { words }
+    }
+
     /// The value of each component.
     #[inline]
     pub fn value(&self, scales: &Scales8) -> [f64; 6] {
@@ -141,6 +171,33 @@ mod tests {
         for bad in [2.0 * s.largest(), f64::NAN, f64::INFINITY] {
             assert!(!Sum6::default().add(pack(DVec3::new(0.0, bad, 0.0), DVec3::ZERO), &all));
         }
+    }
+
+    #[test]
+    fn merged_sums_carry_to_one_representation() {
+        let s = scales(1e3);
+        let terms: Vec<f64x8> = (0..3000)
+            .map(|k| {
+                pack(
+                    DVec3::splat(0.999 - (k % 7) as f64),
+                    DVec3::splat(-0.5 * k as f64 / 3000.0),
+                )
+            })
+            .collect();
+        // The same terms in pieces of different sizes, merged.
+        let merged = |piece: usize| {
+            let mut total = Sum6::default();
+            for chunk in terms.chunks(piece) {
+                let mut part = Sum6::default();
+                chunk.iter().for_each(|t| assert!(part.add(*t, &s)));
+                total.merge(&part);
+            }
+            total
+        };
+        let (a, b) = (merged(100), merged(1000));
+        assert_eq!(a, b);
+        let float: f64 = (0..3000).map(|k| 0.999 - (k % 7) as f64).sum();
+        assert!((a.value(&s)[0] - float).abs() < 1e-9 * float.abs());
     }
 
     proptest! {

@@ -1010,6 +1010,59 @@ impl Neighbours {
         self.rebuilds += 1;
     }
 
+    /// Rebuilds the lists for `particles` (re-sorted into spatial order first) with the
+    /// springs of `pairs` and `faces`, entries by id ((lower id, higher id) and (id, face);
+    /// those naming a particle that `particles` lacks are left out). For a process of a
+    /// split run (`domain.rs`), which gathers its history from other processes: it finds
+    /// no lonely particles, whose clearances would need the particles it does not hold.
+    /// Returns the permutation applied (`Particles::permute`).
+    pub fn rebuild_from(
+        &mut self,
+        particles: &mut Particles,
+        pairs: &[(u32, u32, Springs)],
+        faces_history: &[(u32, u32, Springs)],
+        faces: &[Face],
+        face_grid: &CellGrid,
+    ) -> Vec<u32> {
+        let layout = Layout::of(&particles.radius, self.skin);
+        let inv_h = 1.0 / layout.h;
+        let keys: Vec<(u64, u32)> = particles
+            .x
+            .par_iter()
+            .zip(particles.id.par_iter())
+            .with_min_len(MIN_PARALLEL_LEN)
+            .map(|(&x, &id)| (key(cell_of(x, inv_h)), id))
+            .collect();
+        let mut order: Vec<u32> = (0..particles.len() as u32).collect();
+        order.par_sort_unstable_by_key(|&i| keys[i as usize]);
+        drop(keys);
+        self.pairs = ContactList::default();
+        self.faces = ContactList::default();
+        self.wrapped = ContactList::default();
+        particles.permute(&order);
+        let mut here = rustc_hash::FxHashSet::default();
+        here.extend(particles.id.iter().copied());
+        let local = |entries: &[(u32, u32, Springs)], pair: bool| -> Vec<(u32, u32, Springs)> {
+            entries
+                .iter()
+                .filter(|e| here.contains(&e.0) && (!pair || here.contains(&e.1)))
+                .copied()
+                .collect()
+        };
+        let history = Histories {
+            pairs: History::in_storage(particles, &local(pairs, true), true)
+                .expect("only particles present"),
+            faces: History::in_storage(particles, &local(faces_history, false), false)
+                .expect("only particles present"),
+        };
+        let x = particles.x.clone();
+        self.build(&x, particles, faces, face_grid, layout, &history);
+        self.lonely = Vec::new();
+        self.x_at_build = x;
+        self.rebuilds += 1;
+        order
+    }
+
     /// Builds again the lists of a checkpoint: the particles in their saved storage order,
     /// the positions of the last rebuild (`anchors`) and its lonely particles, and the
     /// contact histories (keyed by storage index, [`History::in_storage`]). The lists are

@@ -55,8 +55,14 @@ impl Particles {
 
     /// Adds a particle with the next id.
     pub fn push(&mut self, p: Particle) {
-        self.id.push(self.next_id);
+        self.insert(self.next_id, p);
         self.next_id += 1;
+    }
+
+    /// Adds a particle that has its id already (one made elsewhere: by another process of a
+    /// split run); `next_id` stays.
+    pub fn insert(&mut self, id: u32, p: Particle) {
+        self.id.push(id);
         self.radius.push(p.radius);
         self.x.push(p.x);
         self.v.push(p.v);

@@ -14,6 +14,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::contact::{Body, Coefficients, ContactLaw, Kinematics, Other, Springs};
+use crate::domain::Domain;
 use crate::exact::{Scale, Scales8, Sum6, pack};
 use crate::integrate::{Density, Inertia, Response, State, advance};
 use crate::lanes::{Gather, Lanes};
@@ -48,6 +49,30 @@ pub struct LoadScales {
 }
 
 impl LoadScales {
+    /// The largest radius the scenario's particles can have.
+    fn largest_radius(s: &Scenario) -> f64 {
+        let mut r_max = s.geometry.radius_max;
+        for region in &s.spawn {
+            r_max = r_max.max(region.radius.largest());
+        }
+        r_max
+    }
+
+    /// Room above the largest total load of one step on a wall: 2^20 contacts of the
+    /// largest force (far more than the grains' weight); torques with the lever `lever`.
+    const WALL_ROOM: f64 = 1048576.0;
+
+    /// The scales of a step's loads on the walls, for torques about points at most `lever`
+    /// from the particles.
+    fn walls(&self, lever: f64) -> Scales8 {
+        let largest = LoadScales::WALL_ROOM * self.force.largest();
+        let (force, torque) = (
+            Scale::for_largest(largest),
+            Scale::for_largest((largest * lever).max(f64::MIN_POSITIVE)),
+        );
+        Scales8::new([force, force, force, torque, torque, torque, force, force])
+    }
+
     /// Room above the largest force of a contact, E* R_max^2 (Hertz at an overlap of R_max,
     /// or the cohesion k_c pi R_max^2): 2^12, which also holds particles up to 64 R_max.
     const ROOM: f64 = 4096.0;
@@ -55,10 +80,7 @@ impl LoadScales {
     /// The scales of a scenario: from its parameters only (not from the particles of the
     /// moment), so that a resumed run and every process of a run use the same ones.
     pub fn of(s: &Scenario) -> LoadScales {
-        let mut r_max = s.geometry.radius_max;
-        for region in &s.spawn {
-            r_max = r_max.max(region.radius.largest());
-        }
+        let r_max = LoadScales::largest_radius(s);
         let mut stiffest: f64 = 0.0;
         for m in &s.materials {
             let m = &m.properties;
@@ -196,12 +218,13 @@ pub enum Stage {
     MeshContacts,
     Integrate,
     Tag,
+    Exchange,
     Stability,
     Remove,
 }
 
 impl Stage {
-    pub const ALL: [Stage; 9] = [
+    pub const ALL: [Stage; 10] = [
         Stage::MoveMeshes,
         Stage::Spawn,
         Stage::Neighbours,
@@ -209,6 +232,7 @@ impl Stage {
         Stage::MeshContacts,
         Stage::Integrate,
         Stage::Tag,
+        Stage::Exchange,
         Stage::Stability,
         Stage::Remove,
     ];
@@ -222,6 +246,7 @@ impl Stage {
             Stage::MeshContacts => "mesh contacts",
             Stage::Integrate => "integrate",
             Stage::Tag => "tag",
+            Stage::Exchange => "exchange",
             Stage::Stability => "stability check",
             Stage::Remove => "remove",
         }
@@ -419,6 +444,31 @@ impl std::ops::AddAssign for Wrench {
     }
 }
 
+/// The reports of every process of a split run, in the order they are told.
+fn gather_told(
+    comm: &dyn crate::comm::Comm,
+    told: Vec<(u8, u64, u64, String)>,
+) -> Vec<(u8, u64, u64, String)> {
+    use crate::comm::{Reader, Writer};
+    let mut w = Writer::default();
+    for (kind, a, b, text) in &told {
+        w.u8(*kind);
+        w.u64(*a);
+        w.u64(*b);
+        w.bytes(text.as_bytes());
+    }
+    let mut all = Vec::new();
+    for m in comm.all_gather(w.0) {
+        let mut r = Reader::new(&m);
+        while !r.done() {
+            let (kind, a, b) = (r.u8(), r.u64(), r.u64());
+            all.push((kind, a, b, String::from_utf8_lossy(r.bytes()).into_owned()));
+        }
+    }
+    all.sort_by_key(|x| (x.0, x.1, x.2));
+    all
+}
+
 /// Fails unless every particle's material is one of the scenario's.
 fn check_materials(p: &Particles, s: &Scenario) -> Result<()> {
     let n = s.materials.len();
@@ -513,9 +563,9 @@ pub struct Simulation {
     /// The mesh files `mesh` was put together from.
     pub mesh_files: Vec<MeshFile>,
     law: ContactLaw,
-    neighbours: Neighbours,
-    face_grid: CellGrid,
-    spawner: Spawner,
+    pub(crate) neighbours: Neighbours,
+    pub(crate) face_grid: CellGrid,
+    pub(crate) spawner: Spawner,
     /// Force and torque on each particle (storage order), summed by stages 3 and 4 and used
     /// up by stage 5.
     loads: Vec<Load>,
@@ -548,10 +598,17 @@ pub struct Simulation {
     /// For each face, its material.
     face_material: Vec<u16>,
     /// For each material, the quotients of its density.
-    densities: Vec<Density>,
+    pub(crate) densities: Vec<Density>,
     /// The loads on each mesh file summed over the steps since the last call of
-    /// [`Simulation::take_wall_loads`] (`[output] wall_forces`).
+    /// [`Simulation::take_wall_loads`] (`[output] wall_forces`): each step's exactly (over
+    /// all contacts, and all processes), then the steps in order.
     wall_sums: Vec<Wrench>,
+    /// The resolutions of the wall loads' sums of a step.
+    wall_scales: Scales8,
+    /// The largest radius the faces are binned for.
+    pub(crate) face_grid_radius: f64,
+    /// This process's share of a run split over several (`domain.rs`).
+    pub(crate) domain: Option<Domain>,
 }
 
 impl Simulation {
@@ -895,6 +952,9 @@ impl Simulation {
             },
             face_file: Vec::new(),
             wall_sums: Vec::new(),
+            wall_scales: Scales8::new([Scale::for_largest(1.0); 8]),
+            face_grid_radius: max_radius,
+            domain: None,
             scenario,
             particles,
             mesh,
@@ -973,6 +1033,8 @@ impl Simulation {
         let t = self.stage_times.add(Stage::Integrate, t);
         self.tag();
         let t = self.stage_times.add(Stage::Tag, t);
+        self.refresh_ghosts();
+        let t = self.stage_times.add(Stage::Exchange, t);
         self.steps += 1;
         self.time = self.steps as f64 * self.scenario.simulation.timestep;
         self.check_stability(deep, non_finite || self.beyond_range)?;
@@ -992,26 +1054,29 @@ impl Simulation {
         if !s.removes() {
             return;
         }
-        let (domain, outlets, periodic) = (s.domain, &s.outlets, s.periodic);
+        let (domain, outlets, periodic) = (s.domain, s.outlets.clone(), s.periodic);
         // Outside the domain through a side that is not periodic.
-        let outside = |x: DVec3| {
+        let outside = move |x: DVec3| {
             domain.is_some_and(|d| {
                 (0..3).any(|a| !periodic[a] && (x[a] < d.min[a] || x[a] > d.max[a]))
             })
         };
         // Where each removed particle goes: an outlet, or `outlets.len()` for the domain.
-        let fate = |x: &DVec3| -> Option<u32> {
-            if let Some(k) = outlets.iter().position(|o| o.contains(*x)) {
+        let fate = move |x: DVec3| -> Option<u32> {
+            if let Some(k) = outlets.iter().position(|o| o.contains(x)) {
                 return Some(k as u32);
             }
-            outside(*x).then_some(outlets.len() as u32)
+            outside(x).then_some(outlets.len() as u32)
         };
+        if self.domain.is_some() {
+            return self.remove_split(fate);
+        }
         let p = &self.particles;
         let gone: Vec<(u32, u32)> =
             p.x.par_iter()
                 .enumerate()
                 .with_min_len(4 * MIN_PARALLEL_LEN)
-                .filter_map(|(i, x)| fate(x).map(|f| (i as u32, f)))
+                .filter_map(|(i, x)| fate(*x).map(|f| (i as u32, f)))
                 .collect();
         if gone.is_empty() {
             return;
@@ -1173,6 +1238,7 @@ impl Simulation {
     pub fn thermo(&self) -> Thermo {
         let p = &self.particles;
         let mut energies: Vec<(u32, f64, f64)> = (0..p.len())
+            .filter(|&k| self.own(k))
             .map(|k| {
                 let m = Inertia::mass_with(
                     p.radius[k],
@@ -1186,20 +1252,46 @@ impl Simulation {
                 )
             })
             .collect();
+        if let Some(d) = &self.domain {
+            // Over all processes, still in id order.
+            use crate::comm::{Reader, Writer};
+            let mut w = Writer::default();
+            for &(id, t, r) in &energies {
+                w.u32(id);
+                w.f64(t);
+                w.f64(r);
+            }
+            energies.clear();
+            for m in d.comm.all_gather(w.0) {
+                let mut r = Reader::new(&m);
+                while !r.done() {
+                    energies.push((r.u32(), r.f64(), r.f64()));
+                }
+            }
+        }
         energies.sort_unstable_by_key(|e| e.0);
         let (translational, rotational) = energies
             .iter()
             .fold((0.0, 0.0), |(t, r), e| (t + e.1, r + e.2));
         let radius_of: rustc_hash::FxHashMap<u32, f64> =
             p.id.iter().copied().zip(p.radius.iter().copied()).collect();
+        let own: Option<rustc_hash::FxHashSet<u32>> = self.domain.as_ref().map(|d| {
+            (0..p.len())
+                .filter(|&k| d.owned[k])
+                .map(|k| p.id[k])
+                .collect()
+        });
         let mut thermo = Thermo {
-            particles: p.len(),
+            particles: energies.len(),
             kinetic_energy: translational + rotational,
             rotational_energy: rotational,
             removed: self.removed.count(),
             ..Thermo::default()
         };
         for c in self.contact_network() {
+            if own.as_ref().is_some_and(|own| !own.contains(&c.id)) {
+                continue; // told by the process that owns it
+            }
             let r = radius_of[&c.id];
             let smaller = match c.with {
                 Partner::Particle(j) => {
@@ -1212,6 +1304,13 @@ impl Simulation {
                 }
             };
             thermo.max_overlap = thermo.max_overlap.max(c.overlap / smaller);
+        }
+        if let Some(d) = &self.domain {
+            let counts = d
+                .comm
+                .sum_i64(&[thermo.pair_contacts as i64, thermo.wall_contacts as i64]);
+            (thermo.pair_contacts, thermo.wall_contacts) = (counts[0] as usize, counts[1] as usize);
+            thermo.max_overlap = d.comm.max(thermo.max_overlap);
         }
         thermo
     }
@@ -1226,6 +1325,21 @@ impl Simulation {
             self.face_file[file.faces.clone()].fill(k as u32);
         }
         self.wall_sums = vec![Wrench::default(); self.mesh_files.len()];
+        // The lever of a torque about a file's point: to its farthest corner, or across the
+        // domain, and a particle's radius; 16 times that, for meshes that move.
+        let mut lever: f64 = 0.0;
+        for file in &self.mesh_files {
+            for face in &self.rest_faces[file.faces.clone()] {
+                for c in face.corners() {
+                    lever = lever.max(c.distance(file.torque_about) + face.radius);
+                }
+            }
+        }
+        if let Some(d) = self.scenario.domain {
+            lever = lever.max((d.max - d.min).length());
+        }
+        lever = 16.0 * (lever + LoadScales::largest_radius(&self.scenario));
+        self.wall_scales = self.scales.walls(lever);
     }
 
     /// The loads on each mesh file summed over the steps since the last call, and the
@@ -1271,7 +1385,18 @@ impl Simulation {
         let p = &self.particles;
         let non_finite =
             |k: usize| !(p.x[k].is_finite() && p.v[k].is_finite() && p.w[k].is_finite());
-        if !bad && deep.iter().all(|d| !d.through()) {
+        // Split over processes: each reports on its own particles (a pair: the one of the
+        // lower id), and all stop if one must.
+        let bad = match &self.domain {
+            Some(d) => {
+                deep.retain(|x| d.owned[x.i]);
+                let own_bad = (0..p.len()).any(|k| d.owned[k] && non_finite(k));
+                let bad = self.beyond_range || own_bad || deep.iter().any(Deep::through);
+                d.comm.any(bad)
+            }
+            None => bad || deep.iter().any(Deep::through),
+        };
+        if !bad {
             for d in deep {
                 if self.warnings.seen.insert(d.key(&p.id)) {
                     self.warnings
@@ -1281,25 +1406,51 @@ impl Simulation {
             }
             return Ok(());
         }
-        let mut what = Vec::new();
+        // What went wrong, each with the order it is told in: the range of the sums, then
+        // up to five particles in id order, then the deepest overlaps by pair.
+        let mut told: Vec<(u8, u64, u64, String)> = Vec::new();
         if self.beyond_range {
-            what.push(format!(
+            told.push((0, 0, 0, format!(
                 "a contact force or torque was not finite or beyond the range of the sums ({:.3e} N, {:.3e} N m: 4096 times the largest a contact of these materials and radii should give)",
                 self.scales.force.largest(),
                 self.scales.torque.largest()
-            ));
+            )));
         }
-        for k in p.id_order().into_iter().filter(|&k| non_finite(k)).take(5) {
-            what.push(format!(
-                "particle {} has a non-finite state (x = {}, v = {}, w = {})",
-                p.id[k], p.x[k], p.v[k], p.w[k]
+        for k in p
+            .id_order()
+            .into_iter()
+            .filter(|&k| self.own(k) && non_finite(k))
+            .take(5)
+        {
+            told.push((
+                1,
+                p.id[k] as u64,
+                0,
+                format!(
+                    "particle {} has a non-finite state (x = {}, v = {}, w = {})",
+                    p.id[k], p.x[k], p.v[k], p.w[k]
+                ),
             ));
         }
         deep.retain(Deep::through);
         deep.sort_by_key(|d| d.key(&p.id));
-        for d in deep.iter().take(5 - what.len().min(5)) {
-            what.push(d.describe(&p.id));
+        for d in deep.iter().take(5) {
+            let (a, other) = d.key(&p.id);
+            let b = match other {
+                Partner::Particle(j) => j as u64,
+                Partner::Face(f) => (1 << 40) | f as u64,
+            };
+            told.push((2, a as u64, b, d.describe(&p.id)));
         }
+        if let Some(d) = &self.domain {
+            told = gather_told(&*d.comm, told);
+        }
+        let mut what: Vec<String> = Vec::new();
+        let kind = |k: u8| told.iter().filter(move |t| t.0 == k).map(|t| t.3.clone());
+        what.extend(kind(0).take(1));
+        what.extend(kind(1).take(5));
+        let room = 5 - what.len().min(5);
+        what.extend(kind(2).take(room));
         Err(Unstable {
             step: self.steps,
             time: self.time,
@@ -1398,6 +1549,9 @@ impl Simulation {
     /// Stage 1 (Section 3.1): new particles in the spawn box or the `[[spawn]]` regions.
     #[inline(never)] // a stage of its own in profiles
     fn spawn(&mut self) {
+        if self.domain.is_some() {
+            return self.spawn_split();
+        }
         let s = &self.scenario;
         if (self.particles.next_id as u64) < s.simulation.max_particles {
             self.spawner.spawn(
@@ -1406,6 +1560,7 @@ impl Simulation {
                 &self.mesh.faces,
                 &self.face_grid,
                 self.time,
+                0.0,
             );
         }
     }
@@ -1426,20 +1581,25 @@ impl Simulation {
     #[inline(never)] // a stage of its own in profiles
     fn update_neighbours(&mut self) {
         let p = &self.particles;
-        if self.neighbours.stale(
+        let stale = self.neighbours.stale(
             &p.x,
             &p.radius,
             &self.mesh.faces,
             self.mesh_drift.max(self.neighbours.shear_drift()),
-        ) {
-            self.rebuild_lists(!self.moving.is_empty());
+        );
+        match &self.domain {
+            // Split over processes: all rebuild when one must.
+            Some(d) if d.comm.any(stale) => self.redistribute(&Default::default()),
+            Some(_) => {}
+            None if stale => self.rebuild_lists(!self.moving.is_empty()),
+            None => {}
         }
     }
 
     /// Rebuilds the Verlet lists (re-sorting the particles into spatial order), re-binning
     /// the faces first if `regrid_faces` (they moved, or larger particles appeared).
     fn rebuild_lists(&mut self, regrid_faces: bool) {
-        if regrid_faces {
+        if regrid_faces || self.particles.max_radius() > self.face_grid_radius {
             self.regrid_faces();
         }
         self.neighbours
@@ -1450,13 +1610,12 @@ impl Simulation {
     /// Bins the faces as they are now for particles up to the largest radius.
     fn regrid_faces(&mut self) {
         let g = &self.scenario.geometry;
-        let max_radius = g.radius_max.max(self.particles.max_radius());
-        self.face_grid = face_grid(&self.mesh.faces, max_radius, self.neighbours.skin);
+        self.regrid_faces_for(g.radius_max.max(self.particles.max_radius()));
     }
 
     /// After a rebuild: loads for the particles, pieces of the face list, and the mesh pose
     /// the lists were built with.
-    fn built(&mut self) {
+    pub(crate) fn built(&mut self) {
         self.loads.clear();
         self.loads.resize(self.particles.len(), Load::default());
         self.built_at = self.steps;
@@ -1752,8 +1911,10 @@ impl Simulation {
             static SCRATCH: std::cell::RefCell<MeshScratch> = Default::default();
         }
         let (face_file, files, about) = (&self.face_file, self.wall_sums.len(), &self.mesh_files);
+        let wall_scales = &self.wall_scales;
+        let owned = self.domain.as_ref().map(|d| &d.owned[..]);
         let all = pieces(bounds, &mut self.loads, start, contact, stores);
-        let walls: Vec<Vec<Wrench>> = all
+        let walls: Vec<(Vec<Sum6>, bool)> = all
             .into_par_iter()
             .with_min_len(MIN_PARALLEL_LEN.div_ceil(FACE_PIECE))
             .map(|piece| {
@@ -1882,9 +2043,9 @@ impl Simulation {
                         a = b;
                     }
                     // The law, `WIDTH` contacts at a time (as for particle pairs), added to
-                    // the particles' loads in slot order, and their reactions to the piece's
-                    // sum for each mesh file.
-                    let mut wall = vec![Wrench::default(); files];
+                    // the particles' loads, and their reactions (of own particles, in a split
+                    // run) to the piece's exact sum for each mesh file.
+                    let (mut wall, mut wall_fine) = (vec![Sum6::default(); files], true);
                     for group in contacts.chunks(WIDTH) {
                         let c: [&Near; WIDTH] =
                             std::array::from_fn(|l| &near[group[l.min(group.len() - 1)] as usize]);
@@ -1939,23 +2100,33 @@ impl Simulation {
                         if files > 0 {
                             // The reaction on the mesh file (Newton's third law for the
                             // force and for the torque about the file's reference point).
-                            for l in 0..group.len() {
+                            for l in (0..group.len()).filter(|&l| owned.is_none_or(|o| o[i[l]])) {
                                 let k = face_file[partner[first + c[l].slot] as usize] as usize;
                                 let arm = p.x[i[l]] - about[k].torque_about;
-                                wall[k] += Wrench {
-                                    f: -f[l],
-                                    tau: -(arm.cross(f[l]) + tau[l]),
-                                };
+                                let reaction = pack(-f[l], -(arm.cross(f[l]) + tau[l]));
+                                wall_fine &= wall[k].add(reaction, wall_scales);
                             }
                         }
                     }
-                    wall
+                    (wall, wall_fine)
                 })
             })
             .collect();
-        for piece in walls {
-            for (sum, w) in self.wall_sums.iter_mut().zip(piece) {
-                *sum += w;
+        if !self.wall_sums.is_empty() {
+            let mut step = vec![Sum6::default(); self.wall_sums.len()];
+            for (piece, fine) in walls {
+                self.beyond_range |= !fine;
+                for (sum, w) in step.iter_mut().zip(&piece) {
+                    sum.merge(w);
+                }
+            }
+            self.reduce_walls(&mut step);
+            for (sum, w) in self.wall_sums.iter_mut().zip(&step) {
+                let [fx, fy, fz, tx, ty, tz] = w.value(&self.wall_scales);
+                *sum += Wrench {
+                    f: DVec3::new(fx, fy, fz),
+                    tau: DVec3::new(tx, ty, tz),
+                };
             }
         }
         self.beyond_range |= beyond.into_inner();

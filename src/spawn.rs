@@ -10,7 +10,7 @@ use rustc_hash::FxHashMap;
 use crate::mesh::Face;
 use crate::neighbours::{CellGrid, cell_of, key};
 use crate::particles::{Particle, Particles};
-use crate::scenario::{RadiusDistribution, Region, Scenario};
+use crate::scenario::{RadiusDistribution, Region, Scenario, SpawnRegion};
 
 /// Draws spawn attempts from a seeded random stream, so the same seed gives the same run.
 #[derive(Clone, Debug)]
@@ -99,6 +99,16 @@ fn draw(rng: &mut ChaCha8Rng, d: &RadiusDistribution) -> f64 {
     }
 }
 
+/// How many particles region `r` should have inserted by the end of the step at `t`:
+/// floor(rate (t + dt - start)), or its count.
+fn due(r: &SpawnRegion, dt: f64, t: f64) -> u64 {
+    match r.rate {
+        Some(rate) => (rate * (t + dt - r.start)).floor() as u64,
+        None => u64::MAX,
+    }
+    .min(r.count.unwrap_or(u64::MAX))
+}
+
 /// The position of a spawner in its random stream, for checkpoints.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SpawnerState {
@@ -147,6 +157,32 @@ impl Spawner {
         self.regions.iter().map(|r| r.inserted).collect()
     }
 
+    /// Whether a step at time `t` would try to spawn, `next_id` particles having been made.
+    pub fn active(&self, s: &Scenario, next_id: u32, t: f64) -> bool {
+        if s.simulation.spawn_attempts == 0 || next_id as u64 >= s.simulation.max_particles {
+            return false;
+        }
+        if s.spawn.is_empty() {
+            return true;
+        }
+        s.spawn.iter().enumerate().any(|(k, r)| {
+            let inserted = self.regions.get(k).map_or(0, |st| st.inserted);
+            t >= r.start && t < r.stop && inserted < due(r, s.simulation.timestep, t)
+        })
+    }
+
+    /// The boxes spawned into: the `[[spawn]]` regions, or the spawn box.
+    pub fn regions(s: &Scenario) -> Vec<Region> {
+        if s.spawn.is_empty() {
+            vec![Region {
+                min: s.geometry.spawn_min,
+                max: s.geometry.spawn_max,
+            }]
+        } else {
+            s.spawn.iter().map(|r| r.region).collect()
+        }
+    }
+
     /// One step of spawning at time `t` (the step ends at `t + dt`), until `N_max`
     /// particles have been created (those removed since included). Without `[[spawn]]`
     /// regions: up to `N_spawn` attempts in the spawn box, each with a uniform centre and a
@@ -154,7 +190,9 @@ impl Spawner {
     /// `start` until `stop`) makes up to `N_spawn` attempts until it has inserted what its
     /// rate asks for by the end of the step (floor(rate (t + dt - start))) or its count. An
     /// attempt is rejected if the sphere would overlap a particle or a mesh face. Returns
-    /// the number of particles added.
+    /// the number of particles added. `present` is the largest radius of the particles
+    /// that exist (`particles` may hold only those near the regions: a process's share).
+    #[allow(clippy::too_many_arguments)]
     pub fn spawn(
         &mut self,
         s: &Scenario,
@@ -162,6 +200,7 @@ impl Spawner {
         faces: &[Face],
         face_grid: &CellGrid,
         t: f64,
+        present: f64,
     ) -> usize {
         let g = &s.geometry;
         let max = s.simulation.max_particles;
@@ -190,7 +229,7 @@ impl Spawner {
                 attempts,
                 u64::MAX,
                 &mut pending,
-                particles,
+                (particles, present),
                 faces,
                 face_grid,
             );
@@ -204,11 +243,7 @@ impl Spawner {
             if t < r.start || t >= r.stop {
                 continue;
             }
-            let due = match r.rate {
-                Some(rate) => (rate * (t + dt - r.start)).floor() as u64,
-                None => u64::MAX,
-            }
-            .min(r.count.unwrap_or(u64::MAX));
+            let due = due(r, dt, t);
             let state = self.regions[k];
             if state.inserted >= due {
                 continue;
@@ -226,7 +261,7 @@ impl Spawner {
                 attempts,
                 due - state.inserted,
                 &mut pending,
-                particles,
+                (particles, present),
                 faces,
                 face_grid,
             );
@@ -250,14 +285,18 @@ impl Spawner {
         attempts: u64,
         budget: u64,
         pending: &mut Option<f64>,
-        particles: &mut Particles,
+        (particles, present): (&mut Particles, f64),
         faces: &[Face],
         face_grid: &CellGrid,
     ) -> u64 {
         let max = s.simulation.max_particles;
         // A grid of the particles that a sphere in the region could touch, grown as
         // particles are added.
-        let h = 2.0 * s.geometry.radius_max.max(particles.max_radius());
+        let h = 2.0
+            * s.geometry
+                .radius_max
+                .max(particles.max_radius())
+                .max(present);
         let inv_h = 1.0 / h;
         let near = Region {
             min: source.region.min - DVec3::splat(h),

@@ -6,11 +6,17 @@
 
 mod common;
 
-use tinydem::simulation::Simulation;
+use tinydem::comm::{Comm, Threads};
+use tinydem::particles::Particles;
+use tinydem::simulation::{Simulation, Wrench};
 
 /// Each particle's id with the bits of its state, in id order.
 fn state_by_id(sim: &Simulation) -> Vec<(u32, Vec<u64>)> {
-    sim.particles
+    bits_by_id(&sim.particles)
+}
+
+fn bits_by_id(particles: &Particles) -> Vec<(u32, Vec<u64>)> {
+    particles
         .iter_by_id()
         .map(|(id, p)| {
             let mut bits: Vec<u64> = [p.x, p.v, p.w]
@@ -23,6 +29,68 @@ fn state_by_id(sim: &Simulation) -> Vec<(u32, Vec<u64>)> {
             (id, bits)
         })
         .collect()
+}
+
+/// What a run ends with, to compare runs: every particle's bits, the loads on the walls
+/// since the start, the particles removed and the energy.
+#[derive(Debug, PartialEq)]
+struct End {
+    particles: Vec<(u32, Vec<u64>)>,
+    walls: Vec<[u64; 6]>,
+    removed: u64,
+    kinetic_energy: u64,
+    contacts: (usize, usize),
+}
+
+fn end_of(sim: &mut Simulation) -> End {
+    let walls = sim
+        .take_wall_loads()
+        .iter()
+        .map(|w: &Wrench| {
+            let a = [w.f.to_array(), w.tau.to_array()].concat();
+            std::array::from_fn(|c| a[c].to_bits())
+        })
+        .collect();
+    let thermo = sim.thermo();
+    End {
+        particles: bits_by_id(&sim.gather_particles()),
+        walls,
+        removed: thermo.removed,
+        kinetic_energy: thermo.kinetic_energy.to_bits(),
+        contacts: (thermo.pair_contacts, thermo.wall_contacts),
+    }
+}
+
+/// A scenario run for `steps` steps split over `k` processes (threads of this one), as
+/// process 0 ends it; and how often the boxes were cut.
+fn split_run(text: &str, steps: u64, k: usize) -> (End, u64) {
+    let text = text.to_string();
+    let handles: Vec<_> = Threads::group(k)
+        .into_iter()
+        .map(|comm| {
+            let text = text.clone();
+            std::thread::spawn(move || {
+                let rank = comm.rank();
+                let sim = Simulation::new(common::scenario(&text)).expect("starts");
+                let mut sim = sim.split(Box::new(comm)).expect("splits");
+                for _ in 0..steps {
+                    sim.step().expect("stable");
+                }
+                let cuts = sim.domain().expect("split").cuts;
+                (rank, end_of(&mut sim), cuts)
+            })
+        })
+        .collect();
+    let mut ends: Vec<(usize, End, u64)> = handles
+        .into_iter()
+        .map(|h| h.join().expect("no panic"))
+        .collect();
+    ends.sort_by_key(|e| e.0);
+    let (_, first, cuts) = ends.remove(0);
+    for (rank, end, _) in ends {
+        assert!(end == first, "process {rank} ends otherwise than process 0");
+    }
+    (first, cuts)
 }
 
 /// The silo of `tests/data/stages` filling through its plug-less outlet: spawning, two
@@ -62,6 +130,31 @@ fn the_skin_changes_how_often_the_lists_are_rebuilt_not_the_bits() {
         assert!(
             state_by_id(sim) == reference,
             "skin {skin}: the state differs from skin 0.5's"
+        );
+    }
+}
+
+#[test]
+fn a_run_split_over_processes_gives_the_bits_of_one_process() {
+    let steps = 2500;
+    let text = silo(0.5);
+    let mut single = common::simulate(&text, steps);
+    let reference = end_of(&mut single);
+    assert!(reference.removed > 0 && reference.particles.len() > 200);
+    for k in [2, 3, 4] {
+        let (end, cuts) = split_run(&text, steps, k);
+        assert!(
+            cuts > 1,
+            "{k} processes: the boxes should be cut anew as the silo fills"
+        );
+        assert_eq!(
+            end.particles.len(),
+            reference.particles.len(),
+            "{k} processes"
+        );
+        assert!(
+            end == reference,
+            "{k} processes: the run differs from one process's"
         );
     }
 }

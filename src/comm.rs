@@ -1,0 +1,269 @@
+//! Messages between the processes of a run split over several (`domain.rs`): the few
+//! collective operations it needs, over bytes, and the encoding of numbers into them.
+//!
+//! [`Comm`] is implemented by [`Solo`] (one process), by [`Threads`] (several simulations in
+//! one process, one thread each: how the tests split a run without MPI) and, with the `mpi`
+//! feature, over MPI. Every operation is collective: each process calls it, in the same
+//! order.
+
+use std::sync::{Arc, Barrier, Mutex};
+
+use glam::{DQuat, DVec3};
+
+/// The collective operations of a run split over `size` processes.
+pub trait Comm: Send {
+    /// This process, from 0.
+    fn rank(&self) -> usize;
+    /// The number of processes.
+    fn size(&self) -> usize;
+    /// Sends `send[q]` to each process q and returns what each process sent to this one.
+    fn all_to_all(&self, send: Vec<Vec<u8>>) -> Vec<Vec<u8>>;
+    /// What every process contributed, by rank (on every process).
+    fn all_gather(&self, data: Vec<u8>) -> Vec<Vec<u8>>;
+
+    /// Whether any process says so.
+    fn any(&self, flag: bool) -> bool {
+        self.all_gather(vec![flag as u8])
+            .iter()
+            .any(|d| d.first() == Some(&1))
+    }
+
+    /// The largest of the processes' values.
+    fn max(&self, x: f64) -> f64 {
+        self.all_gather(x.to_le_bytes().to_vec())
+            .iter()
+            .map(|d| Reader::new(d).f64())
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+
+    /// The sum of the processes' integers (exact, so in any order).
+    fn sum_i64(&self, x: &[i64]) -> Vec<i64> {
+        let mut w = Writer::default();
+        x.iter().for_each(|&v| w.i64(v));
+        let mut total = vec![0i64; x.len()];
+        for d in self.all_gather(w.0) {
+            let mut r = Reader::new(&d);
+            for t in &mut total {
+                *t = t.wrapping_add(r.i64());
+            }
+        }
+        total
+    }
+}
+
+/// A run in one process.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Solo;
+
+impl Comm for Solo {
+    fn rank(&self) -> usize {
+        0
+    }
+    fn size(&self) -> usize {
+        1
+    }
+    fn all_to_all(&self, send: Vec<Vec<u8>>) -> Vec<Vec<u8>> {
+        send
+    }
+    fn all_gather(&self, data: Vec<u8>) -> Vec<Vec<u8>> {
+        vec![data]
+    }
+}
+
+/// What the threads of one [`Threads`] group put down for each other.
+struct Hub {
+    /// For each sender, its messages to each receiver.
+    posted: Mutex<Vec<Vec<Vec<u8>>>>,
+    barrier: Barrier,
+}
+
+/// One of `k` simulations that run as the processes of one split run, each in a thread of
+/// its own: [`Threads::group`] makes the `k` ends.
+pub struct Threads {
+    rank: usize,
+    size: usize,
+    hub: Arc<Hub>,
+}
+
+impl Threads {
+    /// The `k` ends of a group, by rank.
+    pub fn group(k: usize) -> Vec<Threads> {
+        let hub = Arc::new(Hub {
+            posted: Mutex::new(vec![Vec::new(); k]),
+            barrier: Barrier::new(k),
+        });
+        (0..k)
+            .map(|rank| Threads {
+                rank,
+                size: k,
+                hub: hub.clone(),
+            })
+            .collect()
+    }
+}
+
+impl Comm for Threads {
+    fn rank(&self) -> usize {
+        self.rank
+    }
+    fn size(&self) -> usize {
+        self.size
+    }
+    fn all_to_all(&self, send: Vec<Vec<u8>>) -> Vec<Vec<u8>> {
+        assert_eq!(send.len(), self.size, "one message per process");
+        self.hub.posted.lock().expect("not poisoned")[self.rank] = send;
+        self.hub.barrier.wait();
+        let received = {
+            let mut posted = self.hub.posted.lock().expect("not poisoned");
+            (0..self.size)
+                .map(|q| std::mem::take(&mut posted[q][self.rank]))
+                .collect()
+        };
+        // Nobody posts again before everyone has taken theirs.
+        self.hub.barrier.wait();
+        received
+    }
+    fn all_gather(&self, data: Vec<u8>) -> Vec<Vec<u8>> {
+        self.all_to_all(vec![data; self.size])
+    }
+}
+
+/// Numbers into bytes (little-endian), for messages.
+#[derive(Clone, Debug, Default)]
+pub struct Writer(pub Vec<u8>);
+
+impl Writer {
+    pub fn u8(&mut self, v: u8) {
+        self.0.push(v);
+    }
+    pub fn u16(&mut self, v: u16) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+    pub fn u32(&mut self, v: u32) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+    pub fn u64(&mut self, v: u64) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+    pub fn i64(&mut self, v: i64) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+    pub fn f64(&mut self, v: f64) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+    pub fn vec3(&mut self, v: DVec3) {
+        v.to_array().iter().for_each(|&c| self.f64(c));
+    }
+    pub fn quat(&mut self, q: DQuat) {
+        q.to_array().iter().for_each(|&c| self.f64(c));
+    }
+    pub fn bytes(&mut self, b: &[u8]) {
+        self.u64(b.len() as u64);
+        self.0.extend_from_slice(b);
+    }
+}
+
+/// Numbers out of bytes written by a [`Writer`], in the same order. Reading past the end is
+/// a bug of the program (the processes disagree on a message), so it panics.
+pub struct Reader<'a> {
+    data: &'a [u8],
+    at: usize,
+}
+
+impl<'a> Reader<'a> {
+    pub fn new(data: &'a [u8]) -> Self {
+        Reader { data, at: 0 }
+    }
+    pub fn done(&self) -> bool {
+        self.at >= self.data.len()
+    }
+    fn take<const N: usize>(&mut self) -> [u8; N] {
+        let b = self.data[self.at..self.at + N].try_into().expect("N bytes");
+        self.at += N;
+        b
+    }
+    pub fn u8(&mut self) -> u8 {
+        self.take::<1>()[0]
+    }
+    pub fn u16(&mut self) -> u16 {
+        u16::from_le_bytes(self.take())
+    }
+    pub fn u32(&mut self) -> u32 {
+        u32::from_le_bytes(self.take())
+    }
+    pub fn u64(&mut self) -> u64 {
+        u64::from_le_bytes(self.take())
+    }
+    pub fn i64(&mut self) -> i64 {
+        i64::from_le_bytes(self.take())
+    }
+    pub fn f64(&mut self) -> f64 {
+        f64::from_le_bytes(self.take())
+    }
+    pub fn vec3(&mut self) -> DVec3 {
+        DVec3::new(self.f64(), self.f64(), self.f64())
+    }
+    pub fn quat(&mut self) -> DQuat {
+        DQuat::from_xyzw(self.f64(), self.f64(), self.f64(), self.f64())
+    }
+    pub fn bytes(&mut self) -> &'a [u8] {
+        let n = self.u64() as usize;
+        let b = &self.data[self.at..self.at + n];
+        self.at += n;
+        b
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn threads_exchange_what_each_sends_to_each() {
+        let ends = Threads::group(3);
+        let handles: Vec<_> = ends
+            .into_iter()
+            .map(|c| {
+                std::thread::spawn(move || {
+                    let r = c.rank() as u8;
+                    let got = c.all_to_all((0..3).map(|q| vec![r, q as u8]).collect());
+                    let all = c.all_gather(vec![r * 10]);
+                    let total = c.sum_i64(&[r as i64, 1]);
+                    (got, all, total, c.any(r == 2), c.max(r as f64))
+                })
+            })
+            .collect();
+        for (rank, h) in handles.into_iter().enumerate() {
+            let (got, all, total, any, max) = h.join().expect("no panic");
+            let expected: Vec<Vec<u8>> = (0..3).map(|q| vec![q as u8, rank as u8]).collect();
+            assert_eq!(got, expected);
+            assert_eq!(all, vec![vec![0], vec![10], vec![20]]);
+            assert_eq!(total, vec![3, 3]);
+            assert!(any);
+            assert_eq!(max, 2.0);
+        }
+    }
+
+    #[test]
+    fn numbers_read_back_as_written() {
+        let mut w = Writer::default();
+        w.u8(7);
+        w.u16(65000);
+        w.u32(123456789);
+        w.f64(-0.1);
+        w.vec3(DVec3::new(1.0, -2.0, f64::MIN_POSITIVE));
+        w.quat(DQuat::from_xyzw(0.5, 0.5, -0.5, 0.5));
+        w.bytes(b"abc");
+        w.i64(-5);
+        let mut r = Reader::new(&w.0);
+        assert_eq!(r.u8(), 7);
+        assert_eq!(r.u16(), 65000);
+        assert_eq!(r.u32(), 123456789);
+        assert_eq!(r.f64(), -0.1);
+        assert_eq!(r.vec3(), DVec3::new(1.0, -2.0, f64::MIN_POSITIVE));
+        assert_eq!(r.quat(), DQuat::from_xyzw(0.5, 0.5, -0.5, 0.5));
+        assert_eq!(r.bytes(), b"abc");
+        assert_eq!(r.i64(), -5);
+        assert!(r.done());
+    }
+}

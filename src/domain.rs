@@ -1,0 +1,755 @@
+//! A run split over processes (domain decomposition), with the bits of the run in one.
+//!
+//! Each process owns the particles of a box of space, cut by recursive coordinate
+//! bisection ([`Tree`], balanced by count), and holds copies (ghosts) of the other
+//! processes' particles within reach of its box: `r_i + R_max + skin`, so every pair the
+//! lists of one process would hold is listed on the process of each partner. A process
+//! runs the stages of the step on all it holds; a pair of an own particle and a ghost is
+//! evaluated on both sides, from the same bits, so both keep the same springs. Since the
+//! loads are exact sums (`exact.rs`), an own particle's load is that of the run in one
+//! process, bit for bit, and so is its motion. After integrating, each process sends the
+//! new states of its particles to the processes that hold them as ghosts.
+//!
+//! When the lists must be rebuilt (on any process), every process rebuilds them: its
+//! particles that left its box go to their new owners with their contact history (the
+//! springs of their pairs, keyed by the pair of ids, and of their faces), the ghosts are
+//! made afresh, and the boxes are cut anew when the counts are out of balance. Spawning
+//! draws the same random stream on every process, against the particles of all processes
+//! near the spawn regions; removals are counted in id order over all processes. Wall
+//! loads are exact sums over all processes.
+
+use anyhow::{Result, bail};
+use glam::DVec3;
+use rustc_hash::{FxHashMap, FxHashSet};
+
+use crate::comm::{Comm, Reader, Writer};
+use crate::contact::Springs;
+use crate::exact::Sum6;
+use crate::integrate::Inertia;
+use crate::neighbours::face_grid;
+use crate::particles::{Particle, Particles};
+use crate::simulation::{Outflow, Simulation};
+use crate::spawn::Spawner;
+
+/// Past this ratio of the largest process's particle count to the mean, the boxes are cut
+/// anew at the next rebuild.
+const REBALANCE: f64 = 1.1;
+
+/// Bisection steps for each cut: the cut lies within 2^-48 of the particles' extent of
+/// the place that halves the count.
+const BISECTIONS: usize = 48;
+
+/// A node of the bisection: a process's box, or a cut across an axis.
+#[derive(Clone, Copy, Debug)]
+enum Cell {
+    Leaf(usize),
+    Cut {
+        axis: usize,
+        at: f64,
+        below: u32,
+        above: u32,
+    },
+}
+
+/// The boxes of the processes: space cut recursively across an axis at a time (the
+/// outermost boxes reach to infinity).
+#[derive(Clone, Debug)]
+pub struct Tree {
+    cells: Vec<Cell>,
+}
+
+impl Tree {
+    /// The process whose box holds `x` (below a cut: `x[axis] < at`).
+    pub fn owner(&self, x: DVec3) -> usize {
+        let mut c = 0;
+        loop {
+            match self.cells[c] {
+                Cell::Leaf(rank) => return rank,
+                Cell::Cut {
+                    axis,
+                    at,
+                    below,
+                    above,
+                } => c = if x[axis] < at { below } else { above } as usize,
+            }
+        }
+    }
+
+    /// The processes whose boxes meet the cube of half-width `reach` around `x`.
+    pub fn near(&self, x: DVec3, reach: f64, out: &mut Vec<usize>) {
+        out.clear();
+        let mut todo = vec![0u32];
+        while let Some(c) = todo.pop() {
+            match self.cells[c as usize] {
+                Cell::Leaf(rank) => out.push(rank),
+                Cell::Cut {
+                    axis,
+                    at,
+                    below,
+                    above,
+                } => {
+                    if x[axis] - reach < at {
+                        todo.push(below);
+                    }
+                    if x[axis] + reach >= at {
+                        todo.push(above);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Cuts space among the processes of `comm` so that each holds about as many of the
+    /// points as the others (`x`: this process's share of them). Level by level: each group
+    /// of processes cuts its box across the longest extent of its points, at the place
+    /// that leaves below as many points as the first half of its processes should hold,
+    /// found by bisection with the counts summed over all processes. Every process gets
+    /// the same tree.
+    pub fn bisect(comm: &dyn Comm, x: &[DVec3]) -> Tree {
+        struct Group {
+            cell: usize,
+            ranks: std::ops::Range<usize>,
+            members: Vec<u32>,
+        }
+        let mut cells = vec![Cell::Leaf(0)];
+        let mut groups = vec![Group {
+            cell: 0,
+            ranks: 0..comm.size(),
+            members: (0..x.len() as u32).collect(),
+        }];
+        loop {
+            let (split, done): (Vec<Group>, Vec<Group>) =
+                groups.into_iter().partition(|g| g.ranks.len() > 1);
+            for g in done {
+                cells[g.cell] = Cell::Leaf(g.ranks.start);
+            }
+            if split.is_empty() {
+                break;
+            }
+            // The extent and count of each group's points over all processes.
+            let mut w = Writer::default();
+            for g in &split {
+                let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+                for &i in &g.members {
+                    (lo, hi) = (lo.min(x[i as usize]), hi.max(x[i as usize]));
+                }
+                w.vec3(lo);
+                w.vec3(hi);
+                w.u64(g.members.len() as u64);
+            }
+            let mut lo = vec![DVec3::INFINITY; split.len()];
+            let mut hi = vec![DVec3::NEG_INFINITY; split.len()];
+            let mut count = vec![0u64; split.len()];
+            for d in comm.all_gather(w.0) {
+                let mut r = Reader::new(&d);
+                for g in 0..split.len() {
+                    lo[g] = lo[g].min(r.vec3());
+                    hi[g] = hi[g].max(r.vec3());
+                    count[g] += r.u64();
+                }
+            }
+            let axis: Vec<usize> = (0..split.len())
+                .map(|g| {
+                    let e = hi[g] - lo[g];
+                    if !e.is_finite() || (e.x >= e.y && e.x >= e.z) {
+                        0
+                    } else if e.y >= e.z {
+                        1
+                    } else {
+                        2
+                    }
+                })
+                .collect();
+            let target: Vec<i64> = (0..split.len())
+                .map(|g| {
+                    let (n, left) = (split[g].ranks.len() as u64, split[g].ranks.len() as u64 / 2);
+                    ((count[g] * left + n / 2) / n) as i64
+                })
+                .collect();
+            let mut a: Vec<f64> = (0..split.len()).map(|g| lo[g][axis[g]]).collect();
+            let mut b: Vec<f64> = (0..split.len()).map(|g| hi[g][axis[g]]).collect();
+            for g in 0..split.len() {
+                if !(a[g].is_finite() && b[g].is_finite()) {
+                    (a[g], b[g]) = (0.0, 0.0);
+                }
+            }
+            for _ in 0..BISECTIONS {
+                let mid: Vec<f64> = (0..split.len())
+                    .map(|g| a[g] + 0.5 * (b[g] - a[g]))
+                    .collect();
+                let below: Vec<i64> = split
+                    .iter()
+                    .enumerate()
+                    .map(|(g, grp)| {
+                        grp.members
+                            .iter()
+                            .filter(|&&i| x[i as usize][axis[g]] < mid[g])
+                            .count() as i64
+                    })
+                    .collect();
+                let below = comm.sum_i64(&below);
+                for g in 0..split.len() {
+                    if below[g] < target[g] {
+                        a[g] = mid[g];
+                    } else {
+                        b[g] = mid[g];
+                    }
+                }
+            }
+            groups = Vec::new();
+            for (g, grp) in split.into_iter().enumerate() {
+                let (at, axis) = (b[g], axis[g]);
+                let (below, above) = (cells.len(), cells.len() + 1);
+                cells.push(Cell::Leaf(0));
+                cells.push(Cell::Leaf(0));
+                cells[grp.cell] = Cell::Cut {
+                    axis,
+                    at,
+                    below: below as u32,
+                    above: above as u32,
+                };
+                let middle = grp.ranks.start + grp.ranks.len() / 2;
+                let (under, over): (Vec<u32>, Vec<u32>) =
+                    grp.members.iter().partition(|&&i| x[i as usize][axis] < at);
+                groups.push(Group {
+                    cell: below,
+                    ranks: grp.ranks.start..middle,
+                    members: under,
+                });
+                groups.push(Group {
+                    cell: above,
+                    ranks: middle..grp.ranks.end,
+                    members: over,
+                });
+            }
+        }
+        Tree { cells }
+    }
+}
+
+/// The share of one process in a split run.
+pub struct Domain {
+    pub(crate) comm: Box<dyn Comm>,
+    tree: Option<Tree>,
+    /// Whether each particle held (storage order) is this process's own; the others are
+    /// ghosts, copies of other processes' particles.
+    pub(crate) owned: Vec<bool>,
+    /// For each process, the own particles (storage indices, in id order) it holds as
+    /// ghosts; and the ghosts it sends the states of (storage indices, in id order).
+    send: Vec<Vec<u32>>,
+    recv: Vec<Vec<u32>>,
+    /// Times the boxes were cut.
+    pub cuts: u64,
+}
+
+impl Domain {
+    /// This process and the number of processes.
+    pub fn rank(&self) -> (usize, usize) {
+        (self.comm.rank(), self.comm.size())
+    }
+
+    /// Own particles held.
+    pub fn own_count(&self) -> usize {
+        self.owned.iter().filter(|&&o| o).count()
+    }
+}
+
+fn put_particle(w: &mut Writer, id: u32, p: &Particle) {
+    w.u32(id);
+    w.f64(p.radius);
+    w.vec3(p.x);
+    w.vec3(p.v);
+    w.quat(p.q);
+    w.vec3(p.w);
+    w.u32(p.tag);
+    w.u16(p.material);
+}
+
+fn get_particle(r: &mut Reader) -> (u32, Particle) {
+    let id = r.u32();
+    let p = Particle {
+        radius: r.f64(),
+        x: r.vec3(),
+        v: r.vec3(),
+        q: r.quat(),
+        w: r.vec3(),
+        tag: r.u32(),
+        material: r.u16(),
+    };
+    (id, p)
+}
+
+fn put_entry(w: &mut Writer, (a, b, s): &(u32, u32, Springs)) {
+    w.u32(*a);
+    w.u32(*b);
+    w.vec3(s.u_s);
+    w.vec3(s.u_r);
+    w.f64(s.u_t);
+}
+
+fn get_entry(r: &mut Reader) -> (u32, u32, Springs) {
+    (
+        r.u32(),
+        r.u32(),
+        Springs {
+            u_s: r.vec3(),
+            u_r: r.vec3(),
+            u_t: r.f64(),
+        },
+    )
+}
+
+/// Entries sorted by their pair of keys, each once (copies from two processes are the same
+/// bits: both evaluated the pair from the same states).
+fn dedup(mut entries: Vec<(u32, u32, Springs)>) -> Vec<(u32, u32, Springs)> {
+    entries.sort_unstable_by_key(|e| (e.0, e.1));
+    entries.dedup_by_key(|e| (e.0, e.1));
+    entries
+}
+
+impl Simulation {
+    /// Splits this simulation over the processes of `comm`: each process calls it with the
+    /// same simulation (all its particles, as made or restored), keeps its share and the
+    /// ghosts it needs, and from then on steps together with the others.
+    pub fn split(mut self, comm: Box<dyn Comm>) -> Result<Simulation> {
+        if self.scenario.periodicity().is_some() {
+            bail!(
+                "a run over several processes cannot have periodic sides yet: run it in one process"
+            );
+        }
+        let (rank, size) = (comm.rank(), comm.size());
+        let owned = self
+            .particles
+            .id
+            .iter()
+            .map(|&id| id as usize % size == rank)
+            .collect();
+        self.domain = Some(Domain {
+            comm,
+            tree: None,
+            owned,
+            send: Vec::new(),
+            recv: Vec::new(),
+            cuts: 0,
+        });
+        self.redistribute(&FxHashSet::default());
+        Ok(self)
+    }
+
+    /// This process's share of a split run, if it is one.
+    pub fn domain(&self) -> Option<&Domain> {
+        self.domain.as_ref()
+    }
+
+    /// Whether the particle stored at `i` is this process's own (always, in one process).
+    #[inline]
+    pub(crate) fn own(&self, i: usize) -> bool {
+        self.domain.as_ref().is_none_or(|d| d.owned[i])
+    }
+
+    /// Rebuilds the lists of every process of a split run (collective): the own particles
+    /// (but those of ids in `gone`) to the owners of the boxes they are in now (the boxes
+    /// cut anew when out of balance) with the springs of their contacts, then the ghosts
+    /// each process needs, then the lists.
+    pub(crate) fn redistribute(&mut self, gone: &FxHashSet<u32>) {
+        let mut d = self.domain.take().expect("a split run");
+        let (me, k) = (d.comm.rank(), d.comm.size());
+        let p = &self.particles;
+        let history = self.neighbours.history(&p.id, p.next_id as usize);
+        let (pairs, faces) = (history.pairs.entries(), history.faces.entries());
+        drop(history);
+        let index: FxHashMap<u32, u32> =
+            p.id.iter()
+                .enumerate()
+                .map(|(i, &id)| (id, i as u32))
+                .collect();
+        let kept = |i: usize| d.owned[i] && !gone.contains(&p.id[i]);
+        // The boxes, cut anew when the counts are out of balance.
+        let own: Vec<DVec3> = (0..p.len()).filter(|&i| kept(i)).map(|i| p.x[i]).collect();
+        let counts: Vec<u64> = d
+            .comm
+            .all_gather((own.len() as u64).to_le_bytes().to_vec())
+            .iter()
+            .map(|c| Reader::new(c).u64())
+            .collect();
+        let mean = counts.iter().sum::<u64>() as f64 / k as f64;
+        let largest = counts.iter().copied().max().unwrap_or(0) as f64;
+        if d.tree.is_none() || largest > REBALANCE * mean.max(1.0) {
+            d.tree = Some(Tree::bisect(&*d.comm, &own));
+            d.cuts += 1;
+        }
+        drop(own);
+        let tree = d.tree.as_ref().expect("cut");
+        // Own particles to their owners, with the springs of their contacts: a pair's to
+        // the owners of both, as either may need it.
+        let owner = |id: u32| tree.owner(p.x[index[&id] as usize]);
+        let mut particles_to: Vec<Vec<u32>> = vec![Vec::new(); k];
+        for i in (0..p.len()).filter(|&i| kept(i)) {
+            particles_to[tree.owner(p.x[i])].push(i as u32);
+        }
+        let mine = |id: u32| d.owned[index[&id] as usize];
+        let mut pairs_to: Vec<Vec<usize>> = vec![Vec::new(); k];
+        for (e, &(a, b, _)) in pairs.iter().enumerate() {
+            if gone.contains(&a) || gone.contains(&b) || !(mine(a) || mine(b)) {
+                continue;
+            }
+            let (qa, qb) = (owner(a), owner(b));
+            pairs_to[qa].push(e);
+            if qb != qa {
+                pairs_to[qb].push(e);
+            }
+        }
+        let mut faces_to: Vec<Vec<usize>> = vec![Vec::new(); k];
+        for (e, &(a, _, _)) in faces.iter().enumerate() {
+            if !gone.contains(&a) && mine(a) {
+                faces_to[owner(a)].push(e);
+            }
+        }
+        let messages: Vec<Vec<u8>> = (0..k)
+            .map(|q| {
+                let mut w = Writer::default();
+                w.u64(particles_to[q].len() as u64);
+                for &i in &particles_to[q] {
+                    put_particle(&mut w, p.id[i as usize], &p.get(i as usize));
+                }
+                w.u64(pairs_to[q].len() as u64);
+                pairs_to[q]
+                    .iter()
+                    .for_each(|&e| put_entry(&mut w, &pairs[e]));
+                w.u64(faces_to[q].len() as u64);
+                faces_to[q]
+                    .iter()
+                    .for_each(|&e| put_entry(&mut w, &faces[e]));
+                w.0
+            })
+            .collect();
+        drop((particles_to, pairs_to, faces_to, index));
+        let next_id = p.next_id;
+        let mut held = Particles {
+            next_id,
+            ..Particles::default()
+        };
+        let (mut pairs, mut faces) = (Vec::new(), Vec::new());
+        for m in d.comm.all_to_all(messages) {
+            let mut r = Reader::new(&m);
+            for _ in 0..r.u64() {
+                let (id, particle) = get_particle(&mut r);
+                held.insert(id, particle);
+            }
+            for _ in 0..r.u64() {
+                pairs.push(get_entry(&mut r));
+            }
+            for _ in 0..r.u64() {
+                faces.push(get_entry(&mut r));
+            }
+        }
+        let (pairs, faces) = (dedup(pairs), dedup(faces));
+        // Ghosts: copies of own particles for the processes whose boxes are within reach.
+        let n_own = held.len();
+        let r_max = d.comm.max(held.max_radius()).max(0.0);
+        let skin = self.neighbours.skin;
+        let mut ghosts_to: Vec<Vec<u32>> = vec![Vec::new(); k];
+        let mut near = Vec::new();
+        for i in 0..n_own {
+            tree.near(held.x[i], held.radius[i] + r_max + skin, &mut near);
+            for &q in near.iter().filter(|&&q| q != me) {
+                ghosts_to[q].push(held.id[i]);
+            }
+        }
+        let at: FxHashMap<u32, usize> =
+            held.id.iter().enumerate().map(|(i, &id)| (id, i)).collect();
+        let messages: Vec<Vec<u8>> = (0..k)
+            .map(|q| {
+                let mut w = Writer::default();
+                w.u64(ghosts_to[q].len() as u64);
+                for &id in &ghosts_to[q] {
+                    put_particle(&mut w, id, &held.get(at[&id]));
+                }
+                w.0
+            })
+            .collect();
+        drop(at);
+        let mut ghosts_from: Vec<Vec<u32>> = vec![Vec::new(); k];
+        for (q, m) in d.comm.all_to_all(messages).into_iter().enumerate() {
+            let mut r = Reader::new(&m);
+            for _ in 0..r.u64() {
+                let (id, particle) = get_particle(&mut r);
+                held.insert(id, particle);
+                ghosts_from[q].push(id);
+            }
+        }
+        let mut owned: Vec<bool> = (0..held.len()).map(|i| i < n_own).collect();
+        // The lists, with the faces binned for the largest particle of all processes.
+        self.particles = held;
+        let max_radius = self.scenario.geometry.radius_max.max(r_max);
+        if self.mesh_moves() || max_radius > self.face_grid_radius {
+            self.regrid_faces_for(max_radius);
+        }
+        let order = self.neighbours.rebuild_from(
+            &mut self.particles,
+            &pairs,
+            &faces,
+            &self.mesh.faces,
+            &self.face_grid,
+        );
+        owned = order.iter().map(|&o| owned[o as usize]).collect();
+        let at: FxHashMap<u32, u32> = self
+            .particles
+            .id
+            .iter()
+            .enumerate()
+            .map(|(i, &id)| (id, i as u32))
+            .collect();
+        let by_id = |mut ids: Vec<u32>| {
+            ids.sort_unstable();
+            ids.iter().map(|id| at[id]).collect::<Vec<u32>>()
+        };
+        d.send = ghosts_to.into_iter().map(by_id).collect();
+        d.recv = ghosts_from.into_iter().map(by_id).collect();
+        d.owned = owned;
+        self.domain = Some(d);
+        self.built();
+    }
+
+    /// Sends the new states of own particles to the processes that hold them as ghosts,
+    /// and takes theirs (collective).
+    pub(crate) fn refresh_ghosts(&mut self) {
+        let Some(d) = &self.domain else { return };
+        let p = &mut self.particles;
+        let messages: Vec<Vec<u8>> = d
+            .send
+            .iter()
+            .map(|list| {
+                let mut w = Writer(Vec::with_capacity(list.len() * 108));
+                for &i in list {
+                    let i = i as usize;
+                    w.vec3(p.x[i]);
+                    w.vec3(p.v[i]);
+                    w.quat(p.q[i]);
+                    w.vec3(p.w[i]);
+                    w.u32(p.tag[i]);
+                }
+                w.0
+            })
+            .collect();
+        for (m, list) in d.comm.all_to_all(messages).iter().zip(&d.recv) {
+            let mut r = Reader::new(m);
+            for &i in list {
+                let i = i as usize;
+                p.x[i] = r.vec3();
+                p.v[i] = r.vec3();
+                p.q[i] = r.quat();
+                p.w[i] = r.vec3();
+                p.tag[i] = r.u32();
+            }
+        }
+    }
+
+    /// Stage 1 of a split run (collective): every process draws the same candidates and
+    /// tests them against the particles of all processes near the spawn regions; each keeps
+    /// the new particles in its box.
+    pub(crate) fn spawn_split(&mut self) {
+        let s = &self.scenario;
+        let p = &self.particles;
+        if !self.spawner.active(s, p.next_id, self.time) {
+            return;
+        }
+        let d = self.domain.as_ref().expect("a split run");
+        let mut largest = s.geometry.radius_max;
+        for r in &s.spawn {
+            largest = largest.max(r.radius.largest());
+        }
+        let own_max = (0..p.len())
+            .filter(|&i| d.owned[i])
+            .map(|i| p.radius[i])
+            .fold(0.0, f64::max);
+        let present = d.comm.max(own_max).max(0.0);
+        let margin = DVec3::splat(2.0 * largest.max(present));
+        let regions = Spawner::regions(s);
+        let near = |x: DVec3| {
+            regions
+                .iter()
+                .any(|r| x.cmpge(r.min - margin).all() && x.cmple(r.max + margin).all())
+        };
+        let mut w = Writer::default();
+        for i in (0..p.len()).filter(|&i| d.owned[i] && near(p.x[i])) {
+            put_particle(&mut w, p.id[i], &p.get(i));
+        }
+        let mut nearby: Vec<(u32, Particle)> = Vec::new();
+        for m in d.comm.all_gather(w.0) {
+            let mut r = Reader::new(&m);
+            while !r.done() {
+                nearby.push(get_particle(&mut r));
+            }
+        }
+        nearby.sort_unstable_by_key(|e| e.0);
+        let old_next = p.next_id;
+        let mut around = Particles {
+            next_id: old_next,
+            ..Particles::default()
+        };
+        for (id, particle) in nearby {
+            around.insert(id, particle);
+        }
+        self.spawner.spawn(
+            s,
+            &mut around,
+            &self.mesh.faces,
+            &self.face_grid,
+            self.time,
+            present,
+        );
+        if around.next_id == old_next {
+            return;
+        }
+        let d = self.domain.as_mut().expect("a split run");
+        let tree = d.tree.as_ref().expect("cut");
+        let me = d.comm.rank();
+        for i in (0..around.len()).filter(|&i| around.id[i] >= old_next) {
+            let particle = around.get(i);
+            if tree.owner(particle.x) == me {
+                self.particles.insert(around.id[i], particle);
+                d.owned.push(true);
+            }
+        }
+        self.particles.next_id = around.next_id;
+        self.redistribute(&FxHashSet::default());
+    }
+
+    /// Stage 7 of a split run (collective): the own particles that left, counted over all
+    /// processes in id order; then every process rebuilds without them.
+    pub(crate) fn remove_split(&mut self, fate: impl Fn(DVec3) -> Option<u32>) {
+        let d = self.domain.as_ref().expect("a split run");
+        let p = &self.particles;
+        let mut w = Writer::default();
+        for i in (0..p.len()).filter(|&i| d.owned[i]) {
+            if let Some(f) = fate(p.x[i]) {
+                let density = self.densities[p.material[i] as usize];
+                w.u32(p.id[i]);
+                w.u32(f);
+                w.f64(Inertia::mass_with(p.radius[i], density.mass_per_r3));
+            }
+        }
+        let mut gone: Vec<(u32, u32, f64)> = Vec::new();
+        for m in d.comm.all_gather(w.0) {
+            let mut r = Reader::new(&m);
+            while !r.done() {
+                gone.push((r.u32(), r.u32(), r.f64()));
+            }
+        }
+        if gone.is_empty() {
+            return;
+        }
+        // Counted in id order, as in one process.
+        gone.sort_unstable_by_key(|g| g.0);
+        for &(_, f, mass) in &gone {
+            let out: &mut Outflow = match self.removed.outlets.get_mut(f as usize) {
+                Some(o) => o,
+                None => &mut self.removed.domain,
+            };
+            out.count += 1;
+            out.mass += mass;
+        }
+        let ids: FxHashSet<u32> = gone.iter().map(|g| g.0).collect();
+        self.redistribute(&ids);
+    }
+
+    /// The wall loads of this step over all processes (collective): exact sums, merged.
+    pub(crate) fn reduce_walls(&self, step: &mut [Sum6]) {
+        let Some(d) = &self.domain else { return };
+        let words: Vec<i64> = step.iter().flat_map(|s| s.words()).collect();
+        let total = d.comm.sum_i64(&words);
+        for (s, w) in step.iter_mut().zip(total.chunks(12)) {
+            *s = Sum6::from_words(w.try_into().expect("12 words"));
+            s.carry();
+        }
+    }
+
+    /// All particles of a split run, in id order, on every process (collective); this
+    /// process's particles in one.
+    pub fn gather_particles(&self) -> Particles {
+        let p = &self.particles;
+        let Some(d) = &self.domain else {
+            let mut all = Particles {
+                next_id: p.next_id,
+                ..Particles::default()
+            };
+            for (id, particle) in p.iter_by_id() {
+                all.insert(id, particle);
+            }
+            return all;
+        };
+        let mut w = Writer::default();
+        for i in (0..p.len()).filter(|&i| d.owned[i]) {
+            put_particle(&mut w, p.id[i], &p.get(i));
+        }
+        let mut all: Vec<(u32, Particle)> = Vec::new();
+        for m in d.comm.all_gather(w.0) {
+            let mut r = Reader::new(&m);
+            while !r.done() {
+                all.push(get_particle(&mut r));
+            }
+        }
+        all.sort_unstable_by_key(|e| e.0);
+        let mut out = Particles {
+            next_id: p.next_id,
+            ..Particles::default()
+        };
+        for (id, particle) in all {
+            out.insert(id, particle);
+        }
+        out
+    }
+
+    /// Bins the faces for particles up to radius `max_radius`.
+    pub(crate) fn regrid_faces_for(&mut self, max_radius: f64) {
+        self.face_grid = face_grid(&self.mesh.faces, max_radius, self.neighbours.skin);
+        self.face_grid_radius = max_radius;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::comm::Threads;
+
+    #[test]
+    fn bisection_shares_the_points_evenly_and_every_process_agrees() {
+        for k in [2usize, 3, 5] {
+            let handles: Vec<_> = Threads::group(k)
+                .into_iter()
+                .map(|c| {
+                    std::thread::spawn(move || {
+                        // Each process holds a different share of a line of points.
+                        let x: Vec<DVec3> = (0..1000)
+                            .filter(|i| i % k == c.rank())
+                            .map(|i| DVec3::new((i as f64 * 0.37).sin(), i as f64 * 1e-3, 0.0))
+                            .collect();
+                        let tree = Tree::bisect(&c, &x);
+                        let all: Vec<DVec3> = (0..1000)
+                            .map(|i| DVec3::new((i as f64 * 0.37).sin(), i as f64 * 1e-3, 0.0))
+                            .collect();
+                        let mut counts = vec![0; k];
+                        all.iter().for_each(|&x| counts[tree.owner(x)] += 1);
+                        let mut near = Vec::new();
+                        tree.near(all[0], 10.0, &mut near);
+                        near.sort();
+                        (counts, near)
+                    })
+                })
+                .collect();
+            let results: Vec<_> = handles
+                .into_iter()
+                .map(|h| h.join().expect("ran"))
+                .collect();
+            for r in &results {
+                assert_eq!(r, &results[0], "the processes disagree");
+            }
+            let (counts, near) = &results[0];
+            for &c in counts {
+                assert!((c as f64 - 1000.0 / k as f64).abs() <= 2.0, "{counts:?}");
+            }
+            assert_eq!(near, &(0..k).collect::<Vec<_>>());
+        }
+    }
+}
