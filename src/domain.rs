@@ -341,6 +341,13 @@ impl Simulation {
         self.domain.as_ref()
     }
 
+    /// Whether the particle of id `id` is this process's own (of a split run; in one
+    /// process, whether it exists).
+    pub fn owns(&self, id: u32) -> bool {
+        let p = &self.particles;
+        (0..p.len()).any(|i| p.id[i] == id && self.own(i))
+    }
+
     /// Whether the particle stored at `i` is this process's own (always, in one process).
     #[inline]
     pub(crate) fn own(&self, i: usize) -> bool {

@@ -8,6 +8,7 @@ mod common;
 
 use tinydem::comm::{Comm, Threads};
 use tinydem::particles::Particles;
+use tinydem::scenario::Scenario;
 use tinydem::simulation::{Simulation, Wrench};
 
 /// Each particle's id with the bits of its state, in id order.
@@ -62,16 +63,19 @@ fn end_of(sim: &mut Simulation) -> End {
 }
 
 /// A scenario run for `steps` steps split over `k` processes (threads of this one), as
-/// process 0 ends it; and how often the boxes were cut.
-fn split_run(text: &str, steps: u64, k: usize) -> (End, u64) {
-    let text = text.to_string();
+/// process 0 ends it (all end alike); and how often the boxes were cut.
+fn split_run(
+    make: impl Fn() -> Scenario + Send + Clone + 'static,
+    steps: u64,
+    k: usize,
+) -> (End, u64) {
     let handles: Vec<_> = Threads::group(k)
         .into_iter()
         .map(|comm| {
-            let text = text.clone();
+            let make = make.clone();
             std::thread::spawn(move || {
                 let rank = comm.rank();
-                let sim = Simulation::new(common::scenario(&text)).expect("starts");
+                let sim = Simulation::new(make()).expect("starts");
                 let mut sim = sim.split(Box::new(comm)).expect("splits");
                 for _ in 0..steps {
                     sim.step().expect("stable");
@@ -142,7 +146,8 @@ fn a_run_split_over_processes_gives_the_bits_of_one_process() {
     let reference = end_of(&mut single);
     assert!(reference.removed > 0 && reference.particles.len() > 200);
     for k in [2, 3, 4] {
-        let (end, cuts) = split_run(&text, steps, k);
+        let text = text.clone();
+        let (end, cuts) = split_run(move || common::scenario(&text), steps, k);
         assert!(
             cuts > 1,
             "{k} processes: the boxes should be cut anew as the silo fills"
@@ -156,5 +161,117 @@ fn a_run_split_over_processes_gives_the_bits_of_one_process() {
             end == reference,
             "{k} processes: the run differs from one process's"
         );
+    }
+}
+
+/// A closed drum (radius 0.05 m, 0.03 m long along y) as an OFF text: `n` rectangles
+/// around, and two end caps of triangles.
+fn drum(n: usize) -> String {
+    let (r, y) = (0.05, 0.015);
+    let mut v = Vec::new();
+    for k in 0..n {
+        let a = std::f64::consts::TAU * k as f64 / n as f64;
+        v.push(format!("{} {} {}", r * a.cos(), -y, r * a.sin()));
+        v.push(format!("{} {} {}", r * a.cos(), y, r * a.sin()));
+    }
+    v.push(format!("0 {} 0", -y));
+    v.push(format!("0 {y} 0"));
+    let mut f = Vec::new();
+    for k in 0..n {
+        let (a, b) = (2 * k, 2 * ((k + 1) % n));
+        f.push(format!("4 {a} {b} {} {}", b + 1, a + 1));
+        f.push(format!("3 {} {a} {b}", 2 * n));
+        f.push(format!("3 {} {} {}", 2 * n + 1, b + 1, a + 1));
+    }
+    format!(
+        "OFF\n{} {} 0\n{}\n{}\n",
+        v.len(),
+        f.len(),
+        v.join("\n"),
+        f.join("\n")
+    )
+}
+
+/// A rotating drum half full of grains: each grain goes round, across the boxes of the
+/// processes and back, in contact with others and the wall all the while.
+fn tumbler(mesh: &std::path::Path) -> String {
+    format!(
+        "[geometry]\nradius_min = 0.004\nradius_max = 0.005\n\
+         spawn_min = [-0.035, -0.01, -0.035]\nspawn_max = [0.035, 0.01, 0.035]\n\
+         [material]\nyoungs_modulus = 1e6\nrestitution = 0.3\nfriction_sliding = 0.6\nfriction_rolling = 0.1\nfriction_twisting = 0.1\n\
+         [simulation]\nmax_particles = 120\n\
+         [[meshes]]\nfile = \"{}\"\nradii = [0.0]\n\
+         motion = {{ type = \"rotation\", center = [0.0, 0.0, 0.0], axis = [0.0, 1.0, 0.0], angular_velocity = 30.0 }}\n",
+        mesh.display()
+    )
+}
+
+#[test]
+fn grains_crossing_between_processes_in_contact_keep_their_springs() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = dir.path().join("drum.off");
+    std::fs::write(&mesh, drum(24)).unwrap();
+    let text = tumbler(&mesh);
+    let steps = 6000;
+    let mut single = common::simulate(&text, steps);
+    let reference = end_of(&mut single);
+    assert!(
+        reference.contacts.0 > 50 && reference.contacts.1 > 10,
+        "{:?}",
+        reference.contacts
+    );
+    // How often grain 7 changes hands on 2 processes.
+    let handles: Vec<_> = Threads::group(2)
+        .into_iter()
+        .map(|comm| {
+            let text = text.clone();
+            std::thread::spawn(move || {
+                let sim = Simulation::new(common::scenario(&text)).expect("starts");
+                let mut sim = sim.split(Box::new(comm)).expect("splits");
+                let (mut changes, mut had) = (0, None);
+                for _ in 0..steps {
+                    sim.step().expect("stable");
+                    let has = sim.owns(7);
+                    changes += (had.is_some_and(|h| h != has)) as u32;
+                    had = Some(has);
+                }
+                (end_of(&mut sim), changes)
+            })
+        })
+        .collect();
+    for h in handles {
+        let (end, changes) = h.join().expect("no panic");
+        assert!(changes >= 4, "grain 7 changed hands {changes} times");
+        assert!(end == reference, "the split run differs from one process's");
+    }
+}
+
+#[test]
+fn the_reference_cases_split_over_processes_give_the_bits_of_one() {
+    for case in [
+        "headon",
+        "oblique_spin",
+        "floor_slide",
+        "floor_twist",
+        "primitives",
+        "drag",
+        "small_pile",
+    ] {
+        let path = common::data(&format!("reference/{case}/scenario.toml"));
+        let make = move || Scenario::load(&path).expect("loads");
+        let s = make();
+        let steps = s.simulation.frames * s.simulation.steps_per_frame;
+        let mut single = Simulation::new(make()).unwrap();
+        for _ in 0..steps {
+            single.step().unwrap();
+        }
+        let reference = end_of(&mut single);
+        for k in [2, 3, 4] {
+            let (end, _) = split_run(make.clone(), steps, k);
+            assert!(
+                end == reference,
+                "{case} on {k} processes differs from one process"
+            );
+        }
     }
 }
