@@ -28,7 +28,7 @@ use crate::exact::Sum6;
 use crate::integrate::Inertia;
 use crate::neighbours::face_grid;
 use crate::particles::{Particle, Particles};
-use crate::simulation::{Outflow, Simulation};
+use crate::simulation::{ContactRecord, Outflow, Partner, Simulation, Snapshot};
 use crate::spawn::Spawner;
 
 /// Past this ratio of the largest process's particle count to the mean, the boxes are cut
@@ -307,7 +307,178 @@ fn dedup(mut entries: Vec<(u32, u32, Springs)>) -> Vec<(u32, u32, Springs)> {
     entries
 }
 
+/// Every process's contacts (collective), in the order of `Simulation::contact_network`.
+pub(crate) fn gather_contacts(comm: &dyn Comm, mine: Vec<ContactRecord>) -> Vec<ContactRecord> {
+    let mut w = Writer::default();
+    for c in &mine {
+        w.u32(c.id);
+        match c.with {
+            Partner::Particle(j) => {
+                w.u8(0);
+                w.u64(j as u64);
+            }
+            Partner::Face(f) => {
+                w.u8(1);
+                w.u64(f as u64);
+            }
+        }
+        w.vec3(c.point);
+        w.vec3(c.f_n);
+        w.vec3(c.f_t);
+        w.f64(c.overlap);
+    }
+    let mut all = Vec::new();
+    for m in comm.all_gather(w.0) {
+        let mut r = Reader::new(&m);
+        while !r.done() {
+            let id = r.u32();
+            let with = match (r.u8(), r.u64() as usize) {
+                (0, j) => Partner::Particle(j),
+                (_, f) => Partner::Face(f),
+            };
+            all.push(ContactRecord {
+                id,
+                with,
+                point: r.vec3(),
+                f_n: r.vec3(),
+                f_t: r.vec3(),
+                overlap: r.f64(),
+            });
+        }
+    }
+    all.sort_by_key(|r| match r.with {
+        Partner::Particle(j) => (0, r.id, j),
+        Partner::Face(f) => (1, r.id, f),
+    });
+    all
+}
+
+/// Every process's lines (collective), process by process.
+pub(crate) fn gather_lines(comm: &dyn Comm, mine: Vec<String>) -> Vec<String> {
+    let mut w = Writer::default();
+    mine.iter().for_each(|l| w.bytes(l.as_bytes()));
+    let mut all = Vec::new();
+    for m in comm.all_gather(w.0) {
+        let mut r = Reader::new(&m);
+        while !r.done() {
+            all.push(String::from_utf8_lossy(r.bytes()).into_owned());
+        }
+    }
+    all
+}
+
+/// `r` if every process's `r` is fine (collective); otherwise the first failing
+/// process's error, on every process: one error for the user, and no process left
+/// waiting for the others.
+pub fn agree<T>(comm: &dyn Comm, r: Result<T>) -> Result<T> {
+    let mine = match &r {
+        Ok(_) => Vec::new(),
+        Err(e) => format!("{e:#}").into_bytes(),
+    };
+    let all = comm.all_gather(mine);
+    match r {
+        Err(e) => Err(e),
+        Ok(v) => match all.iter().position(|m| !m.is_empty()) {
+            None => Ok(v),
+            Some(q) => bail!("process {q}: {}", String::from_utf8_lossy(&all[q])),
+        },
+    }
+}
+
 impl Simulation {
+    /// Whether this process writes the output: the first of a split run.
+    pub fn is_writer(&self) -> bool {
+        self.domain.as_ref().is_none_or(|d| d.comm.rank() == 0)
+    }
+
+    /// [`agree`] over the processes of a split run; `r` in one process.
+    pub fn agree<T>(&self, r: Result<T>) -> Result<T> {
+        match &self.domain {
+            Some(d) => agree(&*d.comm, r),
+            None => r,
+        }
+    }
+
+    /// Whether `flag` is set on any process (collective in a split run).
+    pub fn any(&self, flag: bool) -> bool {
+        self.domain.as_ref().map_or(flag, |d| d.comm.any(flag))
+    }
+
+    /// The number of particles (of all processes: collective in a split run).
+    pub fn particle_count(&self) -> usize {
+        match &self.domain {
+            Some(d) => d.comm.sum_i64(&[d.own_count() as i64])[0] as usize,
+            None => self.particles.len(),
+        }
+    }
+
+    /// The snapshot of a split run (collective): all particles in id order, the anchors of
+    /// the last rebuild, and the springs of every contact once.
+    pub(crate) fn snapshot_split(&self) -> Snapshot {
+        let d = self.domain.as_ref().expect("a split run");
+        let p = &self.particles;
+        let history = self.neighbours.history(&p.id, p.next_id as usize);
+        let (anchors, _) = self.neighbours.anchors();
+        let own: FxHashSet<u32> = (0..p.len())
+            .filter(|&k| d.owned[k])
+            .map(|k| p.id[k])
+            .collect();
+        let mut w = Writer::default();
+        let pairs: Vec<_> = history
+            .pairs
+            .entries()
+            .into_iter()
+            .filter(|e| own.contains(&e.0) || own.contains(&e.1))
+            .collect();
+        let faces: Vec<_> = history
+            .faces
+            .entries()
+            .into_iter()
+            .filter(|e| own.contains(&e.0))
+            .collect();
+        w.u64(pairs.len() as u64);
+        pairs.iter().for_each(|e| put_entry(&mut w, e));
+        w.u64(faces.len() as u64);
+        faces.iter().for_each(|e| put_entry(&mut w, e));
+        let own_anchors: Vec<(u32, DVec3)> = (0..p.len())
+            .filter(|&k| d.owned[k])
+            .map(|k| (p.id[k], anchors.get(k).copied().unwrap_or(p.x[k])))
+            .collect();
+        w.u64(own_anchors.len() as u64);
+        for &(id, x) in &own_anchors {
+            w.u32(id);
+            w.vec3(x);
+        }
+        let (mut all_pairs, mut all_faces, mut all_anchors) = (Vec::new(), Vec::new(), Vec::new());
+        for m in d.comm.all_gather(w.0) {
+            let mut r = Reader::new(&m);
+            for _ in 0..r.u64() {
+                all_pairs.push(get_entry(&mut r));
+            }
+            for _ in 0..r.u64() {
+                all_faces.push(get_entry(&mut r));
+            }
+            for _ in 0..r.u64() {
+                all_anchors.push((r.u32(), r.vec3()));
+            }
+        }
+        all_anchors.sort_unstable_by_key(|a| a.0);
+        Snapshot {
+            steps: self.steps,
+            built_at: self.built_at,
+            particles: self.gather_particles(),
+            spawner: self.spawner.state(),
+            anchors: all_anchors.into_iter().map(|a| a.1).collect(),
+            lonely: Vec::new(),
+            pair_history: dedup(all_pairs),
+            face_history: dedup(all_faces),
+            removed: self.removed.clone(),
+            wall_sums: self.wall_sums.clone(),
+            scenario: self.scenario.to_toml(),
+            mesh_files: self.mesh_signatures(),
+        }
+    }
+
     /// Splits this simulation over the processes of `comm`: each process calls it with the
     /// same simulation (all its particles, as made or restored), keeps its share and the
     /// ghosts it needs, and from then on steps together with the others.

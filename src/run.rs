@@ -9,6 +9,7 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 
 use crate::checkpoint;
+use crate::comm::Comm;
 use crate::csv::{Extra, frame_name, write_frame};
 use crate::scenario::{Formats, Scenario};
 use crate::simulation::{Simulation, StageTimes, Thermo};
@@ -121,19 +122,23 @@ struct Frames<'a> {
 impl Frames<'_> {
     /// Files that do not change during the run (the static mesh).
     fn start(&self, sim: &Simulation) -> Result<()> {
-        if self.formats.vtk && !sim.mesh_moves() {
+        if self.formats.vtk && !sim.mesh_moves() && sim.is_writer() {
             crate::vtk::write_mesh(&self.dir.join("mesh.vtu"), &sim.mesh)?;
         }
         Ok(())
     }
 
+    /// Frame `k` (collective in a split run: all processes gather, the first writes).
     fn write(&self, k: u64, sim: &Simulation) -> Result<()> {
         let particles = sim.particles_in_domain();
+        let contacts = sim.scenario.contact_network.then(|| sim.contact_network());
+        if !sim.is_writer() {
+            return Ok(());
+        }
         if self.formats.csv {
             write_frame(self.dir, k, &particles, self.extra)?;
         }
-        if sim.scenario.contact_network {
-            let contacts = sim.contact_network();
+        if let Some(contacts) = contacts {
             crate::csv::write_contacts(self.dir, &format!("contacts{k:06}.csv"), &contacts)?;
             if self.formats.vtk {
                 let name = format!("contacts{k:06}.vtp");
@@ -290,29 +295,71 @@ fn claim_output(dir: &Path, overwrite: bool) -> Result<()> {
 
 /// Runs `scenario`, writing frames 0..=N_frames into `output_dir`.
 pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Summary> {
+    run_on(scenario, output_dir, options, None)
+}
+
+/// Runs `scenario` as [`run`] does, split over the processes of `comm` if it has more
+/// than one (each calls it): the first writes the output, all step together.
+pub fn run_on(
+    scenario: Scenario,
+    output_dir: &Path,
+    options: Options,
+    comm: Option<Box<dyn Comm>>,
+) -> Result<Summary> {
     let frames = scenario.simulation.frames;
     let steps_per_frame = scenario.simulation.steps_per_frame;
     let checkpoint_every = scenario.checkpoint_every;
-    let (mut sim, notes) = open(scenario, options.resume, options.from)?;
+    let opened = open(scenario, options.resume, options.from);
+    let (mut sim, notes) = match comm.filter(|c| c.size() > 1) {
+        Some(comm) => {
+            let (sim, notes) = crate::domain::agree(&*comm, opened)?;
+            let split = sim.split(comm);
+            (split?, notes)
+        }
+        None => opened?,
+    };
+    let writer = sim.is_writer();
+    let options = Options {
+        verbosity: if writer {
+            options.verbosity
+        } else {
+            Verbosity::Quiet
+        },
+        ..options
+    };
     if options.verbosity == Verbosity::Normal
         && let Some(path) = options.from
     {
         eprintln!("stage from {}: {}", path.display(), notes.join("; "));
     }
     if !options.force {
-        let n = crate::check::most_particles(&sim.scenario, sim.particles.len());
-        let why = crate::check::refusals(&sim.scenario, n, output_dir);
-        anyhow::ensure!(
-            why.is_empty(),
-            "{}\n(run with --force to run it anyway)",
-            why.join("\n")
-        );
+        let n = crate::check::most_particles(&sim.scenario, sim.particle_count());
+        let why = if writer {
+            crate::check::refusals(&sim.scenario, n, output_dir)
+        } else {
+            Vec::new()
+        };
+        sim.agree(if why.is_empty() {
+            Ok(())
+        } else {
+            Err(anyhow::anyhow!(
+                "{}\n(run with --force to run it anyway)",
+                why.join("\n")
+            ))
+        })?;
     }
-    prepare_output(output_dir)?;
-    let _lock = Lock::take(output_dir)?;
-    if options.resume.is_none() {
-        claim_output(output_dir, options.overwrite)?;
-    }
+    let _lock = sim.agree(
+        writer
+            .then(|| -> Result<Lock> {
+                prepare_output(output_dir)?;
+                let lock = Lock::take(output_dir)?;
+                if options.resume.is_none() {
+                    claim_output(output_dir, options.overwrite)?;
+                }
+                Ok(lock)
+            })
+            .transpose(),
+    )?;
     let start = Instant::now();
     let out = Frames {
         dir: output_dir,
@@ -323,39 +370,58 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
         },
         frame_time: steps_per_frame as f64 * sim.scenario.simulation.timestep,
     };
-    out.start(&sim)?;
+    sim.agree(out.start(&sim))?;
     let mut frames_written = 0;
     let mut output_seconds = 0.0;
     // The logs, continued after the checkpoint's last complete frame when resuming.
     let resumed_at = options.resume.map(|_| sim.steps / steps_per_frame);
-    let mut outlets = (!sim.scenario.outlets.is_empty())
-        .then(|| {
-            Log::open(
-                output_dir,
-                OUTLETS,
-                "frame,time,outlet,count,mass",
-                resumed_at,
-            )
+    let s = &sim.scenario;
+    let logs = writer
+        .then(|| -> Result<_> {
+            let outlets = (!s.outlets.is_empty())
+                .then(|| {
+                    Log::open(
+                        output_dir,
+                        OUTLETS,
+                        "frame,time,outlet,count,mass",
+                        resumed_at,
+                    )
+                })
+                .transpose()?;
+            let walls = s
+                .wall_forces
+                .then(|| {
+                    Log::open(
+                        output_dir,
+                        WALLS,
+                        "frame,time,mesh,fx,fy,fz,tx,ty,tz",
+                        resumed_at,
+                    )
+                })
+                .transpose()?;
+            write_run_toml(output_dir, s)?;
+            Ok((
+                Log::open(output_dir, FRAMES, "frame,step,time", resumed_at)?,
+                Log::open(output_dir, LOG, LOG_HEADER, resumed_at)?,
+                outlets,
+                walls,
+            ))
         })
-        .transpose()?;
-    let mut walls = sim
-        .scenario
-        .wall_forces
-        .then(|| {
-            Log::open(
-                output_dir,
-                WALLS,
-                "frame,time,mesh,fx,fy,fz,tx,ty,tz",
-                resumed_at,
-            )
-        })
-        .transpose()?;
-    let mut frame_log = Log::open(output_dir, FRAMES, "frame,step,time", resumed_at)?;
-    let mut thermo_log = Log::open(output_dir, LOG, LOG_HEADER, resumed_at)?;
-    write_run_toml(output_dir, &sim.scenario)?;
+        .transpose();
+    let mut logs = sim.agree(logs)?;
+    // A frame's lines in the logs (collective in a split run: the state over all
+    // processes; the first writes).
     let mut log = |sim: &mut Simulation, frame: u64| -> Result<Thermo> {
-        frame_log.row(&[&frame, &sim.steps, &sim.time])?;
         let th = sim.thermo();
+        let loads = if frame > 0 {
+            sim.take_wall_loads()
+        } else {
+            Vec::new()
+        };
+        let Some((frame_log, thermo_log, outlets, walls)) = logs.as_mut() else {
+            return Ok(th);
+        };
+        frame_log.row(&[&frame, &sim.steps, &sim.time])?;
         thermo_log.row(&[
             &frame,
             &sim.steps,
@@ -369,7 +435,7 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
             &th.max_overlap,
             &th.removed,
         ])?;
-        if let Some(log) = &mut outlets {
+        if let Some(log) = outlets {
             for (k, o) in sim.removed.outlets.iter().enumerate() {
                 log.row(&[&frame, &sim.time, &k, &o.count, &o.mass])?;
             }
@@ -377,7 +443,7 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
         if let Some(log) = walls.as_mut().filter(|_| frame > 0) {
             // The mean over the steps since the last frame.
             let steps = steps_per_frame as f64;
-            for (k, w) in sim.take_wall_loads().iter().enumerate() {
+            for (k, w) in loads.iter().enumerate() {
                 let (f, t) = (w.f / steps, w.tau / steps);
                 log.row(&[&frame, &sim.time, &k, &f.x, &f.y, &f.z, &t.x, &t.y, &t.z])?;
             }
@@ -386,9 +452,11 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
     };
     let mut first = None;
     if options.resume.is_none() {
-        out.write(0, &sim)?;
+        let written = out.write(0, &sim);
+        sim.agree(written)?;
         frames_written += 1;
-        first = Some(log(&mut sim, 0)?);
+        let logged = log(&mut sim, 0);
+        first = Some(sim.agree(logged)?);
     }
 
     let total_steps = frames * steps_per_frame;
@@ -449,13 +517,9 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
     while sim.steps < total_steps {
         if let Err(unstable) = sim.step() {
             let last = sim.steps.saturating_sub(1) / steps_per_frame.max(1);
-            let written = crate::csv::write_frame_as(
-                output_dir,
-                UNSTABLE,
-                &sim.particles_in_domain(),
-                out.extra,
-            )
-            .is_ok();
+            let state = sim.particles_in_domain();
+            let written = writer
+                && crate::csv::write_frame_as(output_dir, UNSTABLE, &state, out.extra).is_ok();
             anyhow::bail!(
                 "{unstable}.\nThe last complete frame is {}{}.",
                 output_dir.join(frame_name(last)).display(),
@@ -472,8 +536,10 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
         if sim.steps.is_multiple_of(steps_per_frame) {
             let t = Instant::now();
             let frame = sim.steps / steps_per_frame;
-            out.write(frame, &sim)?;
-            let th = log(&mut sim, frame)?;
+            let written = out.write(frame, &sim);
+            sim.agree(written)?;
+            let logged = log(&mut sim, frame);
+            let th = sim.agree(logged)?;
             frames_written += 1;
             status(&mut sim, frame, &th);
             if checkpoint_every > 0 && frame.is_multiple_of(checkpoint_every) {
@@ -484,10 +550,17 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
         if let Some(bar) = bar.as_ref().filter(|_| sim.steps.is_multiple_of(100)) {
             bar.set_position(sim.steps);
         }
-        if options.stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
+        // A stop asked of any process stops all, at the same step.
+        if sim.any(options.stop.is_some_and(|s| s.load(Ordering::Relaxed))) {
             let path = save_checkpoint(output_dir, &sim)?;
             let particles = sim.particles_in_domain();
-            crate::csv::write_frame_as(output_dir, INTERRUPTED, &particles, out.extra)?;
+            let written = if writer {
+                crate::csv::write_frame_as(output_dir, INTERRUPTED, &particles, out.extra)
+                    .map(|_| ())
+            } else {
+                Ok(())
+            };
+            sim.agree(written)?;
             if let Some(bar) = &bar {
                 bar.abandon();
             }
@@ -506,10 +579,12 @@ pub fn run(scenario: Scenario, output_dir: &Path, options: Options) -> Result<Su
     let t = Instant::now();
     save_checkpoint(output_dir, &sim)?;
     output_seconds += t.elapsed().as_secs_f64();
-    let _ = std::fs::remove_file(output_dir.join(INTERRUPTED));
+    if writer {
+        let _ = std::fs::remove_file(output_dir.join(INTERRUPTED));
+    }
     Ok(Summary {
         frames_written,
-        particles: sim.particles.len(),
+        particles: sim.particle_count(),
         steps: sim.steps,
         rebuilds: sim.rebuilds(),
         wall_seconds: start.elapsed().as_secs_f64(),
@@ -653,9 +728,16 @@ fn save_checkpoint(dir: &Path, sim: &Simulation) -> Result<PathBuf> {
 }
 
 /// Writes the checkpoint of `sim` to `path` (`--resume` continues it exactly, `--from`
-/// starts a stage from it).
+/// starts a stage from it). In a split run: collective, one file (as of one process)
+/// written by the first.
 pub fn write_checkpoint(path: &Path, sim: &Simulation) -> Result<()> {
-    checkpoint::save(path, &sim.snapshot(), fingerprint(sim))
+    let snapshot = sim.snapshot();
+    let saved = if sim.is_writer() {
+        checkpoint::save(path, &snapshot, fingerprint(sim))
+    } else {
+        Ok(())
+    };
+    sim.agree(saved)
 }
 
 /// The fingerprint of a simulation's scenario and mesh, for checkpoints.

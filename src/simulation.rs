@@ -583,7 +583,7 @@ pub struct Simulation {
     /// Largest displacement of a moving face since the last neighbour-list rebuild.
     mesh_drift: f64,
     /// Step of the last neighbour-list rebuild.
-    built_at: u64,
+    pub(crate) built_at: u64,
     /// Simulated time [T] and number of steps taken.
     pub time: f64,
     pub steps: u64,
@@ -602,7 +602,7 @@ pub struct Simulation {
     /// The loads on each mesh file summed over the steps since the last call of
     /// [`Simulation::take_wall_loads`] (`[output] wall_forces`): each step's exactly (over
     /// all contacts, and all processes), then the steps in order.
-    wall_sums: Vec<Wrench>,
+    pub(crate) wall_sums: Vec<Wrench>,
     /// The resolutions of the wall loads' sums of a step.
     wall_scales: Scales8,
     /// The largest radius the faces are binned for.
@@ -872,6 +872,9 @@ impl Simulation {
 
     /// The complete state of the run.
     pub fn snapshot(&self) -> Snapshot {
+        if self.domain.is_some() {
+            return self.snapshot_split();
+        }
         let p = &self.particles;
         let history = self.neighbours.history(&p.id, p.next_id as usize);
         let (anchors, lonely) = self.neighbours.anchors();
@@ -999,6 +1002,10 @@ impl Simulation {
     /// axes (between neighbour-list rebuilds they may be up to half the skin beyond a side),
     /// for output; the particles themselves if it has none.
     pub fn particles_in_domain(&self) -> std::borrow::Cow<'_, Particles> {
+        if self.domain.is_some() {
+            // All processes' (collective), in id order; split runs have no periodic sides.
+            return std::borrow::Cow::Owned(self.gather_particles());
+        }
         match self.scenario.periodicity() {
             None => std::borrow::Cow::Borrowed(&self.particles),
             Some(_) => {
@@ -1114,7 +1121,7 @@ impl Simulation {
         let p = &self.particles;
         self.scenario.removes()
             || self.scenario.materials.len() > 1
-            || p.next_id as usize != p.len()
+            || p.next_id as usize != self.particle_count()
     }
 
     /// The contact network at the current state: every touching particle pair and
@@ -1122,6 +1129,22 @@ impl Simulation {
     /// it now, from its current springs (left unchanged): the forces the next step applies.
     /// Pairs by (lower id, higher id), then contacts with faces by (id, face).
     pub fn contact_network(&self) -> Vec<ContactRecord> {
+        let mut network = self.held_contact_network();
+        if let Some(d) = &self.domain {
+            // Each contact from the process that owns its particle (of a pair, the lower id).
+            let p = &self.particles;
+            let own: rustc_hash::FxHashSet<u32> = (0..p.len())
+                .filter(|&k| d.owned[k])
+                .map(|k| p.id[k])
+                .collect();
+            network.retain(|c| own.contains(&c.id));
+            network = crate::domain::gather_contacts(&*d.comm, network);
+        }
+        network
+    }
+
+    /// The contact network of the particles this process holds (own and ghosts).
+    fn held_contact_network(&self) -> Vec<ContactRecord> {
         let p = &self.particles;
         let law = &self.law;
         let mass = |k: usize| {
@@ -1288,7 +1311,7 @@ impl Simulation {
             removed: self.removed.count(),
             ..Thermo::default()
         };
-        for c in self.contact_network() {
+        for c in self.held_contact_network() {
             if own.as_ref().is_some_and(|own| !own.contains(&c.id)) {
                 continue; // told by the process that owns it
             }
@@ -1372,7 +1395,9 @@ impl Simulation {
 
     /// Whether frames carry a tag column: the scenario tags particles, or they came tagged.
     pub fn has_tags(&self) -> bool {
-        !self.scenario.tags.is_empty() || self.particles.tagged()
+        let tagged = self.particles.tagged();
+        let tagged = self.domain.as_ref().map_or(tagged, |d| d.comm.any(tagged));
+        !self.scenario.tags.is_empty() || tagged
     }
 
     /// Stage 6: stop loudly rather than continue a run that has blown up: a non-finite
@@ -1467,7 +1492,12 @@ impl Simulation {
     /// Descriptions of the pairs that overlapped past the smaller radius for the first time
     /// since the last call.
     pub fn take_new_warnings(&mut self) -> Vec<String> {
-        std::mem::take(&mut self.warnings.fresh)
+        let fresh = std::mem::take(&mut self.warnings.fresh);
+        match &self.domain {
+            // Every process's (collective).
+            Some(d) => crate::domain::gather_lines(&*d.comm, fresh),
+            None => fresh,
+        }
     }
 
     /// The likely cause of an instability, from the time step and the material.

@@ -275,3 +275,131 @@ fn the_reference_cases_split_over_processes_give_the_bits_of_one() {
         }
     }
 }
+
+#[test]
+fn a_checkpoint_of_two_processes_resumes_on_three_with_the_same_bits() {
+    let text = silo(0.5);
+    let (first, then) = (1200, 1300);
+    let mut single = common::simulate(&text, first + then);
+    let reference = end_of(&mut single);
+    // 1200 steps on 2 processes, then the checkpoint's snapshot.
+    let handles: Vec<_> = Threads::group(2)
+        .into_iter()
+        .map(|comm| {
+            let text = text.clone();
+            std::thread::spawn(move || {
+                let sim = Simulation::new(common::scenario(&text)).unwrap();
+                let mut sim = sim.split(Box::new(comm)).unwrap();
+                for _ in 0..first {
+                    sim.step().unwrap();
+                }
+                sim.snapshot()
+            })
+        })
+        .collect();
+    let snapshots: Vec<_> = handles.into_iter().map(|h| h.join().unwrap()).collect();
+    assert!(
+        snapshots[0] == snapshots[1],
+        "both processes should see the same snapshot"
+    );
+    let snapshot = snapshots[0].clone();
+    assert!(!snapshot.pair_history.is_empty());
+    // Resumed on 3 processes, and in one.
+    let resumed = {
+        let snapshot = snapshot.clone();
+        let text = text.clone();
+        split_resume(move || (common::scenario(&text), snapshot.clone()), then, 3)
+    };
+    let mut one = Simulation::restore(common::scenario(&text), snapshot).unwrap();
+    for _ in 0..then {
+        one.step().unwrap();
+    }
+    assert!(
+        end_of(&mut one) == reference,
+        "resumed in one process, the run differs"
+    );
+    assert!(
+        resumed == reference,
+        "resumed on 3 processes, the run differs"
+    );
+}
+
+/// A run restored from a snapshot and continued for `steps` on `k` processes.
+fn split_resume(
+    make: impl Fn() -> (Scenario, tinydem::simulation::Snapshot) + Send + Clone + 'static,
+    steps: u64,
+    k: usize,
+) -> End {
+    let handles: Vec<_> = Threads::group(k)
+        .into_iter()
+        .map(|comm| {
+            let make = make.clone();
+            std::thread::spawn(move || {
+                let (scenario, snapshot) = make();
+                let sim = Simulation::restore(scenario, snapshot).unwrap();
+                let mut sim = sim.split(Box::new(comm)).unwrap();
+                for _ in 0..steps {
+                    sim.step().unwrap();
+                }
+                end_of(&mut sim)
+            })
+        })
+        .collect();
+    let mut ends: Vec<End> = handles.into_iter().map(|h| h.join().unwrap()).collect();
+    let first = ends.remove(0);
+    assert!(
+        ends.iter().all(|e| *e == first),
+        "the processes end otherwise"
+    );
+    first
+}
+
+#[test]
+fn the_output_of_a_split_run_is_that_of_one_process_byte_for_byte() {
+    use tinydem::run::{Options, Verbosity, run_on};
+    let mut text = silo(0.5);
+    text.push_str("contacts = true\nformats = [\"csv\", \"vtk\"]\n");
+    text = text.replace(
+        "max_particles = 300\n",
+        "max_particles = 300\nframes = 5\nsteps_per_frame = 400\n",
+    );
+    let options = Options {
+        verbosity: Verbosity::Quiet,
+        resume: None,
+        from: None,
+        overwrite: false,
+        force: true,
+        stop: None,
+    };
+    let one = tempfile::tempdir().unwrap();
+    tinydem::run::run(common::scenario(&text), one.path(), options).unwrap();
+    let split = tempfile::tempdir().unwrap();
+    let handles: Vec<_> = Threads::group(3)
+        .into_iter()
+        .map(|comm| {
+            let (text, dir) = (text.clone(), split.path().to_path_buf());
+            std::thread::spawn(move || {
+                run_on(common::scenario(&text), &dir, options, Some(Box::new(comm)))
+                    .map(|s| s.particles)
+            })
+        })
+        .collect();
+    for h in handles {
+        h.join().unwrap().unwrap();
+    }
+    let mut names: Vec<String> = std::fs::read_dir(one.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .filter(|n| n != "checkpoint.bin")
+        .collect();
+    names.sort();
+    assert!(
+        names.iter().any(|n| n == "walls.csv") && names.iter().any(|n| n == "contacts000005.csv"),
+        "{names:?}"
+    );
+    for name in &names {
+        let a = std::fs::read(one.path().join(name)).unwrap();
+        let b = std::fs::read(split.path().join(name)).unwrap_or_default();
+        assert!(a == b, "{name} differs");
+    }
+}
