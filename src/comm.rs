@@ -11,7 +11,7 @@ use std::sync::{Arc, Barrier, Mutex};
 use glam::{DQuat, DVec3};
 
 /// The collective operations of a run split over `size` processes.
-pub trait Comm: Send {
+pub trait Comm: Send + Sync {
     /// This process, from 0.
     fn rank(&self) -> usize;
     /// The number of processes.
