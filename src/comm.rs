@@ -128,6 +128,151 @@ impl Comm for Threads {
     }
 }
 
+/// The number of processes and this process's rank, as an MPI launcher (`mpirun`,
+/// `mpiexec`, `srun`) tells them in the environment (OpenMPI, MPICH): known before MPI
+/// starts, whatever the build, so that a build without MPI can say so and only the first
+/// process prints.
+pub fn launched() -> Option<(usize, usize)> {
+    let var = |names: &[&str]| {
+        names
+            .iter()
+            .find_map(|n| std::env::var(n).ok()?.parse::<usize>().ok())
+    };
+    let size = var(&["OMPI_COMM_WORLD_SIZE", "PMI_SIZE"])?;
+    let rank = var(&["OMPI_COMM_WORLD_RANK", "PMI_RANK", "PMIX_RANK"]).unwrap_or(0);
+    Some((size, rank))
+}
+
+/// The processes of this node (for the default thread count: the cores shared among them).
+pub fn processes_on_this_node() -> usize {
+    [
+        "OMPI_COMM_WORLD_LOCAL_SIZE",
+        "MPI_LOCALNRANKS",
+        "SLURM_NTASKS_PER_NODE",
+    ]
+    .iter()
+    .find_map(|n| std::env::var(n).ok()?.parse::<usize>().ok())
+    .unwrap_or(1)
+    .max(1)
+}
+
+#[cfg(feature = "mpi")]
+pub use over_mpi::Mpi;
+
+#[cfg(feature = "mpi")]
+mod over_mpi {
+    use mpi::datatype::{Partition, PartitionMut};
+    use mpi::traits::*;
+
+    /// The processes of `mpirun`, over the system's MPI (the `mpi` feature).
+    pub struct Mpi {
+        world: mpi::topology::SimpleCommunicator,
+        /// Finalizes MPI when dropped.
+        _universe: mpi::environment::Universe,
+    }
+
+    // SAFETY: MPI is initialized with MPI_THREAD_SERIALIZED, and the run calls it from one
+    // thread at a time (the thread that steps the simulation; `Comm` methods are never
+    // called from its parallel loops).
+    unsafe impl Send for Mpi {}
+    unsafe impl Sync for Mpi {}
+
+    impl Mpi {
+        /// Initializes MPI (once per program).
+        pub fn init() -> anyhow::Result<Mpi> {
+            let (universe, threading) = mpi::initialize_with_threading(mpi::Threading::Serialized)
+                .ok_or_else(|| anyhow::anyhow!("MPI is initialized already"))?;
+            anyhow::ensure!(
+                threading >= mpi::Threading::Serialized,
+                "this MPI library does not allow calls from a thread other than the first"
+            );
+            Ok(Mpi {
+                world: universe.world(),
+                _universe: universe,
+            })
+        }
+    }
+
+    /// The offsets of consecutive pieces of `counts` bytes.
+    fn offsets(counts: &[mpi::Count]) -> Vec<mpi::Count> {
+        counts
+            .iter()
+            .scan(0, |at, &c| {
+                let o = *at;
+                *at += c;
+                Some(o)
+            })
+            .collect()
+    }
+
+    /// `buf` cut into pieces of `counts` bytes.
+    fn pieces(buf: &[u8], counts: &[mpi::Count]) -> Vec<Vec<u8>> {
+        let mut at = 0;
+        counts
+            .iter()
+            .map(|&c| {
+                let piece = buf[at..at + c as usize].to_vec();
+                at += c as usize;
+                piece
+            })
+            .collect()
+    }
+
+    /// `len` zero bytes in a real allocation: an empty `Vec`'s pointer is 1, which OpenMPI
+    /// takes for MPI_IN_PLACE.
+    fn zeros(len: usize) -> Vec<u8> {
+        let mut v = Vec::with_capacity(len.max(1));
+        v.resize(len, 0);
+        v
+    }
+
+    /// `data` in a real allocation (see [`zeros`]).
+    fn allocated(mut data: Vec<u8>) -> Vec<u8> {
+        data.reserve(1);
+        data
+    }
+
+    fn count(len: usize) -> mpi::Count {
+        mpi::Count::try_from(len).expect("a message below 2 GiB")
+    }
+
+    impl super::Comm for Mpi {
+        fn rank(&self) -> usize {
+            self.world.rank() as usize
+        }
+        fn size(&self) -> usize {
+            self.world.size() as usize
+        }
+        fn all_to_all(&self, send: Vec<Vec<u8>>) -> Vec<Vec<u8>> {
+            let counts: Vec<mpi::Count> = send.iter().map(|m| count(m.len())).collect();
+            let mut from = vec![0 as mpi::Count; self.size()];
+            self.world.all_to_all_into(&counts[..], &mut from[..]);
+            let flat = allocated(send.concat());
+            let mut buf = zeros(from.iter().map(|&c| c as usize).sum());
+            {
+                let out = Partition::new(&flat[..], &counts[..], offsets(&counts));
+                let into_offsets = offsets(&from);
+                let mut into = PartitionMut::new(&mut buf[..], &from[..], into_offsets);
+                self.world.all_to_all_varcount_into(&out, &mut into);
+            }
+            pieces(&buf, &from)
+        }
+        fn all_gather(&self, data: Vec<u8>) -> Vec<Vec<u8>> {
+            let mut counts = vec![0 as mpi::Count; self.size()];
+            self.world
+                .all_gather_into(&count(data.len()), &mut counts[..]);
+            let mut buf = zeros(counts.iter().map(|&c| c as usize).sum());
+            let data = allocated(data);
+            {
+                let at = offsets(&counts);
+                let mut into = PartitionMut::new(&mut buf[..], &counts[..], at);
+                self.world.all_gather_varcount_into(&data[..], &mut into);
+            }
+            pieces(&buf, &counts)
+        }
+    }
+}
+
 /// Numbers into bytes (little-endian), for messages.
 #[derive(Clone, Debug, Default)]
 pub struct Writer(pub Vec<u8>);

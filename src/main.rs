@@ -10,8 +10,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use glam::DVec3;
 use tinydem::check::{describe, describe_stage};
+use tinydem::comm::Comm;
 use tinydem::render::{Animation, ColorBy, Fixed, Style, View};
-use tinydem::run::{Interrupted, Options, Summary, Verbosity, run};
+use tinydem::run::{Interrupted, Options, Summary, Verbosity, run_on};
 use tinydem::scenario::Scenario;
 use tinydem::simulation::Stage;
 
@@ -22,7 +23,8 @@ use tinydem::simulation::Stage;
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
-    /// Number of worker threads (default: all cores).
+    /// Number of worker threads (default: all cores; under mpirun, the cores shared among
+    /// the processes of this machine).
     #[arg(long, global = true)]
     threads: Option<usize>,
     /// Continue the interrupted default run from its checkpoint.
@@ -197,16 +199,46 @@ fn fix_mmap_threshold() {
 fn main() -> ExitCode {
     fix_mmap_threshold();
     let cli = Cli::parse();
+    // Under mpirun, the first process speaks for all (they fail alike, see `domain::agree`).
+    let first = tinydem::comm::launched().is_none_or(|(_, rank)| rank == 0);
     match real_main(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) if e.downcast_ref::<Interrupted>().is_some() => {
-            eprintln!("{e:#}");
+            if first {
+                eprintln!("{e:#}");
+            }
             ExitCode::from(130)
         }
         Err(e) => {
-            eprintln!("error: {e:#}");
+            if first {
+                eprintln!("error: {e:#}");
+            }
             ExitCode::FAILURE
         }
+    }
+}
+
+/// The processes a run is split over when started by an MPI launcher (in a build with the
+/// `mpi` feature); none otherwise.
+fn world() -> Result<Option<Box<dyn Comm>>> {
+    let Some((size, _)) = tinydem::comm::launched() else {
+        return Ok(None);
+    };
+    #[cfg(feature = "mpi")]
+    {
+        let _ = size;
+        let comm: Box<dyn Comm> = Box::new(tinydem::comm::Mpi::init()?);
+        Ok(Some(comm))
+    }
+    #[cfg(not(feature = "mpi"))]
+    {
+        anyhow::ensure!(
+            size <= 1,
+            "started as one of {size} processes, but this tinydem was built without MPI: \
+             build it with `cargo build --release --features mpi` (needs an MPI library, \
+             e.g. Debian's libopenmpi-dev, and libclang-dev)"
+        );
+        Ok(None)
     }
 }
 
@@ -217,15 +249,19 @@ fn catch_signals() -> Result<()> {
 }
 
 fn real_main(cli: Cli) -> Result<()> {
+    let world = world()?;
     let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(n) = cli.threads {
         anyhow::ensure!(n >= 1, "--threads must be at least 1");
         pool = pool.num_threads(n);
+    } else if world.is_some() {
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        pool = pool.num_threads((cores / tinydem::comm::processes_on_this_node()).max(1));
     }
     // The time loop runs on a worker of the pool, so that small parallel loops run inline
     // instead of waking another thread for every stage.
     let pool = pool.build().context("cannot start the thread pool")?;
-    pool.install(|| execute(cli.command, cli.resume, cli.overwrite, cli.force))
+    pool.install(|| execute(cli.command, cli.resume, cli.overwrite, cli.force, world))
 }
 
 fn execute(
@@ -233,7 +269,9 @@ fn execute(
     resume_default: Option<PathBuf>,
     overwrite_default: bool,
     force_default: bool,
+    world: Option<Box<dyn Comm>>,
 ) -> Result<()> {
+    let first = world.as_ref().is_none_or(|c| c.rank() == 0);
     match command {
         None => {
             let s = Scenario::default();
@@ -247,8 +285,10 @@ fn execute(
                 force: force_default,
                 stop: Some(&STOP),
             };
-            let summary = run(s, &out, options)?;
-            report(&summary, &out);
+            let summary = run_on(s, &out, options, world)?;
+            if first {
+                report(&summary, &out);
+            }
         }
         Some(Command::Run {
             scenario,
@@ -275,11 +315,11 @@ fn execute(
                 force,
                 stop: Some(&STOP),
             };
-            let summary = run(s, &out, options)?;
-            if !quiet {
-                report(&summary, &out);
-            } else {
-                warn(&summary);
+            let summary = run_on(s, &out, options, world)?;
+            match (first, quiet) {
+                (true, false) => report(&summary, &out),
+                (true, true) => warn(&summary),
+                (false, _) => {}
             }
         }
         Some(Command::Bench {

@@ -1,0 +1,228 @@
+//! Runs under `mpirun` (the `mpi` feature; `.ci/run` installs OpenMPI): the output of a run
+//! split over 2, 3 and 4 processes is that of one process byte for byte, a checkpoint
+//! written on Ctrl-C by 2 processes resumes on 3 with the same bits, and a bad scenario
+//! gives one error.
+#![cfg(feature = "mpi")]
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::time::{Duration, Instant};
+
+fn mpirun(np: usize, args: &[&str], dir: &Path) -> Command {
+    let mut c = Command::new("mpirun");
+    c.args(["--oversubscribe", "-np", &np.to_string()])
+        .arg(env!("CARGO_BIN_EXE_tinydem"))
+        .args(args)
+        // Containers run as root; OpenMPI refuses that unless told.
+        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        .current_dir(dir);
+    c
+}
+
+fn run(np: usize, args: &[&str], dir: &Path) -> Output {
+    let out = if np == 1 {
+        common::tinydem(args, dir)
+    } else {
+        mpirun(np, args, dir).output().expect("mpirun runs")
+    };
+    assert!(
+        out.status.success(),
+        "{np} processes, {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+/// The files of an output directory that a run writes the same on any process count (all
+/// but the checkpoint, which holds the storage order, and run.toml, which names the
+/// command line).
+fn outputs(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut files: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap())
+        .map(|e| (e.file_name().into_string().unwrap(), e.path()))
+        .filter(|(n, _)| n != "checkpoint.bin" && n != "run.toml" && n != ".lock")
+        .map(|(n, p)| (n, std::fs::read(p).unwrap()))
+        .collect();
+    files.sort();
+    files
+}
+
+fn same_output(scenario: &Path, counts: &[usize]) {
+    let dir = tempfile::tempdir().unwrap();
+    let name = scenario.to_str().unwrap();
+    run(1, &["run", name, "-o", "one", "-q"], dir.path());
+    let one = outputs(&dir.path().join("one"));
+    assert!(one.len() > 3, "{name}: {} files", one.len());
+    for &np in counts {
+        let out = format!("np{np}");
+        run(np, &["run", name, "-o", &out, "-q"], dir.path());
+        let split = outputs(&dir.path().join(&out));
+        let names = |f: &[(String, Vec<u8>)]| f.iter().map(|e| e.0.clone()).collect::<Vec<_>>();
+        assert_eq!(
+            names(&split),
+            names(&one),
+            "{name} on {np} processes: other files"
+        );
+        for ((file, a), (_, b)) in one.iter().zip(&split) {
+            assert!(a == b, "{name} on {np} processes: {file} differs");
+        }
+    }
+}
+
+#[test]
+fn reference_cases_on_1_to_4_processes_write_the_same_bytes() {
+    for case in [
+        "headon",
+        "oblique_spin",
+        "floor_slide",
+        "floor_twist",
+        "primitives",
+        "drag",
+        "small_pile",
+    ] {
+        same_output(
+            &common::data(&format!("reference/{case}/scenario.toml")),
+            &[2, 3, 4],
+        );
+    }
+}
+
+/// The filling, discharging silo: spawning, an outlet, wall loads, contact networks in CSV
+/// and VTK.
+fn silo(dir: &Path, frames: u64) -> PathBuf {
+    let path = dir.join("silo.toml");
+    std::fs::write(
+        &path,
+        format!(
+            "[geometry]\nradius_min = 0.003\nradius_max = 0.004\nmesh = \"{}\"\nmesh_radii = [0.0]\n\
+             spawn_min = [-0.05, -0.05, 0.06]\nspawn_max = [0.05, 0.05, 0.14]\n\
+             [material]\nrestitution = 0.3\nfriction_sliding = 0.5\nfriction_rolling = 0.1\nfriction_twisting = 0.1\n\
+             [simulation]\nmax_particles = 300\nframes = {frames}\nsteps_per_frame = 250\n\
+             [domain]\nmin = [-0.1, -0.1, -0.2]\nmax = [0.1, 0.1, 0.2]\n\
+             [[outlets]]\nmin = [-0.1, -0.1, -0.2]\nmax = [0.1, 0.1, -0.05]\n\
+             [output]\nwall_forces = true\ncontacts = true\nformats = [\"csv\", \"vtk\"]\n",
+            common::data("stages/silo.off").display()
+        ),
+    )
+    .unwrap();
+    path
+}
+
+#[test]
+fn a_filling_silo_on_1_to_4_processes_writes_the_same_bytes() {
+    let dir = tempfile::tempdir().unwrap();
+    same_output(&silo(dir.path(), 10), &[2, 3, 4]);
+}
+
+#[test]
+fn a_tumbling_drum_on_1_to_3_processes_writes_the_same_bytes() {
+    // A moving mesh, grains crossing between processes in contact all the while.
+    let dir = tempfile::tempdir().unwrap();
+    let mut v = Vec::new();
+    let mut f = Vec::new();
+    let n = 24;
+    for k in 0..n {
+        let a = std::f64::consts::TAU * k as f64 / n as f64;
+        v.push(format!("{} -0.015 {}", 0.05 * a.cos(), 0.05 * a.sin()));
+        v.push(format!("{} 0.015 {}", 0.05 * a.cos(), 0.05 * a.sin()));
+    }
+    v.push("0 -0.015 0".into());
+    v.push("0 0.015 0".into());
+    for k in 0..n {
+        let (a, b) = (2 * k, 2 * ((k + 1) % n));
+        f.push(format!("4 {a} {b} {} {}", b + 1, a + 1));
+        f.push(format!("3 {} {a} {b}", 2 * n));
+        f.push(format!("3 {} {} {}", 2 * n + 1, b + 1, a + 1));
+    }
+    let off = format!(
+        "OFF\n{} {} 0\n{}\n{}\n",
+        v.len(),
+        f.len(),
+        v.join("\n"),
+        f.join("\n")
+    );
+    std::fs::write(dir.path().join("drum.off"), off).unwrap();
+    let path = dir.path().join("drum.toml");
+    std::fs::write(
+        &path,
+        "[geometry]\nradius_min = 0.004\nradius_max = 0.005\n\
+         spawn_min = [-0.035, -0.01, -0.035]\nspawn_max = [0.035, 0.01, 0.035]\n\
+         [material]\nyoungs_modulus = 1e6\nrestitution = 0.3\nfriction_sliding = 0.6\nfriction_rolling = 0.1\nfriction_twisting = 0.1\n\
+         [simulation]\nmax_particles = 120\nframes = 12\nsteps_per_frame = 500\n\
+         [[meshes]]\nfile = \"drum.off\"\nradii = [0.0]\n\
+         motion = { type = \"rotation\", center = [0.0, 0.0, 0.0], axis = [0.0, 1.0, 0.0], angular_velocity = 30.0 }\n\
+         [output]\nwall_forces = true\nformats = [\"csv\", \"vtk\"]\n",
+    )
+    .unwrap();
+    same_output(&path, &[2, 3]);
+}
+
+#[test]
+fn ctrl_c_on_2_processes_checkpoints_and_3_resume_with_the_same_bytes() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = silo(dir.path(), 600);
+    let name = scenario.to_str().unwrap();
+    run(1, &["run", name, "-o", "one", "-q"], dir.path());
+    let mut child = mpirun(2, &["run", name, "-o", "cut", "-q"], dir.path())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    // Interrupted once some frames are out.
+    let frames = dir.path().join("cut/frames.csv");
+    let start = Instant::now();
+    while std::fs::read_to_string(&frames).map_or(0, |t| t.lines().count()) < 30 {
+        assert!(start.elapsed() < Duration::from_secs(60), "no frames");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    // SIGINT to mpirun, which passes it on to the processes.
+    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+    let status = child.wait().unwrap();
+    assert!(!status.success(), "the run should stop interrupted");
+    let cut = dir.path().join("cut");
+    assert!(cut.join("checkpoint.bin").exists() && cut.join("interrupted.csv").exists());
+    let done = std::fs::read_to_string(&frames).unwrap().lines().count();
+    assert!(
+        done < 600,
+        "interrupted after {done} frames: too late to tell"
+    );
+    run(
+        3,
+        &[
+            "run",
+            name,
+            "-o",
+            "cut",
+            "-q",
+            "--resume",
+            "cut/checkpoint.bin",
+        ],
+        dir.path(),
+    );
+    let (one, resumed) = (outputs(&dir.path().join("one")), outputs(&cut));
+    for (file, a) in &one {
+        let b = resumed.iter().find(|e| &e.0 == file).map(|e| &e.1);
+        assert!(b == Some(a), "{file} differs after resuming on 3 processes");
+    }
+}
+
+#[test]
+fn a_bad_scenario_on_3_processes_gives_one_error() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("bad.toml"), "[geometry]\nradius_min = -1\n").unwrap();
+    let start = Instant::now();
+    let out = mpirun(3, &["run", "bad.toml", "-o", "out"], dir.path())
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(
+        start.elapsed() < Duration::from_secs(30),
+        "it should not hang"
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.matches("error: ").count(), 1, "{err}");
+    assert!(err.contains("radius_min = -1"), "{err}");
+}
