@@ -3,7 +3,10 @@
 # and prints the ratio of Cundall numbers (particle-steps per second) per N and worker count.
 # Ratios measured in one run are what count on a noisy machine.
 #
-#   bench/peers.sh [SIZES] [WORKERS] [ROUNDS]     defaults: "1000 10000 100000" "1 2" 3
+#   bench/peers.sh [SIZES] [WORKERS] [ROUNDS] [SPLIT]   defaults: "1000 10000 100000" "1 2" 3 threads
+#
+# The peers run WORKERS MPI processes; tinydem runs WORKERS threads in one process, or, with
+# SPLIT = ranks, WORKERS processes of one thread under mpirun (built with --features mpi).
 #
 # Installs the peers from Debian when missing (apt-get install liggghts lammps).
 set -euo pipefail
@@ -12,6 +15,7 @@ root=$(dirname "$here")
 sizes=${1:-"1000 10000 100000"}
 workers=${2:-"1 2"}
 rounds=${3:-3}
+split=${4:-threads}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 
@@ -19,7 +23,9 @@ if ! command -v liggghts >/dev/null; then
   echo "installing LIGGGHTS and LAMMPS from Debian..." >&2
   (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq liggghts lammps) >/dev/null
 fi
-cargo build --release --quiet --manifest-path "$root/Cargo.toml"
+features=()
+[ "$split" = ranks ] && features=(--features mpi)
+cargo build --release --quiet "${features[@]}" --manifest-path "$root/Cargo.toml"
 tinydem="$root/target/release/tinydem"
 
 # Peer steps: about 2e7 particle-steps per run for small N, at least 100.
@@ -42,8 +48,12 @@ peer() { # code n workers
   awk -v s="$steps" '/^Loop time of/ {print $4 / s}' "$log"
 }
 
-ours() { # n workers -> seconds per step
-  "$tinydem" bench --single --sizes "$1" --threads "$2" --repeats 1 | awk -v n="$1" '{print $3 / 1000}'
+ours() { # n workers -> seconds per step (column 4 of the bench row: ms per step)
+  if [ "$split" = ranks ] && [ "$2" -gt 1 ]; then
+    mpirun --allow-run-as-root --oversubscribe -np "$2" "$tinydem" bench --single --sizes "$1" --threads 1 --repeats 1
+  else
+    "$tinydem" bench --single --sizes "$1" --threads "$2" --repeats 1
+  fi | awk '{print $4 / 1000}'
 }
 
 median() { sort -g | awk '{a[NR]=$1} END {print a[int((NR+1)/2)]}'; }

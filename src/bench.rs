@@ -92,12 +92,14 @@ pub fn setup(n: usize) -> Result<Simulation> {
 #[derive(Clone, Debug)]
 pub struct Measurement {
     pub n: usize,
+    /// Threads per process, and processes (a run split over several under mpirun).
     pub threads: usize,
+    pub ranks: usize,
     /// Median over the repeats, milliseconds per step.
     pub ms_per_step: f64,
     /// N / (seconds per step).
     pub cundall: f64,
-    /// Peak resident memory of the process [bytes], and its growth per particle.
+    /// Peak resident memory of the processes [bytes], and its growth per particle.
     pub peak_bytes: u64,
     pub bytes_per_particle: f64,
     /// Neighbour-list rebuilds per 100 timed steps.
@@ -109,6 +111,9 @@ pub struct Measurement {
     /// and on particle-particle contacts.
     pub lists_share: f64,
     pub pairs_share: f64,
+    /// Share spent sending the new states of particles to the processes that hold them as
+    /// ghosts (the exchange stage; the other messages are within their stages).
+    pub exchange_share: f64,
 }
 
 /// Reads a field of `/proc/self/status` in bytes (Linux); 0 elsewhere.
@@ -131,11 +136,21 @@ pub fn default_steps(n: usize) -> u64 {
     (10_000_000 / n as u64).clamp(100, 5000)
 }
 
-/// Runs the benchmark for `n` particles on the current thread pool: a warm-up, then
-/// `repeats` timed segments of `steps` steps.
-pub fn measure(n: usize, steps: u64, repeats: usize) -> Result<Measurement> {
+/// Runs the benchmark for `n` particles on the current thread pool, split over the
+/// processes of `world` if given: a warm-up, then `repeats` timed segments of `steps`
+/// steps.
+pub fn measure(
+    n: usize,
+    steps: u64,
+    repeats: usize,
+    world: Option<Box<dyn crate::comm::Comm>>,
+) -> Result<Measurement> {
     let rss_before = proc_status_bytes("VmRSS:");
     let mut sim = setup(n)?;
+    let ranks = world.as_ref().map_or(1, |w| w.size());
+    if let Some(world) = world.filter(|w| w.size() > 1) {
+        sim = sim.split(world)?;
+    }
     for _ in 0..steps.min(20) {
         sim.step()?; // warm-up: first neighbour lists, caches
     }
@@ -155,36 +170,49 @@ pub fn measure(n: usize, steps: u64, repeats: usize) -> Result<Measurement> {
         (sim.stage_times.of(stage) - stages_before.of(stage)) / timed.max(f64::MIN_POSITIVE)
     };
     let (lists_share, pairs_share) = (share(Stage::Neighbours), share(Stage::ParticleContacts));
+    let exchange_share = share(Stage::Exchange);
     times.sort_by(f64::total_cmp);
     let per_step = times[times.len() / 2];
-    let peak = proc_status_bytes("VmHWM:");
+    // Over all processes: memory, list slots (ghosts' included) and contacts.
+    let (p, f) = sim.list_slots();
+    let thermo = sim.thermo();
+    let mine = [
+        proc_status_bytes("VmHWM:") as i64,
+        rss_before as i64,
+        (p + f) as i64,
+    ];
+    let [peak, before, slots] = match sim.domain() {
+        Some(d) => d.comm.sum_i64(&mine).try_into().expect("three sums"),
+        None => mine,
+    };
+    let peak = peak as u64;
     Ok(Measurement {
         n,
         threads: rayon::current_num_threads(),
+        ranks,
         ms_per_step: per_step * 1e3,
         cundall: n as f64 / per_step,
         peak_bytes: peak,
-        bytes_per_particle: peak.saturating_sub(rss_before) as f64 / n as f64,
+        bytes_per_particle: peak.saturating_sub(before as u64) as f64 / n as f64,
         rebuilds_per_100_steps: (sim.rebuilds() - rebuilds_before) as f64 * 100.0
             / (steps * repeats as u64) as f64,
-        contacts_per_particle: sim.contact_count() as f64 / n as f64,
-        slots_per_particle: {
-            let (p, f) = sim.list_slots();
-            (p + f) as f64 / n as f64
-        },
+        contacts_per_particle: (thermo.pair_contacts + thermo.wall_contacts) as f64 / n as f64,
+        slots_per_particle: slots as f64 / n as f64,
         lists_share,
         pairs_share,
+        exchange_share,
     })
 }
 
 impl Measurement {
-    pub const HEADER: &'static str = "       N  threads   ms/step    Cundall   peak MB  B/particle  rebuilds/100  contacts/particle  list/particle  lists %  pairs %";
+    pub const HEADER: &'static str = "       N  threads  ranks   ms/step    Cundall   peak MB  B/particle  rebuilds/100  contacts/particle  list/particle  lists %  pairs %  exchange %";
 
     pub fn row(&self) -> String {
         format!(
-            "{:>8}  {:>7}  {:>8.3}  {:>9.3e}  {:>8.1}  {:>10.0}  {:>12.2}  {:>17.2}  {:>13.2}  {:>7.0}  {:>7.0}",
+            "{:>8}  {:>7}  {:>5}  {:>8.3}  {:>9.3e}  {:>8.1}  {:>10.0}  {:>12.2}  {:>17.2}  {:>13.2}  {:>7.0}  {:>7.0}  {:>10.0}",
             self.n,
             self.threads,
+            self.ranks,
             self.ms_per_step,
             self.cundall,
             self.peak_bytes as f64 / 1e6,
@@ -193,7 +221,8 @@ impl Measurement {
             self.contacts_per_particle,
             self.slots_per_particle,
             100.0 * self.lists_share,
-            100.0 * self.pairs_share
+            100.0 * self.pairs_share,
+            100.0 * self.exchange_share
         )
     }
 }

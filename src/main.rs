@@ -168,6 +168,10 @@ enum Command {
         /// Thread counts to run each size with (default: 1 and all cores).
         #[arg(long = "workers", value_delimiter = ',')]
         workers: Vec<usize>,
+        /// Process counts to split each size over, under `mpirun --oversubscribe` (a build
+        /// with the `mpi` feature; default: 1).
+        #[arg(long, value_delimiter = ',', default_values_t = [1])]
+        ranks: Vec<usize>,
         /// Steps per timed segment (default: about 10^7 particle-steps, at least 100).
         #[arg(long)]
         steps: Option<u64>,
@@ -326,6 +330,7 @@ fn execute(
             mut sizes,
             huge,
             workers,
+            ranks,
             steps,
             repeats,
             single,
@@ -340,11 +345,15 @@ fn execute(
                     n,
                     steps.unwrap_or(tinydem::bench::default_steps(n)),
                     repeats,
+                    world,
                 )?;
-                println!("{}", m.row());
+                if first {
+                    println!("{}", m.row());
+                }
                 return Ok(());
             }
-            bench(&sizes, &workers, steps, repeats)?;
+            anyhow::ensure!(ranks.iter().all(|&r| r >= 1), "--ranks must be at least 1");
+            bench(&sizes, &workers, &ranks, steps, repeats)?;
         }
         Some(Command::Render {
             path,
@@ -513,9 +522,15 @@ fn report(summary: &Summary, out: &std::path::Path) {
     eprintln!("time: {}", shown.join(", "));
 }
 
-/// Runs every (size, workers) configuration in a child process, so that each reports its
-/// own peak memory, and prints the table.
-fn bench(sizes: &[usize], workers: &[usize], steps: Option<u64>, repeats: usize) -> Result<()> {
+/// Runs every (size, workers, ranks) configuration in a child process (or `mpirun` of
+/// several), so that each reports its own peak memory, and prints the table.
+fn bench(
+    sizes: &[usize],
+    workers: &[usize],
+    ranks: &[usize],
+    steps: Option<u64>,
+    repeats: usize,
+) -> Result<()> {
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let workers: Vec<usize> = if workers.is_empty() {
         let mut w = vec![1, cores];
@@ -527,8 +542,17 @@ fn bench(sizes: &[usize], workers: &[usize], steps: Option<u64>, repeats: usize)
     let exe = std::env::current_exe().context("cannot locate the tinydem executable")?;
     println!("{}", tinydem::bench::Measurement::HEADER);
     for &n in sizes {
-        for &t in &workers {
-            let mut cmd = std::process::Command::new(&exe);
+        for (&t, &r) in workers
+            .iter()
+            .flat_map(|t| ranks.iter().map(move |r| (t, r)))
+        {
+            let mut cmd = if r == 1 {
+                std::process::Command::new(&exe)
+            } else {
+                let mut c = std::process::Command::new("mpirun");
+                c.args(["--oversubscribe", "-np", &r.to_string()]).arg(&exe);
+                c
+            };
             cmd.args([
                 "bench",
                 "--single",
@@ -544,7 +568,7 @@ fn bench(sizes: &[usize], workers: &[usize], steps: Option<u64>, repeats: usize)
             let out = cmd.output().context("cannot run the benchmark process")?;
             if !out.status.success() {
                 anyhow::bail!(
-                    "benchmark N = {n}, {t} threads failed: {}",
+                    "benchmark N = {n}, {t} threads, {r} processes failed: {}",
                     String::from_utf8_lossy(&out.stderr).trim()
                 );
             }

@@ -302,8 +302,8 @@ fn bench_runs_a_small_configuration() {
         .split_whitespace()
         .collect();
     assert_eq!(row[0], "1000");
-    let cundall: f64 = row[3].parse().unwrap();
-    let contacts: f64 = row[7].parse().unwrap();
+    let cundall: f64 = row[4].parse().unwrap();
+    let contacts: f64 = row[8].parse().unwrap();
     assert!(cundall > 0.0);
     // The settled packing: about 3.7 contacts per particle counted per particle, i.e.
     // about half that counted once per pair, plus walls.
