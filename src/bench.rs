@@ -173,14 +173,15 @@ pub fn measure(
     let exchange_share = share(Stage::Exchange);
     times.sort_by(f64::total_cmp);
     let per_step = times[times.len() / 2];
-    // Over all processes: memory, list slots (ghosts' included) and contacts.
+    // Over all processes: memory (before counting the contacts, which takes some), list
+    // slots (ghosts' included) and contacts.
     let (p, f) = sim.list_slots();
-    let thermo = sim.thermo();
     let mine = [
         proc_status_bytes("VmHWM:") as i64,
         rss_before as i64,
         (p + f) as i64,
     ];
+    let thermo = sim.thermo();
     let [peak, before, slots] = match sim.domain() {
         Some(d) => d.comm.sum_i64(&mine).try_into().expect("three sums"),
         None => mine,

@@ -533,9 +533,7 @@ impl Simulation {
         let mut d = self.domain.take().expect("a split run");
         let (me, k) = (d.comm.rank(), d.comm.size());
         let p = &self.particles;
-        let history = self.neighbours.history(&p.id, p.next_id as usize);
-        let (pairs, faces) = (history.pairs.entries(), history.faces.entries());
-        drop(history);
+        let (pairs, faces) = self.neighbours.entries_by_id(&p.id);
         let index: FxHashMap<u32, u32> =
             p.id.iter()
                 .enumerate()
@@ -558,17 +556,19 @@ impl Simulation {
         }
         drop(own);
         let tree = d.tree.as_ref().expect("cut");
-        // Own particles to their owners, with the springs of their contacts: a pair's to
-        // the owners of both, as either may need it.
+        // Own particles that left the box to their new owners (the others stay), with the
+        // springs of their contacts. A pair's springs go to the owners of both partners,
+        // sent by the owner of its lower id (the other owner has the same springs), so each
+        // arrives once.
         let owner = |id: u32| tree.owner(p.x[index[&id] as usize]);
+        let mine = |id: u32| d.owned[index[&id] as usize];
         let mut particles_to: Vec<Vec<u32>> = vec![Vec::new(); k];
         for i in (0..p.len()).filter(|&i| kept(i)) {
             particles_to[tree.owner(p.x[i])].push(i as u32);
         }
-        let mine = |id: u32| d.owned[index[&id] as usize];
         let mut pairs_to: Vec<Vec<usize>> = vec![Vec::new(); k];
         for (e, &(a, b, _)) in pairs.iter().enumerate() {
-            if gone.contains(&a) || gone.contains(&b) || !(mine(a) || mine(b)) {
+            if gone.contains(&a) || gone.contains(&b) || !mine(a) {
                 continue;
             }
             let (qa, qb) = (owner(a), owner(b));
@@ -586,6 +586,9 @@ impl Simulation {
         let messages: Vec<Vec<u8>> = (0..k)
             .map(|q| {
                 let mut w = Writer::default();
+                if q == me {
+                    return w.0; // what stays, stays
+                }
                 w.u64(particles_to[q].len() as u64);
                 for &i in &particles_to[q] {
                     put_particle(&mut w, p.id[i as usize], &p.get(i as usize));
@@ -601,27 +604,34 @@ impl Simulation {
                 w.0
             })
             .collect();
-        drop((particles_to, pairs_to, faces_to, index));
-        let next_id = p.next_id;
+        drop(index);
         let mut held = Particles {
-            next_id,
+            next_id: p.next_id,
             ..Particles::default()
         };
-        let (mut pairs, mut faces) = (Vec::new(), Vec::new());
-        for m in d.comm.all_to_all(messages) {
-            let mut r = Reader::new(&m);
+        for &i in &particles_to[me] {
+            held.insert(p.id[i as usize], p.get(i as usize));
+        }
+        let mut kept_pairs: Vec<_> = pairs_to[me].iter().map(|&e| pairs[e]).collect();
+        let mut kept_faces: Vec<_> = faces_to[me].iter().map(|&e| faces[e]).collect();
+        drop((particles_to, pairs_to, faces_to, pairs, faces));
+        for (q, m) in d.comm.all_to_all(messages).iter().enumerate() {
+            if q == me {
+                continue;
+            }
+            let mut r = Reader::new(m);
             for _ in 0..r.u64() {
                 let (id, particle) = get_particle(&mut r);
                 held.insert(id, particle);
             }
             for _ in 0..r.u64() {
-                pairs.push(get_entry(&mut r));
+                kept_pairs.push(get_entry(&mut r));
             }
             for _ in 0..r.u64() {
-                faces.push(get_entry(&mut r));
+                kept_faces.push(get_entry(&mut r));
             }
         }
-        let (pairs, faces) = (dedup(pairs), dedup(faces));
+        let (pairs, faces) = (kept_pairs, kept_faces);
         // Ghosts: copies of own particles for the processes whose boxes are within reach.
         let n_own = held.len();
         let r_max = d.comm.max(held.max_radius()).max(0.0);

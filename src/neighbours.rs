@@ -628,6 +628,9 @@ impl History {
     }
 }
 
+/// Contact histories as lists of entries: particle pairs and particle-face contacts.
+pub type Entries = (Vec<(u32, u32, Springs)>, Vec<(u32, u32, Springs)>);
+
 /// The contact histories of both lists.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Histories {
@@ -917,6 +920,26 @@ impl Neighbours {
             pairs: ContactList::history_of(&[&self.pairs, &self.wrapped], id_count, pair_key(ids)),
             faces: self.faces.history(id_count, |i, f| Some((ids[i], f))),
         }
+    }
+
+    /// The contact histories of the current lists by id, unsorted: particle pairs as
+    /// (lower id, higher id, springs), particle-face contacts as (id, face, springs).
+    pub fn entries_by_id(&self, ids: &[u32]) -> Entries {
+        let key = pair_key(ids);
+        let pairs = [&self.pairs, &self.wrapped]
+            .iter()
+            .flat_map(|list| {
+                list.live()
+                    .filter_map(|(i, k, s)| key(i, list.partner[k]).map(|(a, b)| (a, b, s)))
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        let faces = self
+            .faces
+            .live()
+            .map(|(i, k, s)| (ids[i], self.faces.partner[k], s))
+            .collect();
+        (pairs, faces)
     }
 
     /// The positions the lists were built at and the lonely particles' allowances: with
