@@ -532,8 +532,11 @@ impl Simulation {
     pub(crate) fn redistribute(&mut self, gone: &FxHashSet<u32>) {
         let mut d = self.domain.take().expect("a split run");
         let (me, k) = (d.comm.rank(), d.comm.size());
-        let p = &self.particles;
-        let (pairs, faces) = self.neighbours.entries_by_id(&p.id);
+        // The old lists and particles go as soon as what they hold is out.
+        let (pairs, faces) = self.neighbours.entries_by_id(&self.particles.id);
+        self.neighbours.clear_lists();
+        let old = std::mem::take(&mut self.particles);
+        let p = &old;
         let index: FxHashMap<u32, u32> =
             p.id.iter()
                 .enumerate()
@@ -614,7 +617,7 @@ impl Simulation {
         }
         let mut kept_pairs: Vec<_> = pairs_to[me].iter().map(|&e| pairs[e]).collect();
         let mut kept_faces: Vec<_> = faces_to[me].iter().map(|&e| faces[e]).collect();
-        drop((particles_to, pairs_to, faces_to, pairs, faces));
+        drop((particles_to, pairs_to, faces_to, pairs, faces, old));
         for (q, m) in d.comm.all_to_all(messages).iter().enumerate() {
             if q == me {
                 continue;

@@ -922,6 +922,13 @@ impl Neighbours {
         }
     }
 
+    /// Drops the lists (their memory), until the next rebuild.
+    pub fn clear_lists(&mut self) {
+        self.pairs = ContactList::default();
+        self.faces = ContactList::default();
+        self.wrapped = ContactList::default();
+    }
+
     /// The contact histories of the current lists by id, unsorted: particle pairs as
     /// (lower id, higher id, springs), particle-face contacts as (id, face, springs).
     pub fn entries_by_id(&self, ids: &[u32]) -> Entries {
