@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! step:  move meshes -> spawn -> update neighbours -> particle contacts -> mesh contacts
-//!        -> integrate -> check stability
+//!        -> integrate -> tag -> exchange (split runs) -> check stability -> remove
 //! ```
 
 use std::sync::Mutex;
