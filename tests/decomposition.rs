@@ -403,3 +403,55 @@ fn the_output_of_a_split_run_is_that_of_one_process_byte_for_byte() {
         assert!(a == b, "{name} differs");
     }
 }
+
+#[test]
+fn an_instability_split_over_processes_stops_all_with_the_message_of_one() {
+    // Twelve small grains shot into big ones along a line, across the processes' boxes: each
+    // gets wholly inside its target within a step or two; the message names five of them.
+    let dir = tempfile::tempdir().unwrap();
+    let mut rows = String::from("x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz\n");
+    for k in 0..12 {
+        let x = 0.05 * k as f64;
+        rows.push_str(&format!("{},0,0,0.002,5,0,0,1,0,0,0,0,0,0\n", x - 0.0125));
+        rows.push_str(&format!("{x},0,0,0.01,0,0,0,1,0,0,0,0,0,0\n"));
+    }
+    let csv = dir.path().join("p.csv");
+    std::fs::write(&csv, rows).unwrap();
+    let text = format!(
+        "[geometry]\nradius_min = 0.002\nradius_max = 0.01\n[kinetics]\ngravity = [0.0, 0.0, 0.0]\n\
+         [simulation]\nmax_particles = 0\ntimestep = 1e-3\n[input]\nparticles = \"{}\"\n",
+        csv.display()
+    );
+    let mut single = Simulation::new(common::scenario(&text)).unwrap();
+    let expected = loop {
+        if let Err(e) = single.step() {
+            break e.to_string();
+        }
+        assert!(single.steps < 100, "the run should become unstable");
+    };
+    assert_eq!(
+        expected.matches("smaller diameter").count(),
+        5,
+        "{expected}"
+    );
+    for k in [2, 3] {
+        let handles: Vec<_> = Threads::group(k)
+            .into_iter()
+            .map(|comm| {
+                let text = text.clone();
+                std::thread::spawn(move || {
+                    let sim = Simulation::new(common::scenario(&text)).unwrap();
+                    let mut sim = sim.split(Box::new(comm)).unwrap();
+                    loop {
+                        if let Err(e) = sim.step() {
+                            break e.to_string();
+                        }
+                    }
+                })
+            })
+            .collect();
+        for h in handles {
+            assert_eq!(h.join().unwrap(), expected, "{k} processes");
+        }
+    }
+}
