@@ -353,6 +353,31 @@ pub(crate) fn gather_contacts(comm: &dyn Comm, mine: Vec<ContactRecord>) -> Vec<
     all
 }
 
+/// The particles of `p` that `pick` picks (storage indices), of every process
+/// (collective), in id order; `next_id` that of `p`.
+fn gather_by_id(comm: &dyn Comm, p: &Particles, pick: impl Fn(usize) -> bool) -> Particles {
+    let mut w = Writer::default();
+    for i in (0..p.len()).filter(|&i| pick(i)) {
+        put_particle(&mut w, p.id[i], &p.get(i));
+    }
+    let mut all: Vec<(u32, Particle)> = Vec::new();
+    for m in comm.all_gather(w.0) {
+        let mut r = Reader::new(&m);
+        while !r.done() {
+            all.push(get_particle(&mut r));
+        }
+    }
+    all.sort_unstable_by_key(|e| e.0);
+    let mut out = Particles {
+        next_id: p.next_id,
+        ..Particles::default()
+    };
+    for (id, particle) in all {
+        out.insert(id, particle);
+    }
+    out
+}
+
 /// Every process's lines (collective), process by process.
 pub(crate) fn gather_lines(comm: &dyn Comm, mine: Vec<String>) -> Vec<String> {
     let mut w = Writer::default();
@@ -762,26 +787,8 @@ impl Simulation {
                 .iter()
                 .any(|r| x.cmpge(r.min - margin).all() && x.cmple(r.max + margin).all())
         };
-        let mut w = Writer::default();
-        for i in (0..p.len()).filter(|&i| d.owned[i] && near(p.x[i])) {
-            put_particle(&mut w, p.id[i], &p.get(i));
-        }
-        let mut nearby: Vec<(u32, Particle)> = Vec::new();
-        for m in d.comm.all_gather(w.0) {
-            let mut r = Reader::new(&m);
-            while !r.done() {
-                nearby.push(get_particle(&mut r));
-            }
-        }
-        nearby.sort_unstable_by_key(|e| e.0);
         let old_next = p.next_id;
-        let mut around = Particles {
-            next_id: old_next,
-            ..Particles::default()
-        };
-        for (id, particle) in nearby {
-            around.insert(id, particle);
-        }
+        let mut around = gather_by_id(&*d.comm, p, |i| d.owned[i] && near(p.x[i]));
         self.spawner.spawn(
             s,
             &mut around,
@@ -860,36 +867,10 @@ impl Simulation {
     /// process's particles in one.
     pub fn gather_particles(&self) -> Particles {
         let p = &self.particles;
-        let Some(d) = &self.domain else {
-            let mut all = Particles {
-                next_id: p.next_id,
-                ..Particles::default()
-            };
-            for (id, particle) in p.iter_by_id() {
-                all.insert(id, particle);
-            }
-            return all;
-        };
-        let mut w = Writer::default();
-        for i in (0..p.len()).filter(|&i| d.owned[i]) {
-            put_particle(&mut w, p.id[i], &p.get(i));
+        match &self.domain {
+            Some(d) => gather_by_id(&*d.comm, p, |i| d.owned[i]),
+            None => gather_by_id(&crate::comm::Solo, p, |_| true),
         }
-        let mut all: Vec<(u32, Particle)> = Vec::new();
-        for m in d.comm.all_gather(w.0) {
-            let mut r = Reader::new(&m);
-            while !r.done() {
-                all.push(get_particle(&mut r));
-            }
-        }
-        all.sort_unstable_by_key(|e| e.0);
-        let mut out = Particles {
-            next_id: p.next_id,
-            ..Particles::default()
-        };
-        for (id, particle) in all {
-            out.insert(id, particle);
-        }
-        out
     }
 
     /// Bins the faces for particles up to radius `max_radius`.
