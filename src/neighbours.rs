@@ -681,6 +681,20 @@ impl Layout {
     }
 }
 
+impl Layout {
+    /// Each particle's (cell key, id): the order the lists keep them in.
+    fn keys(&self, particles: &Particles) -> Vec<(u64, u32)> {
+        let inv_h = 1.0 / self.h;
+        particles
+            .x
+            .par_iter()
+            .zip(particles.id.par_iter())
+            .with_min_len(MIN_PARALLEL_LEN)
+            .map(|(&x, &id)| (key(cell_of(x, inv_h)), id))
+            .collect()
+    }
+}
+
 /// Verlet lists of particle pairs and particle-face pairs.
 #[derive(Clone, Debug, Default)]
 pub struct Neighbours {
@@ -986,14 +1000,7 @@ impl Neighbours {
                 .for_each(|(x, v)| (*x, *v) = periodic.wrap_state(*x, *v));
         }
         let layout = Layout::of(&particles.radius, self.skin);
-        let inv_h = 1.0 / layout.h;
-        let keys: Vec<(u64, u32)> = particles
-            .x
-            .par_iter()
-            .zip(particles.id.par_iter())
-            .with_min_len(MIN_PARALLEL_LEN)
-            .map(|(&x, &id)| (key(cell_of(x, inv_h)), id))
-            .collect();
+        let keys = layout.keys(particles);
         let order: Option<Vec<u32>> = (!gone.is_empty() || !keys.is_sorted()).then(|| {
             let mut gone = gone.iter().peekable();
             let mut order: Vec<u32> = (0..particles.len() as u32)
@@ -1055,14 +1062,7 @@ impl Neighbours {
         face_grid: &CellGrid,
     ) -> Vec<u32> {
         let layout = Layout::of(&particles.radius, self.skin);
-        let inv_h = 1.0 / layout.h;
-        let keys: Vec<(u64, u32)> = particles
-            .x
-            .par_iter()
-            .zip(particles.id.par_iter())
-            .with_min_len(MIN_PARALLEL_LEN)
-            .map(|(&x, &id)| (key(cell_of(x, inv_h)), id))
-            .collect();
+        let keys = layout.keys(particles);
         let mut order: Vec<u32> = (0..particles.len() as u32).collect();
         order.par_sort_unstable_by_key(|&i| keys[i as usize]);
         drop(keys);

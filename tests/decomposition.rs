@@ -164,34 +164,6 @@ fn a_run_split_over_processes_gives_the_bits_of_one_process() {
     }
 }
 
-/// A closed drum (radius 0.05 m, 0.03 m long along y) as an OFF text: `n` rectangles
-/// around, and two end caps of triangles.
-fn drum(n: usize) -> String {
-    let (r, y) = (0.05, 0.015);
-    let mut v = Vec::new();
-    for k in 0..n {
-        let a = std::f64::consts::TAU * k as f64 / n as f64;
-        v.push(format!("{} {} {}", r * a.cos(), -y, r * a.sin()));
-        v.push(format!("{} {} {}", r * a.cos(), y, r * a.sin()));
-    }
-    v.push(format!("0 {} 0", -y));
-    v.push(format!("0 {y} 0"));
-    let mut f = Vec::new();
-    for k in 0..n {
-        let (a, b) = (2 * k, 2 * ((k + 1) % n));
-        f.push(format!("4 {a} {b} {} {}", b + 1, a + 1));
-        f.push(format!("3 {} {a} {b}", 2 * n));
-        f.push(format!("3 {} {} {}", 2 * n + 1, b + 1, a + 1));
-    }
-    format!(
-        "OFF\n{} {} 0\n{}\n{}\n",
-        v.len(),
-        f.len(),
-        v.join("\n"),
-        f.join("\n")
-    )
-}
-
 /// A rotating drum half full of grains: each grain goes round, across the boxes of the
 /// processes and back, in contact with others and the wall all the while.
 fn tumbler(mesh: &std::path::Path) -> String {
@@ -210,7 +182,7 @@ fn tumbler(mesh: &std::path::Path) -> String {
 fn grains_crossing_between_processes_in_contact_keep_their_springs() {
     let dir = tempfile::tempdir().unwrap();
     let mesh = dir.path().join("drum.off");
-    std::fs::write(&mesh, drum(24)).unwrap();
+    std::fs::write(&mesh, common::drum_off(24)).unwrap();
     let text = tumbler(&mesh);
     let steps = 6000;
     let mut single = common::simulate(&text, steps);

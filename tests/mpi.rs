@@ -122,29 +122,7 @@ fn a_filling_silo_on_1_to_4_processes_writes_the_same_bytes() {
 fn a_tumbling_drum_on_1_to_3_processes_writes_the_same_bytes() {
     // A moving mesh, grains crossing between processes in contact all the while.
     let dir = tempfile::tempdir().unwrap();
-    let mut v = Vec::new();
-    let mut f = Vec::new();
-    let n = 24;
-    for k in 0..n {
-        let a = std::f64::consts::TAU * k as f64 / n as f64;
-        v.push(format!("{} -0.015 {}", 0.05 * a.cos(), 0.05 * a.sin()));
-        v.push(format!("{} 0.015 {}", 0.05 * a.cos(), 0.05 * a.sin()));
-    }
-    v.push("0 -0.015 0".into());
-    v.push("0 0.015 0".into());
-    for k in 0..n {
-        let (a, b) = (2 * k, 2 * ((k + 1) % n));
-        f.push(format!("4 {a} {b} {} {}", b + 1, a + 1));
-        f.push(format!("3 {} {a} {b}", 2 * n));
-        f.push(format!("3 {} {} {}", 2 * n + 1, b + 1, a + 1));
-    }
-    let off = format!(
-        "OFF\n{} {} 0\n{}\n{}\n",
-        v.len(),
-        f.len(),
-        v.join("\n"),
-        f.join("\n")
-    );
+    let off = common::drum_off(24);
     std::fs::write(dir.path().join("drum.off"), off).unwrap();
     let path = dir.path().join("drum.toml");
     std::fs::write(

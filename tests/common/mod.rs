@@ -45,3 +45,31 @@ pub fn tinydem_with_env(args: &[&str], dir: &Path, env: &[(&str, &str)]) -> Outp
         .output()
         .expect("binary runs")
 }
+
+/// A closed drum (radius 0.05 m, 0.03 m long along y) as an OFF text: `n` rectangles around,
+/// and two end caps of triangles.
+pub fn drum_off(n: usize) -> String {
+    let (r, y) = (0.05, 0.015);
+    let mut v = Vec::new();
+    for k in 0..n {
+        let a = std::f64::consts::TAU * k as f64 / n as f64;
+        v.push(format!("{} {} {}", r * a.cos(), -y, r * a.sin()));
+        v.push(format!("{} {} {}", r * a.cos(), y, r * a.sin()));
+    }
+    v.push(format!("0 {} 0", -y));
+    v.push(format!("0 {y} 0"));
+    let mut f = Vec::new();
+    for k in 0..n {
+        let (a, b) = (2 * k, 2 * ((k + 1) % n));
+        f.push(format!("4 {a} {b} {} {}", b + 1, a + 1));
+        f.push(format!("3 {} {a} {b}", 2 * n));
+        f.push(format!("3 {} {} {}", 2 * n + 1, b + 1, a + 1));
+    }
+    format!(
+        "OFF\n{} {} 0\n{}\n{}\n",
+        v.len(),
+        f.len(),
+        v.join("\n"),
+        f.join("\n")
+    )
+}
