@@ -157,7 +157,7 @@ pub fn processes_on_this_node() -> usize {
 }
 
 #[cfg(feature = "mpi")]
-pub use over_mpi::Mpi;
+pub use over_mpi::{Finalize, Mpi};
 
 #[cfg(feature = "mpi")]
 mod over_mpi {
@@ -167,7 +167,13 @@ mod over_mpi {
     /// The processes of `mpirun`, over the system's MPI (the `mpi` feature).
     pub struct Mpi {
         world: mpi::topology::SimpleCommunicator,
-        /// Finalizes MPI when dropped.
+    }
+
+    /// Finalizes MPI when dropped: held by `main` until the first process has printed the
+    /// run's last words. MPI_Finalize waits for every process, so no process exits (and
+    /// makes `mpirun` kill the rest) before the first one has written its error or its
+    /// "interrupted".
+    pub struct Finalize {
         _universe: mpi::environment::Universe,
     }
 
@@ -178,18 +184,22 @@ mod over_mpi {
     unsafe impl Sync for Mpi {}
 
     impl Mpi {
-        /// Initializes MPI (once per program).
-        pub fn init() -> anyhow::Result<Mpi> {
+        /// Initializes MPI (once per program). Drop the [`Finalize`] after every `Mpi`.
+        pub fn init() -> anyhow::Result<(Mpi, Finalize)> {
             let (universe, threading) = mpi::initialize_with_threading(mpi::Threading::Serialized)
                 .ok_or_else(|| anyhow::anyhow!("MPI is initialized already"))?;
             anyhow::ensure!(
                 threading >= mpi::Threading::Serialized,
                 "this MPI library does not allow calls from a thread other than the first"
             );
-            Ok(Mpi {
-                world: universe.world(),
-                _universe: universe,
-            })
+            Ok((
+                Mpi {
+                    world: universe.world(),
+                },
+                Finalize {
+                    _universe: universe,
+                },
+            ))
         }
     }
 

@@ -205,7 +205,18 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     // Under mpirun, the first process speaks for all (they fail alike, see `domain::agree`).
     let first = tinydem::comm::launched().is_none_or(|(_, rank)| rank == 0);
-    match real_main(cli) {
+    // Held to the end, after the last words: only then may the other processes exit
+    // (see `Finalize`).
+    let (world, _finalize) = match world() {
+        Ok(w) => w,
+        Err(e) => return last_words(first, Err(e)),
+    };
+    last_words(first, real_main(cli, world))
+}
+
+/// Prints how the command ended (from the first process only) and gives the exit code.
+fn last_words(first: bool, outcome: Result<()>) -> ExitCode {
+    match outcome {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) if e.downcast_ref::<Interrupted>().is_some() => {
             if first {
@@ -222,17 +233,24 @@ fn main() -> ExitCode {
     }
 }
 
+/// Holds MPI initialized until dropped (nothing without the `mpi` feature).
+#[cfg(feature = "mpi")]
+type Finalize = Option<tinydem::comm::Finalize>;
+#[cfg(not(feature = "mpi"))]
+type Finalize = ();
+
 /// The processes a run is split over when started by an MPI launcher (in a build with the
 /// `mpi` feature); none otherwise.
-fn world() -> Result<Option<Box<dyn Comm>>> {
+fn world() -> Result<(Option<Box<dyn Comm>>, Finalize)> {
     let Some((size, _)) = tinydem::comm::launched() else {
-        return Ok(None);
+        return Ok((None, Finalize::default()));
     };
     #[cfg(feature = "mpi")]
     {
         let _ = size;
-        let comm: Box<dyn Comm> = Box::new(tinydem::comm::Mpi::init()?);
-        Ok(Some(comm))
+        let (comm, finalize) = tinydem::comm::Mpi::init()?;
+        let comm: Box<dyn Comm> = Box::new(comm);
+        Ok((Some(comm), Some(finalize)))
     }
     #[cfg(not(feature = "mpi"))]
     {
@@ -242,7 +260,7 @@ fn world() -> Result<Option<Box<dyn Comm>>> {
              build it with `cargo build --release --features mpi` (needs an MPI library, \
              e.g. Debian's libopenmpi-dev, and libclang-dev)"
         );
-        Ok(None)
+        Ok((None, ()))
     }
 }
 
@@ -252,8 +270,7 @@ fn catch_signals() -> Result<()> {
         .context("cannot install the signal handler")
 }
 
-fn real_main(cli: Cli) -> Result<()> {
-    let world = world()?;
+fn real_main(cli: Cli, world: Option<Box<dyn Comm>>) -> Result<()> {
     let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(n) = cli.threads {
         anyhow::ensure!(n >= 1, "--threads must be at least 1");

@@ -145,8 +145,8 @@ fn ctrl_c_on_2_processes_checkpoints_and_3_resume_with_the_same_bytes() {
     let scenario = silo(dir.path(), 600);
     let name = scenario.to_str().unwrap();
     run(1, &["run", name, "-o", "one", "-q"], dir.path());
-    let mut child = mpirun(2, &["run", name, "-o", "cut", "-q"], dir.path())
-        .stderr(std::process::Stdio::null())
+    let child = mpirun(2, &["run", name, "-o", "cut", "-q"], dir.path())
+        .stderr(std::process::Stdio::piped())
         .spawn()
         .unwrap();
     // Interrupted once some frames are out.
@@ -158,8 +158,11 @@ fn ctrl_c_on_2_processes_checkpoints_and_3_resume_with_the_same_bytes() {
     }
     // SIGINT to mpirun, which passes it on to the processes.
     unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
-    let status = child.wait().unwrap();
-    assert!(!status.success(), "the run should stop interrupted");
+    let out = child.wait_with_output().unwrap();
+    assert!(!out.status.success(), "the run should stop interrupted");
+    // Said once, by the first process, before any process exits.
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.matches("interrupted after step").count(), 1, "{err}");
     let cut = dir.path().join("cut");
     assert!(cut.join("checkpoint.bin").exists() && cut.join("interrupted.csv").exists());
     let done = std::fs::read_to_string(&frames).unwrap().lines().count();
