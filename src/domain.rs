@@ -17,6 +17,14 @@
 //! draws the same random stream on every process, against the particles of all processes
 //! near the spawn regions; removals are counted in id order over all processes. Wall
 //! loads are exact sums over all processes.
+//!
+//! In a periodic domain a process also holds, at their own places, the particles whose
+//! images across the sides come within reach of its box; its lists pair them across the
+//! sides as the lists of one process do, seen from the particle of the lower id with the
+//! other at the image nearest it (a shift found from the two positions alone), so both
+//! processes of such a pair see it with the same bits. Positions are wrapped into the box
+//! at rebuilds, which rounds them: so the split run rebuilds at the steps the run in one
+//! process does (see [`Placement`]).
 
 use anyhow::{Result, bail};
 use glam::DVec3;
@@ -225,6 +233,18 @@ impl Tree {
         }
         Tree { cells }
     }
+}
+
+/// Where a redistribution places the particles (for their owners, ghosts and lists).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Placement {
+    /// Where they are now (put back into a periodic box first): a rebuild of the lists.
+    Now,
+    /// Where the lists of the run in one process were last built, its anchors: on
+    /// splitting a simulation made or restored in one process, so that the split run
+    /// rebuilds its lists (and puts particles back into a periodic box) at the steps that
+    /// run would.
+    Anchors,
 }
 
 /// The share of one process in a split run.
@@ -508,11 +528,6 @@ impl Simulation {
     /// same simulation (all its particles, as made or restored), keeps its share and the
     /// ghosts it needs, and from then on steps together with the others.
     pub fn split(mut self, comm: Box<dyn Comm>) -> Result<Simulation> {
-        if self.scenario.periodicity().is_some() {
-            bail!(
-                "a run over several processes cannot have periodic sides yet: run it in one process"
-            );
-        }
         let (rank, size) = (comm.rank(), comm.size());
         let owned = self
             .particles
@@ -528,7 +543,7 @@ impl Simulation {
             recv: Vec::new(),
             cuts: 0,
         });
-        self.redistribute(&FxHashSet::default());
+        self.redistribute(&FxHashSet::default(), Placement::Anchors);
         Ok(self)
     }
 
@@ -551,10 +566,36 @@ impl Simulation {
     }
 
     /// Rebuilds the lists of every process of a split run (collective): the own particles
-    /// (but those of ids in `gone`) to the owners of the boxes they are in now (the boxes
-    /// cut anew when out of balance) with the springs of their contacts, then the ghosts
-    /// each process needs, then the lists.
-    pub(crate) fn redistribute(&mut self, gone: &FxHashSet<u32>) {
+    /// (but those of ids in `gone`) to the owners of the boxes they are in (the boxes cut
+    /// anew when out of balance) with the springs of their contacts, then the ghosts each
+    /// process needs, then the lists; all at the particles' places of `placement`.
+    pub(crate) fn redistribute(&mut self, gone: &FxHashSet<u32>, placement: Placement) {
+        // The anchors of the run in one process, if its lists were built: there the lists
+        // are built again, with the mesh and sheared images where they were then, as a
+        // checkpoint restores them.
+        let anchors = match placement {
+            Placement::Now => None,
+            Placement::Anchors => {
+                let (a, _) = self.neighbours.anchors();
+                (a.len() == self.particles.len()).then(|| a.to_vec())
+            }
+        };
+        let (anchors_missing, restore_clock) = (anchors.is_none(), anchors.is_some());
+        let clock = (self.steps, self.time);
+        if anchors.is_some() {
+            self.steps = self.built_at;
+            self.time = self.built_at as f64 * self.scenario.simulation.timestep;
+            self.slide_images();
+            self.move_meshes();
+        }
+        if let (Placement::Now, Some(periodic)) = (placement, self.neighbours.periodic) {
+            // As at a rebuild in one process: the particles put back into the box (the
+            // ghosts too, as their owners do, so that every process places them alike).
+            let p = &mut self.particles;
+            for (x, v) in p.x.iter_mut().zip(p.v.iter_mut()) {
+                (*x, *v) = periodic.wrap_state(*x, *v);
+            }
+        }
         let mut d = self.domain.take().expect("a split run");
         let (me, k) = (d.comm.rank(), d.comm.size());
         // The old lists and particles go as soon as what they hold is out.
@@ -562,6 +603,8 @@ impl Simulation {
         self.neighbours.clear_lists();
         let old = std::mem::take(&mut self.particles);
         let p = &old;
+        // Where each particle is placed: where it is now, or at its anchor.
+        let place = anchors.unwrap_or_else(|| p.x.clone());
         let index: FxHashMap<u32, u32> =
             p.id.iter()
                 .enumerate()
@@ -569,7 +612,10 @@ impl Simulation {
                 .collect();
         let kept = |i: usize| d.owned[i] && !gone.contains(&p.id[i]);
         // The boxes, cut anew when the counts are out of balance.
-        let own: Vec<DVec3> = (0..p.len()).filter(|&i| kept(i)).map(|i| p.x[i]).collect();
+        let own: Vec<DVec3> = (0..p.len())
+            .filter(|&i| kept(i))
+            .map(|i| place[i])
+            .collect();
         let counts: Vec<u64> = d
             .comm
             .all_gather((own.len() as u64).to_le_bytes().to_vec())
@@ -588,11 +634,11 @@ impl Simulation {
         // springs of their contacts. A pair's springs go to the owners of both partners,
         // sent by the owner of its lower id (the other owner has the same springs), so each
         // arrives once.
-        let owner = |id: u32| tree.owner(p.x[index[&id] as usize]);
+        let owner = |id: u32| tree.owner(place[index[&id] as usize]);
         let mine = |id: u32| d.owned[index[&id] as usize];
         let mut particles_to: Vec<Vec<u32>> = vec![Vec::new(); k];
         for i in (0..p.len()).filter(|&i| kept(i)) {
-            particles_to[tree.owner(p.x[i])].push(i as u32);
+            particles_to[tree.owner(place[i])].push(i as u32);
         }
         let mut pairs_to: Vec<Vec<usize>> = vec![Vec::new(); k];
         for (e, &(a, b, _)) in pairs.iter().enumerate() {
@@ -620,6 +666,7 @@ impl Simulation {
                 w.u64(particles_to[q].len() as u64);
                 for &i in &particles_to[q] {
                     put_particle(&mut w, p.id[i as usize], &p.get(i as usize));
+                    w.vec3(place[i as usize]);
                 }
                 w.u64(pairs_to[q].len() as u64);
                 pairs_to[q]
@@ -637,12 +684,14 @@ impl Simulation {
             next_id: p.next_id,
             ..Particles::default()
         };
+        let mut held_at = Vec::new();
         for &i in &particles_to[me] {
             held.insert(p.id[i as usize], p.get(i as usize));
+            held_at.push(place[i as usize]);
         }
         let mut kept_pairs: Vec<_> = pairs_to[me].iter().map(|&e| pairs[e]).collect();
         let mut kept_faces: Vec<_> = faces_to[me].iter().map(|&e| faces[e]).collect();
-        drop((particles_to, pairs_to, faces_to, pairs, faces, old));
+        drop((particles_to, pairs_to, faces_to, pairs, faces, old, place));
         for (q, m) in d.comm.all_to_all(messages).iter().enumerate() {
             if q == me {
                 continue;
@@ -651,6 +700,7 @@ impl Simulation {
             for _ in 0..r.u64() {
                 let (id, particle) = get_particle(&mut r);
                 held.insert(id, particle);
+                held_at.push(r.vec3());
             }
             for _ in 0..r.u64() {
                 kept_pairs.push(get_entry(&mut r));
@@ -660,37 +710,54 @@ impl Simulation {
             }
         }
         let (pairs, faces) = (kept_pairs, kept_faces);
-        // Ghosts: copies of own particles for the processes whose boxes are within reach.
+        // Ghosts: copies of own particles for the processes whose boxes are within reach of
+        // them or, across periodic sides, of their images.
         let n_own = held.len();
         let r_max = d.comm.max(held.max_radius()).max(0.0);
         let skin = self.neighbours.skin;
+        let periodic = self.neighbours.periodic;
         let mut ghosts_to: Vec<Vec<u32>> = vec![Vec::new(); k];
-        let mut near = Vec::new();
-        for i in 0..n_own {
-            tree.near(held.x[i], held.radius[i] + r_max + skin, &mut near);
-            for &q in near.iter().filter(|&&q| q != me) {
-                ghosts_to[q].push(held.id[i]);
+        let (mut near, mut images, mut to) = (Vec::new(), Vec::new(), Vec::new());
+        for (i, (&x, &r)) in held_at.iter().zip(&held.radius).enumerate().take(n_own) {
+            let reach = r + r_max + skin;
+            to.clear();
+            tree.near(x, reach, &mut near);
+            to.extend_from_slice(&near);
+            if let Some(periodic) = periodic {
+                periodic.image_shifts(x, reach, &mut images);
+                for &(s, _) in &images {
+                    tree.near(x + s, reach, &mut near);
+                    to.extend_from_slice(&near);
+                }
+                to.sort_unstable();
+                to.dedup();
+            }
+            for &q in to.iter().filter(|&&q| q != me) {
+                ghosts_to[q].push(i as u32);
             }
         }
-        let at: FxHashMap<u32, usize> =
-            held.id.iter().enumerate().map(|(i, &id)| (id, i)).collect();
         let messages: Vec<Vec<u8>> = (0..k)
             .map(|q| {
                 let mut w = Writer::default();
                 w.u64(ghosts_to[q].len() as u64);
-                for &id in &ghosts_to[q] {
-                    put_particle(&mut w, id, &held.get(at[&id]));
+                for &i in &ghosts_to[q] {
+                    put_particle(&mut w, held.id[i as usize], &held.get(i as usize));
+                    w.vec3(held_at[i as usize]);
                 }
                 w.0
             })
             .collect();
-        drop(at);
+        let ghosts_to: Vec<Vec<u32>> = ghosts_to
+            .into_iter()
+            .map(|list| list.into_iter().map(|i| held.id[i as usize]).collect())
+            .collect();
         let mut ghosts_from: Vec<Vec<u32>> = vec![Vec::new(); k];
         for (q, m) in d.comm.all_to_all(messages).into_iter().enumerate() {
             let mut r = Reader::new(&m);
             for _ in 0..r.u64() {
                 let (id, particle) = get_particle(&mut r);
                 held.insert(id, particle);
+                held_at.push(r.vec3());
                 ghosts_from[q].push(id);
             }
         }
@@ -703,11 +770,16 @@ impl Simulation {
         }
         let order = self.neighbours.rebuild_from(
             &mut self.particles,
+            held_at,
             &pairs,
             &faces,
             &self.mesh.faces,
             &self.face_grid,
         );
+        if placement == Placement::Anchors && anchors_missing {
+            // Never built in one process: stale at the first step, as there.
+            self.neighbours.forget_anchors();
+        }
         owned = order.iter().map(|&o| owned[o as usize]).collect();
         let at: FxHashMap<u32, u32> = self
             .particles
@@ -725,6 +797,10 @@ impl Simulation {
         d.owned = owned;
         self.domain = Some(d);
         self.built();
+        if restore_clock {
+            (self.steps, self.time) = clock;
+            self.move_meshes();
+        }
     }
 
     /// Sends the new states of own particles to the processes that hold them as ghosts,
@@ -780,12 +856,26 @@ impl Simulation {
             .map(|i| p.radius[i])
             .fold(0.0, f64::max);
         let present = d.comm.max(own_max).max(0.0);
-        let margin = DVec3::splat(2.0 * largest.max(present));
+        // Twice the largest radius is the reach of a test; a little more keeps rounding
+        // (of images across the sides) from leaving out a particle at that reach.
+        let margin = DVec3::splat(2.5 * largest.max(present));
         let regions = Spawner::regions(s);
-        let near = |x: DVec3| {
+        let in_reach = |x: DVec3| {
             regions
                 .iter()
                 .any(|r| x.cmpge(r.min - margin).all() && x.cmple(r.max + margin).all())
+        };
+        // In a periodic domain, also the particles whose images are near (the spawner sees
+        // them through the sides).
+        let periodic = self.spawner.periodic;
+        let near = |x: DVec3| match periodic {
+            None => in_reach(x),
+            Some(periodic) => {
+                let x = periodic.wrap(x);
+                let mut images = Vec::new();
+                periodic.image_shifts(x, margin.x, &mut images);
+                in_reach(x) || images.iter().any(|&(s, _)| in_reach(x + s))
+            }
         };
         let old_next = p.next_id;
         let mut around = gather_by_id(&*d.comm, p, |i| d.owned[i] && near(p.x[i]));
@@ -811,7 +901,7 @@ impl Simulation {
             }
         }
         self.particles.next_id = around.next_id;
-        self.redistribute(&FxHashSet::default());
+        self.redistribute(&FxHashSet::default(), Placement::Now);
     }
 
     /// Stage 7 of a split run (collective): the own particles that left, counted over all
@@ -849,7 +939,7 @@ impl Simulation {
             out.mass += mass;
         }
         let ids: FxHashSet<u32> = gone.iter().map(|g| g.0).collect();
-        self.redistribute(&ids);
+        self.redistribute(&ids, Placement::Now);
     }
 
     /// The wall loads of this step over all processes (collective): exact sums, merged.

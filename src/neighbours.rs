@@ -252,6 +252,26 @@ impl Periodic {
         sh.offset.rem_euclid(self.length[sh.axis])
     }
 
+    /// The image of a point at `x` nearest to a point at `to` (both in the box): its shift
+    /// and how often it crosses the gradient axis of a sheared box (-1, 0, 1). The shift
+    /// depends on the two points alone (not on how the image was found), so the pair of a
+    /// particle and the other's image is seen with the same bits wherever it is listed.
+    pub(crate) fn image_towards(&self, x: DVec3, to: DVec3) -> (DVec3, i8) {
+        let periods = |a: usize, d: f64| (d / self.length[a]).round();
+        let mut e = DVec3::ZERO;
+        let mut n = 0.0;
+        let gradient = self.shear.map(|sh| sh.gradient);
+        if let Some(sh) = self.shear {
+            n = periods(sh.gradient, to[sh.gradient] - x[sh.gradient]);
+            e[sh.gradient] = n * self.length[sh.gradient];
+            e[sh.axis] = n * self.offset_in_period(sh);
+        }
+        for a in (0..3).filter(|&a| self.axes[a] && Some(a) != gradient) {
+            e[a] += periods(a, to[a] - x[a] - e[a]) * self.length[a];
+        }
+        (e, n as i8)
+    }
+
     /// The images of a point at `x` (in the box) that come within `reach` of the box: their
     /// shifts and how many times each crosses the gradient axis (-1, 0, 1; 0 without
     /// shear). For each periodic axis where the point (or an image of it) is within `reach`
@@ -682,13 +702,12 @@ impl Layout {
 }
 
 impl Layout {
-    /// Each particle's (cell key, id): the order the lists keep them in.
-    fn keys(&self, particles: &Particles) -> Vec<(u64, u32)> {
+    /// Each particle's (cell key, id) for particles at `x` of ids `id`: the order the
+    /// lists keep them in.
+    fn keys(&self, x: &[DVec3], id: &[u32]) -> Vec<(u64, u32)> {
         let inv_h = 1.0 / self.h;
-        particles
-            .x
-            .par_iter()
-            .zip(particles.id.par_iter())
+        x.par_iter()
+            .zip(id.par_iter())
             .with_min_len(MIN_PARALLEL_LEN)
             .map(|(&x, &id)| (key(cell_of(x, inv_h)), id))
             .collect()
@@ -704,8 +723,8 @@ pub struct Neighbours {
     pub pairs: ContactList,
     /// Particle-face pairs.
     pub faces: ContactList,
-    /// Particle pairs that touch across a periodic boundary: partner `j` seen at
-    /// `x_j + shift[slot]`.
+    /// Particle pairs that touch across a periodic boundary: the particle of the higher id
+    /// seen at its image, `x + shift[slot]`.
     pub wrapped: ContactList,
     pub shift: Vec<DVec3>,
     /// For each slot of `wrapped`, how often the partner's image crosses the gradient axis
@@ -765,8 +784,8 @@ impl Neighbours {
         }
     }
 
-    /// Where the partner of slot `k` of `wrapped` is seen, relative to where it is: the
-    /// shift of its image now, and the velocity the image adds.
+    /// Where the particle of the higher id of slot `k` of `wrapped` is seen, relative to
+    /// where it is: the shift of its image now, and the velocity the image adds.
     #[inline]
     pub fn image(&self, k: usize) -> (DVec3, DVec3) {
         let n = self.crossings[k] as f64;
@@ -779,6 +798,25 @@ impl Neighbours {
                 (self.shift[k] + drift, dv)
             }
             _ => (self.shift[k], DVec3::ZERO),
+        }
+    }
+
+    /// The pair of slot `k` of `wrapped`, listed under `a` with partner `b` (storage
+    /// indices), as the law sees it: body i the particle of the lower id, body j the other,
+    /// and where j's image is relative to j (shift, added velocity).
+    #[inline]
+    pub fn across(
+        &self,
+        ids: &[u32],
+        a: usize,
+        b: usize,
+        k: usize,
+    ) -> (usize, usize, DVec3, DVec3) {
+        let (shift, dv) = self.image(k);
+        if ids[a] < ids[b] {
+            (a, b, shift, dv)
+        } else {
+            (b, a, shift, dv)
         }
     }
 
@@ -1000,7 +1038,7 @@ impl Neighbours {
                 .for_each(|(x, v)| (*x, *v) = periodic.wrap_state(*x, *v));
         }
         let layout = Layout::of(&particles.radius, self.skin);
-        let keys = layout.keys(particles);
+        let keys = layout.keys(&particles.x, &particles.id);
         let order: Option<Vec<u32>> = (!gone.is_empty() || !keys.is_sorted()).then(|| {
             let mut gone = gone.iter().peekable();
             let mut order: Vec<u32> = (0..particles.len() as u32)
@@ -1047,22 +1085,25 @@ impl Neighbours {
         self.rebuilds += 1;
     }
 
-    /// Rebuilds the lists for `particles` (re-sorted into spatial order first) with the
-    /// springs of `pairs` and `faces`, entries by id ((lower id, higher id) and (id, face);
-    /// those naming a particle that `particles` lacks are left out). For a process of a
-    /// split run (`domain.rs`), which gathers its history from other processes: it finds
-    /// no lonely particles, whose clearances would need the particles it does not hold.
-    /// Returns the permutation applied (`Particles::permute`).
+    /// Rebuilds the lists for `particles` (re-sorted into spatial order first) at the
+    /// positions `at` (one per particle: where they are, or the anchors of an earlier
+    /// rebuild, which become the anchors again), with the springs of `pairs` and `faces`,
+    /// entries by id ((lower id, higher id) and (id, face); those naming a particle that
+    /// `particles` lacks are left out). For a process of a split run (`domain.rs`), which
+    /// gathers its history from other processes: it finds no lonely particles, whose
+    /// clearances would need the particles it does not hold. Returns the permutation
+    /// applied (`Particles::permute`).
     pub fn rebuild_from(
         &mut self,
         particles: &mut Particles,
+        at: Vec<DVec3>,
         pairs: &[(u32, u32, Springs)],
         faces_history: &[(u32, u32, Springs)],
         faces: &[Face],
         face_grid: &CellGrid,
     ) -> Vec<u32> {
         let layout = Layout::of(&particles.radius, self.skin);
-        let keys = layout.keys(particles);
+        let keys = layout.keys(&at, &particles.id);
         let mut order: Vec<u32> = (0..particles.len() as u32).collect();
         order.par_sort_unstable_by_key(|&i| keys[i as usize]);
         drop(keys);
@@ -1070,6 +1111,8 @@ impl Neighbours {
         self.faces = ContactList::default();
         self.wrapped = ContactList::default();
         particles.permute(&order);
+        let x: Vec<DVec3> = order.iter().map(|&o| at[o as usize]).collect();
+        drop(at);
         let mut here = rustc_hash::FxHashSet::default();
         here.extend(particles.id.iter().copied());
         let local = |entries: &[(u32, u32, Springs)], pair: bool| -> Vec<(u32, u32, Springs)> {
@@ -1085,12 +1128,18 @@ impl Neighbours {
             faces: History::in_storage(particles, &local(faces_history, false), false)
                 .expect("only particles present"),
         };
-        let x = particles.x.clone();
         self.build(&x, particles, faces, face_grid, layout, &history);
         self.lonely = Vec::new();
         self.x_at_build = x;
         self.rebuilds += 1;
         order
+    }
+
+    /// Forgets the anchors of the last rebuild, so that the lists count as stale at the
+    /// next step (as those of a simulation never stepped).
+    pub fn forget_anchors(&mut self) {
+        self.x_at_build = Vec::new();
+        self.lonely = Vec::new();
     }
 
     /// Builds again the lists of a checkpoint: the particles in their saved storage order,
@@ -1266,6 +1315,17 @@ impl Neighbours {
                 .flatten()
                 .collect();
             found.sort_unstable_by_key(|&(i, j, _, _)| (i, j));
+            // Each pair as the law sees it: the particle of the higher id at its image
+            // nearest the other.
+            let ids = &particles.id;
+            for f in &mut found {
+                let (lo, hi) = if ids[f.0 as usize] < ids[f.1 as usize] {
+                    (f.0, f.1)
+                } else {
+                    (f.1, f.0)
+                };
+                (f.2, f.3) = periodic.image_towards(x[hi as usize], x[lo as usize]);
+            }
             let (start, partner) = compress(n, found.iter().map(|&(i, j, _, _)| (i, j)));
             self.shift = found.iter().map(|f| f.2).collect();
             self.crossings = found.iter().map(|f| f.3).collect();
@@ -1619,5 +1679,49 @@ mod tests {
             "they passed through each other's place"
         );
         assert!(rebuilds < 150, "{rebuilds} rebuilds");
+    }
+
+    /// The image a wrapped pair is seen with is the one `image_shifts` finds, and the same
+    /// whichever particle is the one listed: its shift depends on the two points alone.
+    #[test]
+    fn the_image_towards_a_point_is_the_nearest_one_found() {
+        let sheared = Periodic {
+            min: DVec3::splat(-0.05),
+            length: DVec3::new(0.1, 0.08, 0.1),
+            axes: [true, true, true],
+            shear: Some(Shear {
+                velocity: 0.3,
+                axis: 0,
+                gradient: 2,
+                offset: 0.1234,
+            }),
+        };
+        let plain = Periodic {
+            shear: None,
+            ..sheared
+        };
+        let mut shifts = Vec::new();
+        for periodic in [plain, sheared] {
+            let mut checked = 0;
+            for k in 0..4000u64 {
+                let h = |m: u64| {
+                    let z = (k * 8 + m).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+                    ((z ^ (z >> 29)).wrapping_mul(0xBF58_476D_1CE4_E5B9) >> 40) as f64
+                        / (1u64 << 24) as f64
+                };
+                let x = periodic.min + DVec3::new(h(1), h(2), h(3)) * periodic.length;
+                let to = periodic.min + DVec3::new(h(4), h(5), h(6)) * periodic.length;
+                let reach = 0.02;
+                periodic.image_shifts(x, reach, &mut shifts);
+                for &(s, n) in &shifts {
+                    if (x + s).distance(to) < reach {
+                        let (e, m) = periodic.image_towards(x, to);
+                        assert!((e - s).length() < 1e-12 && m == n, "{x} {to}: {e} {s}");
+                        checked += 1;
+                    }
+                }
+            }
+            assert!(checked > 20, "{checked} pairs across the sides");
+        }
     }
 }

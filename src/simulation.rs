@@ -1002,21 +1002,18 @@ impl Simulation {
     /// axes (between neighbour-list rebuilds they may be up to half the skin beyond a side),
     /// for output; the particles themselves if it has none.
     pub fn particles_in_domain(&self) -> std::borrow::Cow<'_, Particles> {
-        if self.domain.is_some() {
-            // All processes' (collective), in id order; split runs have no periodic sides.
-            return std::borrow::Cow::Owned(self.gather_particles());
-        }
-        match self.scenario.periodicity() {
-            None => std::borrow::Cow::Borrowed(&self.particles),
-            Some(_) => {
-                let periodic = self.neighbours.periodic.expect("set from the scenario");
-                let mut p = self.particles.clone();
-                for (x, v) in p.x.iter_mut().zip(p.v.iter_mut()) {
-                    (*x, *v) = periodic.wrap_state(*x, *v);
-                }
-                std::borrow::Cow::Owned(p)
+        // Of a split run, all processes' (collective), in id order.
+        let mut p = match (&self.domain, self.neighbours.periodic) {
+            (None, None) => return std::borrow::Cow::Borrowed(&self.particles),
+            (None, Some(_)) => self.particles.clone(),
+            (Some(_), _) => self.gather_particles(),
+        };
+        if let Some(periodic) = self.neighbours.periodic {
+            for (x, v) in p.x.iter_mut().zip(p.v.iter_mut()) {
+                (*x, *v) = periodic.wrap_state(*x, *v);
             }
         }
+        std::borrow::Cow::Owned(p)
     }
 
     /// Advances the simulation by one time step Δt.
@@ -1191,19 +1188,15 @@ impl Simulation {
         };
         // Pairs within the box, and across periodic sides with the partner at its image.
         let nb = &self.neighbours;
-        let within = open(&nb.pairs)
-            .into_iter()
-            .map(|(a, b, s, _)| (a, b, s, DVec3::ZERO));
-        let across = open(&nb.wrapped)
-            .into_iter()
-            .map(|(a, b, s, k)| (a, b, s, nb.image(k)));
-        let within = within.map(|(a, b, s, shift)| (a, b, s, (shift, DVec3::ZERO)));
-        for (a, b, springs, (shift, dv)) in within.chain(across) {
-            let (i, j, shift, dv) = if p.id[a] < p.id[b] {
-                (a, b, shift, dv)
-            } else {
-                (b, a, -shift, -dv)
-            };
+        let within = open(&nb.pairs).into_iter().map(|(a, b, s, _)| {
+            let (i, j) = if p.id[a] < p.id[b] { (a, b) } else { (b, a) };
+            (i, j, s, DVec3::ZERO, DVec3::ZERO)
+        });
+        let across = open(&nb.wrapped).into_iter().map(|(a, b, s, k)| {
+            let (i, j, shift, dv) = nb.across(&p.id, a, b, k);
+            (i, j, s, shift, dv)
+        });
+        for (i, j, springs, shift, dv) in within.chain(across) {
             let bj = Body {
                 x: p.x[j] + shift,
                 v: p.v[j] + dv,
@@ -1522,7 +1515,7 @@ impl Simulation {
     }
 
     /// Stage 0: moving mesh parts to their pose at the current time, with their velocity.
-    fn move_meshes(&mut self) {
+    pub(crate) fn move_meshes(&mut self) {
         let t = self.time;
         let mut drift: f64 = 0.0;
         for part in &mut self.moving {
@@ -1597,7 +1590,7 @@ impl Simulation {
 
     /// Lees-Edwards: the images across the gradient sides of a sheared domain to their
     /// offset V t now (for the lists and the spawner).
-    fn slide_images(&mut self) {
+    pub(crate) fn slide_images(&mut self) {
         let time = self.time;
         if let Some(periodic) = &mut self.neighbours.periodic
             && let Some(shear) = &mut periodic.shear
@@ -1619,7 +1612,9 @@ impl Simulation {
         );
         match &self.domain {
             // Split over processes: all rebuild when one must.
-            Some(d) if d.comm.any(stale) => self.redistribute(&Default::default()),
+            Some(d) if d.comm.any(stale) => {
+                self.redistribute(&Default::default(), crate::domain::Placement::Now)
+            }
             Some(_) => {}
             None if stale => self.rebuild_lists(!self.moving.is_empty()),
             None => {}
@@ -1839,7 +1834,6 @@ impl Simulation {
         let law = &self.law;
         let nb = &mut self.neighbours;
         let images: Vec<(DVec3, DVec3)> = (0..nb.shift.len()).map(|k| nb.image(k)).collect();
-        let image = |k: usize| images[k];
         let ContactList {
             start,
             partner,
@@ -1858,13 +1852,10 @@ impl Simulation {
             for a in pieces[piece] as usize..pieces[piece + 1] as usize {
                 for k in start[a] as usize..start[a + 1] as usize {
                     let b = partner[k] as usize;
-                    // Seen from the lower id: the other at its image (and its velocity).
-                    let (shift, dv) = image(k);
-                    let (i, j, shift, dv) = if p.id[a] < p.id[b] {
-                        (a, b, shift, dv)
-                    } else {
-                        (b, a, -shift, -dv)
-                    };
+                    // Seen from the lower id: the other at its image (and its velocity), as
+                    // `Neighbours::across`.
+                    let (shift, dv) = images[k];
+                    let (i, j) = if p.id[a] < p.id[b] { (a, b) } else { (b, a) };
                     let body = |k: usize, x: DVec3, dv: DVec3| Body {
                         x,
                         radius: p.radius[k],

@@ -251,16 +251,33 @@ fn the_reference_cases_split_over_processes_give_the_bits_of_one() {
 #[test]
 fn a_checkpoint_of_two_processes_resumes_on_three_with_the_same_bits() {
     let text = silo(0.5);
-    let (first, then) = (1200, 1300);
-    let mut single = common::simulate(&text, first + then);
+    checkpoint_on_2_resumes_on_3(move || common::scenario(&text), 1200, 1300);
+}
+
+#[test]
+fn a_sheared_periodic_box_checkpointed_on_two_processes_resumes_on_three() {
+    checkpoint_on_2_resumes_on_3(shear_cell, 700, 600);
+}
+
+/// A run of `first + then` steps in one process; and `first` steps on 2 processes, then
+/// the checkpoint's snapshot resumed for `then` steps on 3 and in one: all end alike.
+fn checkpoint_on_2_resumes_on_3(
+    make: impl Fn() -> Scenario + Send + Clone + 'static,
+    first: u64,
+    then: u64,
+) {
+    let mut single = Simulation::new(make()).unwrap();
+    for _ in 0..first + then {
+        single.step().unwrap();
+    }
     let reference = end_of(&mut single);
-    // 1200 steps on 2 processes, then the checkpoint's snapshot.
+    // `first` steps on 2 processes, then the checkpoint's snapshot.
     let handles: Vec<_> = Threads::group(2)
         .into_iter()
         .map(|comm| {
-            let text = text.clone();
+            let make = make.clone();
             std::thread::spawn(move || {
-                let sim = Simulation::new(common::scenario(&text)).unwrap();
+                let sim = Simulation::new(make()).unwrap();
                 let mut sim = sim.split(Box::new(comm)).unwrap();
                 for _ in 0..first {
                     sim.step().unwrap();
@@ -278,11 +295,10 @@ fn a_checkpoint_of_two_processes_resumes_on_three_with_the_same_bits() {
     assert!(!snapshot.pair_history.is_empty());
     // Resumed on 3 processes, and in one.
     let resumed = {
-        let snapshot = snapshot.clone();
-        let text = text.clone();
-        split_resume(move || (common::scenario(&text), snapshot.clone()), then, 3)
+        let (snapshot, make) = (snapshot.clone(), make.clone());
+        split_resume(move || (make(), snapshot.clone()), then, 3)
     };
-    let mut one = Simulation::restore(common::scenario(&text), snapshot).unwrap();
+    let mut one = Simulation::restore(make(), snapshot).unwrap();
     for _ in 0..then {
         one.step().unwrap();
     }
@@ -425,5 +441,75 @@ fn an_instability_split_over_processes_stops_all_with_the_message_of_one() {
         for h in handles {
             assert_eq!(h.join().unwrap(), expected, "{k} processes");
         }
+    }
+}
+
+/// A chute periodic along x and y: grains spawned over the whole box fall onto a plate,
+/// pile up and flow down the slope of gravity along x, across the periodic sides and the
+/// processes' boxes, in contact all the while.
+fn periodic_chute() -> String {
+    "[geometry]\nradius_min = 0.003\nradius_max = 0.004\nmesh = \"domain/plate.off\"\nmesh_radii = [0.0]\n\
+     [material]\nrestitution = 0.3\nfriction_sliding = 0.4\nfriction_rolling = 0.05\nfriction_twisting = 0.05\n\
+     [kinetics]\ngravity = [4.0, 1.0, -9.0]\n\
+     [simulation]\nmax_particles = 400\n\
+     [domain]\nmin = [-0.04, -0.03, -0.05]\nmax = [0.04, 0.03, 0.2]\nperiodic = [true, true, false]\n\
+     [[spawn]]\nmin = [-0.04, -0.03, 0.01]\nmax = [0.04, 0.03, 0.06]\ncount = 400\n\
+     [output]\nwall_forces = true\n"
+        .into()
+}
+
+#[test]
+fn a_periodic_chute_split_over_processes_gives_the_bits_of_one() {
+    let steps = 4000;
+    let text = periodic_chute();
+    let mut single = common::simulate(&text, steps);
+    let crossed = single
+        .particles
+        .x
+        .iter()
+        .filter(|x| x.x.abs() > 0.04 || x.y.abs() > 0.03)
+        .count();
+    let reference = end_of(&mut single);
+    eprintln!(
+        "chute: {} grains, contacts {:?}, {crossed} beyond a side now, {} rebuilds",
+        reference.particles.len(),
+        reference.contacts,
+        single.rebuilds()
+    );
+    assert!(reference.particles.len() >= 300);
+    assert!(reference.contacts.0 > 100 && reference.contacts.1 > 50);
+    for k in [2, 3, 4] {
+        let text = text.clone();
+        let (end, _) = split_run(move || common::scenario(&text), steps, k);
+        assert!(
+            end == reference,
+            "{k} processes: the periodic chute differs from one process's"
+        );
+    }
+}
+
+/// The shear cell of the examples: a box periodic along x, y and z, sheared by
+/// Lees-Edwards boundaries, with two materials.
+fn shear_cell() -> Scenario {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("examples/h_shear_cell/scenario.toml");
+    Scenario::load(&path).expect("loads")
+}
+
+#[test]
+fn a_sheared_periodic_box_split_over_processes_gives_the_bits_of_one() {
+    let steps = 1500;
+    let mut single = Simulation::new(shear_cell()).unwrap();
+    for _ in 0..steps {
+        single.step().unwrap();
+    }
+    let reference = end_of(&mut single);
+    assert!(reference.contacts.0 > 300, "{:?}", reference.contacts);
+    for k in [2, 3] {
+        let (end, _) = split_run(shear_cell, steps, k);
+        assert!(
+            end == reference,
+            "{k} processes: the sheared box differs from one process's"
+        );
     }
 }

@@ -207,3 +207,22 @@ fn a_bad_scenario_on_3_processes_gives_one_error() {
     assert_eq!(err.matches("error: ").count(), 1, "{err}");
     assert!(err.contains("radius_min = -1"), "{err}");
 }
+
+#[test]
+fn a_sheared_periodic_box_on_1_to_3_processes_writes_the_same_bytes() {
+    // The shear cell of the examples (periodic along x, y and z, Lees-Edwards boundaries,
+    // two materials, contact networks), for fewer frames.
+    let dir = tempfile::tempdir().unwrap();
+    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/h_shear_cell");
+    let text = std::fs::read_to_string(example.join("scenario.toml"))
+        .unwrap()
+        .replace("frames = 40", "frames = 6")
+        .replace(
+            "particles = \"initial.csv\"",
+            &format!("particles = \"{}\"", example.join("initial.csv").display()),
+        );
+    assert!(text.contains("frames = 6") && text.contains("lees_edwards"));
+    let path = dir.path().join("shear.toml");
+    std::fs::write(&path, text).unwrap();
+    same_output(&path, &[2, 3]);
+}
