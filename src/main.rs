@@ -293,6 +293,15 @@ fn execute(
     world: Option<Box<dyn Comm>>,
 ) -> Result<()> {
     let first = world.as_ref().is_none_or(|c| c.rank() == 0);
+    // Under mpirun, a command that does not step a simulation runs on the first process
+    // only: the others would do the same work and write the same files at the same time.
+    let splits = matches!(
+        command,
+        None | Some(Command::Run { .. }) | Some(Command::Bench { single: true, .. })
+    );
+    if !first && !splits {
+        return Ok(());
+    }
     match command {
         None => {
             let s = Scenario::default();

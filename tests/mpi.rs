@@ -226,3 +226,19 @@ fn a_sheared_periodic_box_on_1_to_3_processes_writes_the_same_bytes() {
     std::fs::write(&path, text).unwrap();
     same_output(&path, &[2, 3]);
 }
+
+#[test]
+fn commands_that_do_not_step_run_once_under_mpirun() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = silo(dir.path(), 4);
+    let name = scenario.to_str().unwrap();
+    let one = run(1, &["check", name], dir.path());
+    let two = run(2, &["check", name], dir.path());
+    let (one, two) = (
+        String::from_utf8_lossy(&one.stdout),
+        String::from_utf8_lossy(&two.stdout),
+    );
+    // The same report, once (but the free space and the threads it would run on).
+    assert_eq!(two.matches("scenario is valid").count(), 1, "{two}");
+    assert_eq!(two.lines().count(), one.lines().count(), "{two}");
+}
