@@ -21,6 +21,18 @@ pub trait Comm: Send + Sync {
     /// What every process contributed, by rank (on every process).
     fn all_gather(&self, data: Vec<u8>) -> Vec<Vec<u8>>;
 
+    /// Sends each `(q, message)` of `send` to process q and receives one message from each
+    /// process of `from`, in that order: messages between neighbours only. Every process
+    /// calls it, and `from` names exactly the processes that send to this one.
+    fn exchange(&self, send: Vec<(usize, Vec<u8>)>, from: &[usize]) -> Vec<Vec<u8>> {
+        let mut all = vec![Vec::new(); self.size()];
+        for (q, m) in send {
+            all[q] = m;
+        }
+        let mut got = self.all_to_all(all);
+        from.iter().map(|&q| std::mem::take(&mut got[q])).collect()
+    }
+
     /// Whether any process says so.
     fn any(&self, flag: bool) -> bool {
         self.all_gather(vec![flag as u8])
@@ -161,8 +173,12 @@ pub use over_mpi::{Finalize, Mpi};
 
 #[cfg(feature = "mpi")]
 mod over_mpi {
+    use mpi::collective::SystemOperation;
     use mpi::datatype::{Partition, PartitionMut};
     use mpi::traits::*;
+
+    /// The tag of [`super::Comm::exchange`]'s messages (the only point-to-point ones).
+    const EXCHANGE: mpi::Tag = 7;
 
     /// The processes of `mpirun`, over the system's MPI (the `mpi` feature).
     pub struct Mpi {
@@ -266,6 +282,44 @@ mod over_mpi {
                 self.world.all_to_all_varcount_into(&out, &mut into);
             }
             pieces(&buf, &from)
+        }
+        fn exchange(&self, send: Vec<(usize, Vec<u8>)>, from: &[usize]) -> Vec<Vec<u8>> {
+            let rank = |q: usize| self.world.process_at_rank(q as mpi::Rank);
+            mpi::request::scope(|scope| {
+                let sent: Vec<_> = send
+                    .iter()
+                    .map(|(q, m)| rank(*q).immediate_send_with_tag(scope, &m[..], EXCHANGE))
+                    .collect();
+                let got = from
+                    .iter()
+                    .map(|&q| rank(q).receive_vec_with_tag::<u8>(EXCHANGE).0)
+                    .collect();
+                sent.into_iter().for_each(|r| {
+                    r.wait();
+                });
+                got
+            })
+        }
+        fn any(&self, flag: bool) -> bool {
+            let mut any = false;
+            self.world
+                .all_reduce_into(&flag, &mut any, SystemOperation::logical_or());
+            any
+        }
+        fn max(&self, x: f64) -> f64 {
+            let mut max = f64::NEG_INFINITY;
+            self.world
+                .all_reduce_into(&x, &mut max, SystemOperation::max());
+            max
+        }
+        fn sum_i64(&self, x: &[i64]) -> Vec<i64> {
+            if x.is_empty() {
+                return Vec::new();
+            }
+            let mut total = vec![0i64; x.len()];
+            self.world
+                .all_reduce_into(x, &mut total[..], SystemOperation::sum());
+            total
         }
         fn all_gather(&self, data: Vec<u8>) -> Vec<Vec<u8>> {
             let mut counts = vec![0 as mpi::Count; self.size()];

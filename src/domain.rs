@@ -808,10 +808,12 @@ impl Simulation {
     pub(crate) fn refresh_ghosts(&mut self) {
         let Some(d) = &self.domain else { return };
         let p = &mut self.particles;
-        let messages: Vec<Vec<u8>> = d
+        let messages: Vec<(usize, Vec<u8>)> = d
             .send
             .iter()
-            .map(|list| {
+            .enumerate()
+            .filter(|(_, list)| !list.is_empty())
+            .map(|(q, list)| {
                 let mut w = Writer(Vec::with_capacity(list.len() * 108));
                 for &i in list {
                     let i = i as usize;
@@ -821,12 +823,16 @@ impl Simulation {
                     w.vec3(p.w[i]);
                     w.u32(p.tag[i]);
                 }
-                w.0
+                (q, w.0)
             })
             .collect();
-        for (m, list) in d.comm.all_to_all(messages).iter().zip(&d.recv) {
+        // Only the processes that hold ghosts of ours, or ours of theirs, hear from us.
+        let from: Vec<usize> = (0..d.recv.len())
+            .filter(|&q| !d.recv[q].is_empty())
+            .collect();
+        for (m, &q) in d.comm.exchange(messages, &from).iter().zip(&from) {
             let mut r = Reader::new(m);
-            for &i in list {
+            for &i in &d.recv[q] {
                 let i = i as usize;
                 p.x[i] = r.vec3();
                 p.v[i] = r.vec3();
