@@ -22,15 +22,21 @@ pub trait Comm: Send + Sync {
     fn all_gather(&self, data: Vec<u8>) -> Vec<Vec<u8>>;
 
     /// Sends each `(q, message)` of `send` to process q and receives one message from each
-    /// process of `from`, in that order: messages between neighbours only. Every process
-    /// calls it, and `from` names exactly the processes that send to this one.
-    fn exchange(&self, send: Vec<(usize, Vec<u8>)>, from: &[usize]) -> Vec<Vec<u8>> {
+    /// process q of `from`, of the length given with it, in that order: messages between
+    /// neighbours only. Every process calls it, and `from` names exactly the processes that
+    /// send to this one, with the lengths they send.
+    fn exchange(&self, send: Vec<(usize, Vec<u8>)>, from: &[(usize, usize)]) -> Vec<Vec<u8>> {
         let mut all = vec![Vec::new(); self.size()];
         for (q, m) in send {
             all[q] = m;
         }
         let mut got = self.all_to_all(all);
-        from.iter().map(|&q| std::mem::take(&mut got[q])).collect()
+        from.iter()
+            .map(|&(q, len)| {
+                assert_eq!(got[q].len(), len, "the message of process {q}");
+                std::mem::take(&mut got[q])
+            })
+            .collect()
     }
 
     /// Whether any process says so.
@@ -283,22 +289,31 @@ mod over_mpi {
             }
             pieces(&buf, &from)
         }
-        fn exchange(&self, send: Vec<(usize, Vec<u8>)>, from: &[usize]) -> Vec<Vec<u8>> {
+        fn exchange(&self, send: Vec<(usize, Vec<u8>)>, from: &[(usize, usize)]) -> Vec<Vec<u8>> {
             let rank = |q: usize| self.world.process_at_rank(q as mpi::Rank);
+            // The receives posted first, into buffers of the known lengths, so that no
+            // message waits in MPI's own buffers for its receive.
+            let mut got: Vec<Vec<u8>> = from.iter().map(|&(_, len)| zeros(len)).collect();
             mpi::request::scope(|scope| {
-                let sent: Vec<_> = send
+                let receiving: Vec<_> = got
+                    .iter_mut()
+                    .zip(from)
+                    .map(|(buf, &(q, _))| {
+                        rank(q).immediate_receive_into_with_tag(scope, &mut buf[..], EXCHANGE)
+                    })
+                    .collect();
+                let sending: Vec<_> = send
                     .iter()
                     .map(|(q, m)| rank(*q).immediate_send_with_tag(scope, &m[..], EXCHANGE))
                     .collect();
-                let got = from
-                    .iter()
-                    .map(|&q| rank(q).receive_vec_with_tag::<u8>(EXCHANGE).0)
-                    .collect();
-                sent.into_iter().for_each(|r| {
+                for r in receiving {
                     r.wait();
-                });
-                got
-            })
+                }
+                for r in sending {
+                    r.wait();
+                }
+            });
+            got
         }
         fn any(&self, flag: bool) -> bool {
             let mut any = false;

@@ -235,6 +235,10 @@ impl Tree {
     }
 }
 
+/// The bytes of a ghost's new state each step: position, velocity, orientation, angular
+/// velocity and tag.
+const GHOST_STATE: usize = 3 * 8 + 3 * 8 + 4 * 8 + 3 * 8 + 4;
+
 /// Where a redistribution places the particles (for their owners, ghosts and lists).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Placement {
@@ -603,8 +607,13 @@ impl Simulation {
         self.neighbours.clear_lists();
         let old = std::mem::take(&mut self.particles);
         let p = &old;
-        // Where each particle is placed: where it is now, or at its anchor.
-        let place = anchors.unwrap_or_else(|| p.x.clone());
+        // Where each particle is placed: at its anchor (which it carries along), or where
+        // it is now.
+        let carry = anchors.is_some();
+        let place: std::borrow::Cow<[DVec3]> = match anchors {
+            Some(a) => a.into(),
+            None => p.x.as_slice().into(),
+        };
         let index: FxHashMap<u32, u32> =
             p.id.iter()
                 .enumerate()
@@ -666,7 +675,9 @@ impl Simulation {
                 w.u64(particles_to[q].len() as u64);
                 for &i in &particles_to[q] {
                     put_particle(&mut w, p.id[i as usize], &p.get(i as usize));
-                    w.vec3(place[i as usize]);
+                    if carry {
+                        w.vec3(place[i as usize]);
+                    }
                 }
                 w.u64(pairs_to[q].len() as u64);
                 pairs_to[q]
@@ -684,14 +695,17 @@ impl Simulation {
             next_id: p.next_id,
             ..Particles::default()
         };
-        let mut held_at = Vec::new();
+        let mut held_at = carry.then(Vec::new);
         for &i in &particles_to[me] {
             held.insert(p.id[i as usize], p.get(i as usize));
-            held_at.push(place[i as usize]);
+            if let Some(at) = &mut held_at {
+                at.push(place[i as usize]);
+            }
         }
         let mut kept_pairs: Vec<_> = pairs_to[me].iter().map(|&e| pairs[e]).collect();
         let mut kept_faces: Vec<_> = faces_to[me].iter().map(|&e| faces[e]).collect();
-        drop((particles_to, pairs_to, faces_to, pairs, faces, old, place));
+        drop(place);
+        drop((particles_to, pairs_to, faces_to, pairs, faces, old));
         for (q, m) in d.comm.all_to_all(messages).iter().enumerate() {
             if q == me {
                 continue;
@@ -700,7 +714,9 @@ impl Simulation {
             for _ in 0..r.u64() {
                 let (id, particle) = get_particle(&mut r);
                 held.insert(id, particle);
-                held_at.push(r.vec3());
+                if let Some(at) = &mut held_at {
+                    at.push(r.vec3());
+                }
             }
             for _ in 0..r.u64() {
                 kept_pairs.push(get_entry(&mut r));
@@ -718,8 +734,9 @@ impl Simulation {
         let periodic = self.neighbours.periodic;
         let mut ghosts_to: Vec<Vec<u32>> = vec![Vec::new(); k];
         let (mut near, mut images, mut to) = (Vec::new(), Vec::new(), Vec::new());
-        for (i, (&x, &r)) in held_at.iter().zip(&held.radius).enumerate().take(n_own) {
-            let reach = r + r_max + skin;
+        for i in 0..n_own {
+            let x = held_at.as_ref().map_or(held.x[i], |at| at[i]);
+            let reach = held.radius[i] + r_max + skin;
             to.clear();
             tree.near(x, reach, &mut near);
             to.extend_from_slice(&near);
@@ -742,7 +759,9 @@ impl Simulation {
                 w.u64(ghosts_to[q].len() as u64);
                 for &i in &ghosts_to[q] {
                     put_particle(&mut w, held.id[i as usize], &held.get(i as usize));
-                    w.vec3(held_at[i as usize]);
+                    if let Some(at) = &held_at {
+                        w.vec3(at[i as usize]);
+                    }
                 }
                 w.0
             })
@@ -757,7 +776,9 @@ impl Simulation {
             for _ in 0..r.u64() {
                 let (id, particle) = get_particle(&mut r);
                 held.insert(id, particle);
-                held_at.push(r.vec3());
+                if let Some(at) = &mut held_at {
+                    at.push(r.vec3());
+                }
                 ghosts_from[q].push(id);
             }
         }
@@ -814,7 +835,7 @@ impl Simulation {
             .enumerate()
             .filter(|(_, list)| !list.is_empty())
             .map(|(q, list)| {
-                let mut w = Writer(Vec::with_capacity(list.len() * 108));
+                let mut w = Writer(Vec::with_capacity(list.len() * GHOST_STATE));
                 for &i in list {
                     let i = i as usize;
                     w.vec3(p.x[i]);
@@ -827,10 +848,11 @@ impl Simulation {
             })
             .collect();
         // Only the processes that hold ghosts of ours, or ours of theirs, hear from us.
-        let from: Vec<usize> = (0..d.recv.len())
+        let from: Vec<(usize, usize)> = (0..d.recv.len())
             .filter(|&q| !d.recv[q].is_empty())
+            .map(|q| (q, d.recv[q].len() * GHOST_STATE))
             .collect();
-        for (m, &q) in d.comm.exchange(messages, &from).iter().zip(&from) {
+        for (m, &(q, _)) in d.comm.exchange(messages, &from).iter().zip(&from) {
             let mut r = Reader::new(m);
             for &i in &d.recv[q] {
                 let i = i as usize;

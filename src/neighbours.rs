@@ -1085,9 +1085,9 @@ impl Neighbours {
         self.rebuilds += 1;
     }
 
-    /// Rebuilds the lists for `particles` (re-sorted into spatial order first) at the
-    /// positions `at` (one per particle: where they are, or the anchors of an earlier
-    /// rebuild, which become the anchors again), with the springs of `pairs` and `faces`,
+    /// Rebuilds the lists for `particles` (re-sorted into spatial order first) where they
+    /// are, or at the positions `at` (one per particle: the anchors of an earlier rebuild,
+    /// which become the anchors again), with the springs of `pairs` and `faces`,
     /// entries by id ((lower id, higher id) and (id, face); those naming a particle that
     /// `particles` lacks are left out). For a process of a split run (`domain.rs`), which
     /// gathers its history from other processes: it finds no lonely particles, whose
@@ -1096,14 +1096,14 @@ impl Neighbours {
     pub fn rebuild_from(
         &mut self,
         particles: &mut Particles,
-        at: Vec<DVec3>,
+        at: Option<Vec<DVec3>>,
         pairs: &[(u32, u32, Springs)],
         faces_history: &[(u32, u32, Springs)],
         faces: &[Face],
         face_grid: &CellGrid,
     ) -> Vec<u32> {
         let layout = Layout::of(&particles.radius, self.skin);
-        let keys = layout.keys(&at, &particles.id);
+        let keys = layout.keys(at.as_deref().unwrap_or(&particles.x), &particles.id);
         let mut order: Vec<u32> = (0..particles.len() as u32).collect();
         order.par_sort_unstable_by_key(|&i| keys[i as usize]);
         drop(keys);
@@ -1111,8 +1111,12 @@ impl Neighbours {
         self.faces = ContactList::default();
         self.wrapped = ContactList::default();
         particles.permute(&order);
-        let x: Vec<DVec3> = order.iter().map(|&o| at[o as usize]).collect();
-        drop(at);
+        let at = at.map(|at| {
+            order
+                .iter()
+                .map(|&o| at[o as usize])
+                .collect::<Vec<DVec3>>()
+        });
         let mut here = rustc_hash::FxHashSet::default();
         here.extend(particles.id.iter().copied());
         let local = |entries: &[(u32, u32, Springs)], pair: bool| -> Vec<(u32, u32, Springs)> {
@@ -1128,6 +1132,7 @@ impl Neighbours {
             faces: History::in_storage(particles, &local(faces_history, false), false)
                 .expect("only particles present"),
         };
+        let x = at.unwrap_or_else(|| particles.x.clone());
         self.build(&x, particles, faces, face_grid, layout, &history);
         self.lonely = Vec::new();
         self.x_at_build = x;
