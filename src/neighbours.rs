@@ -411,6 +411,25 @@ impl ContactList {
         self.stores.iter().map(Store::len).sum()
     }
 
+    /// Calls `f` with owner, slot and springs of every slot with non-zero springs, in slot
+    /// order (as [`ContactList::live`], in plain loops).
+    fn for_each_live(&self, mut f: impl FnMut(usize, usize, Springs)) {
+        for p in 0..self.pieces.len().saturating_sub(1) {
+            let store = &self.stores[p];
+            for i in self.pieces[p] as usize..self.pieces[p + 1] as usize {
+                for k in self.run(i) {
+                    let c = self.contact[k];
+                    if c != NONE {
+                        let s = store.springs[c as usize];
+                        if s != Springs::default() {
+                            f(i, k, s);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
     /// Every slot with non-zero springs: owner, slot and springs, in slot order.
     fn live(&self) -> impl Iterator<Item = (usize, usize, Springs)> + '_ {
         (0..self.pieces.len().saturating_sub(1)).flat_map(move |p| {
@@ -583,35 +602,57 @@ impl History {
     }
 
     /// The history of saved `(id, other, springs)` entries (a checkpoint's) for `particles`
-    /// (in storage order): keyed by storage index, `pairs` or not.
+    /// (in storage order): keyed by storage index, `pairs` or not. An entry naming a
+    /// particle that `particles` lacks is an error.
     pub fn in_storage(
         particles: &Particles,
         entries: &[(u32, u32, Springs)],
         pairs: bool,
     ) -> Result<History, String> {
-        let n = particles.len();
-        let mut index = vec![u32::MAX; particles.next_id as usize];
-        for (k, &id) in particles.id.iter().enumerate() {
-            index[id as usize] = k as u32;
-        }
+        Self::keyed(
+            &storage_index(particles),
+            particles.len(),
+            entries,
+            pairs,
+            false,
+        )
+    }
+
+    /// [`History::in_storage`] for `n` particles, whose storage indices by id are `index`
+    /// ([`storage_index`]), of the entries that name only them; the others are left out.
+    fn of_present(
+        index: &[u32],
+        n: usize,
+        entries: &[(u32, u32, Springs)],
+        pairs: bool,
+    ) -> History {
+        Self::keyed(index, n, entries, pairs, true).expect("entries of absent particles left out")
+    }
+
+    fn keyed(
+        index: &[u32],
+        n: usize,
+        entries: &[(u32, u32, Springs)],
+        pairs: bool,
+        skip_absent: bool,
+    ) -> Result<History, String> {
         let at = |id: u32| match index.get(id as usize) {
-            Some(&k) if k != u32::MAX => Ok(k),
+            Some(&k) if k != NONE => Ok(Some(k)),
+            _ if skip_absent => Ok(None),
             _ => Err(format!(
                 "contact of particle id {id}, which the checkpoint lacks"
             )),
         };
-        let keyed = entries
-            .iter()
-            .map(|&(a, b, s)| {
-                let a = at(a)?;
-                if pairs {
-                    let b = at(b)?;
-                    Ok((a.min(b), a.max(b), s))
-                } else {
-                    Ok((a, b, s))
-                }
-            })
-            .collect::<Result<Vec<_>, String>>()?;
+        let mut keyed = Vec::with_capacity(entries.len());
+        for &(a, b, s) in entries {
+            let Some(a) = at(a)? else { continue };
+            if pairs {
+                let Some(b) = at(b)? else { continue };
+                keyed.push((a.min(b), a.max(b), s));
+            } else {
+                keyed.push((a, b, s));
+            }
+        }
         Ok(History::from_entries(
             n,
             keyed.iter().map(|e| e.0),
@@ -656,6 +697,15 @@ pub type Entries = (Vec<(u32, u32, Springs)>, Vec<(u32, u32, Springs)>);
 pub struct Histories {
     pub pairs: History,
     pub faces: History,
+}
+
+/// The storage index of each id of `particles` (by id; [`NONE`] for ids it lacks).
+fn storage_index(particles: &Particles) -> Vec<u32> {
+    let mut index = vec![NONE; particles.next_id as usize];
+    for (k, &id) in particles.id.iter().enumerate() {
+        index[id as usize] = k as u32;
+    }
+    index
 }
 
 /// The history of particle pairs of a list, by (lower id, higher id).
@@ -984,20 +1034,16 @@ impl Neighbours {
     /// The contact histories of the current lists by id, unsorted: particle pairs as
     /// (lower id, higher id, springs), particle-face contacts as (id, face, springs).
     pub fn entries_by_id(&self, ids: &[u32]) -> Entries {
-        let key = pair_key(ids);
-        let pairs = [&self.pairs, &self.wrapped]
-            .iter()
-            .flat_map(|list| {
-                list.live()
-                    .filter_map(|(i, k, s)| key(i, list.partner[k]).map(|(a, b)| (a, b, s)))
-                    .collect::<Vec<_>>()
-            })
-            .collect();
-        let faces = self
-            .faces
-            .live()
-            .map(|(i, k, s)| (ids[i], self.faces.partner[k], s))
-            .collect();
+        let mut pairs = Vec::with_capacity(self.pairs.contacts() + self.wrapped.contacts());
+        for list in [&self.pairs, &self.wrapped] {
+            list.for_each_live(|i, k, s| {
+                let (a, b) = (ids[i], ids[list.partner[k] as usize]);
+                pairs.push((a.min(b), a.max(b), s));
+            });
+        }
+        let mut faces = Vec::with_capacity(self.faces.contacts());
+        self.faces
+            .for_each_live(|i, k, s| faces.push((ids[i], self.faces.partner[k], s)));
         (pairs, faces)
     }
 
@@ -1117,21 +1163,12 @@ impl Neighbours {
                 .map(|&o| at[o as usize])
                 .collect::<Vec<DVec3>>()
         });
-        let mut here = rustc_hash::FxHashSet::default();
-        here.extend(particles.id.iter().copied());
-        let local = |entries: &[(u32, u32, Springs)], pair: bool| -> Vec<(u32, u32, Springs)> {
-            entries
-                .iter()
-                .filter(|e| here.contains(&e.0) && (!pair || here.contains(&e.1)))
-                .copied()
-                .collect()
-        };
+        let index = storage_index(particles);
         let history = Histories {
-            pairs: History::in_storage(particles, &local(pairs, true), true)
-                .expect("only particles present"),
-            faces: History::in_storage(particles, &local(faces_history, false), false)
-                .expect("only particles present"),
+            pairs: History::of_present(&index, particles.len(), pairs, true),
+            faces: History::of_present(&index, particles.len(), faces_history, false),
         };
+        drop(index);
         let x = at.unwrap_or_else(|| particles.x.clone());
         self.build(&x, particles, faces, face_grid, layout, &history);
         self.lonely = Vec::new();
