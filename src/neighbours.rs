@@ -412,7 +412,7 @@ impl ContactList {
     }
 
     /// Calls `f` with owner, slot and springs of every slot with non-zero springs, in slot
-    /// order (as [`ContactList::live`], in plain loops).
+    /// order.
     fn for_each_live(&self, mut f: impl FnMut(usize, usize, Springs)) {
         for p in 0..self.pieces.len().saturating_sub(1) {
             let store = &self.stores[p];
@@ -430,22 +430,6 @@ impl ContactList {
         }
     }
 
-    /// Every slot with non-zero springs: owner, slot and springs, in slot order.
-    fn live(&self) -> impl Iterator<Item = (usize, usize, Springs)> + '_ {
-        (0..self.pieces.len().saturating_sub(1)).flat_map(move |p| {
-            let store = &self.stores[p];
-            (self.pieces[p] as usize..self.pieces[p + 1] as usize).flat_map(move |i| {
-                self.run(i).filter_map(move |k| match self.contact[k] {
-                    NONE => None,
-                    c => {
-                        let s = store.springs[c as usize];
-                        (s != Springs::default()).then_some((i, k, s))
-                    }
-                })
-            })
-        })
-    }
-
     /// The contact history of the list: for each slot with springs, the key that
     /// `key(owner, partner)` gives it (first keys below `keys`; none: the contact is
     /// dropped) and its springs.
@@ -454,13 +438,7 @@ impl ContactList {
         keys: usize,
         key: impl Fn(usize, u32) -> Option<(u32, u32)> + Sync,
     ) -> History {
-        History::from_entries(
-            keys,
-            self.live()
-                .filter_map(|(i, k, _)| key(i, self.partner[k]).map(|k| k.0)),
-            self.live()
-                .filter_map(|(i, k, s)| key(i, self.partner[k]).map(|(a, other)| (a, other, s))),
-        )
+        Self::history_of(&[self], keys, key)
     }
 
     /// The contact history of several lists of the same kind (particle pairs, within the
@@ -470,13 +448,15 @@ impl ContactList {
         keys: usize,
         key: impl Fn(usize, u32) -> Option<(u32, u32)> + Sync,
     ) -> History {
-        let entries = || {
-            lists.iter().flat_map(|list| {
-                list.live()
-                    .filter_map(|(i, k, s)| key(i, list.partner[k]).map(|(a, o)| (a, o, s)))
-            })
-        };
-        History::from_entries(keys, entries().map(|e| e.0), entries())
+        History::from_visits(keys, |f| {
+            for list in lists {
+                list.for_each_live(|i, k, s| {
+                    if let Some((a, other)) = key(i, list.partner[k]) {
+                        f(a, other, s);
+                    }
+                });
+            }
+        })
     }
 
     /// A list from runs in compressed form cut into pieces at `pieces` (owner bounds), each
@@ -559,16 +539,11 @@ pub struct History {
 
 impl History {
     /// The history of `(a, other, springs)` entries, `a` below `keys`: a counting sort by
-    /// `a` (`first` yields the same keys in the same order), then each run by `other`.
-    fn from_entries(
-        keys: usize,
-        first: impl Iterator<Item = u32>,
-        entries: impl Iterator<Item = (u32, u32, Springs)>,
-    ) -> History {
+    /// `a`, then each run by `other`. `visit` hands every entry to its argument, the same
+    /// entries in the same order each time it is called (twice: to count, then to place).
+    fn from_visits(keys: usize, visit: impl Fn(&mut dyn FnMut(u32, u32, Springs))) -> History {
         let mut start = vec![0u32; keys + 1];
-        for a in first {
-            start[a as usize + 1] += 1;
-        }
+        visit(&mut |a, _, _| start[a as usize + 1] += 1);
         for k in 0..keys {
             start[k + 1] += start[k];
         }
@@ -576,11 +551,11 @@ impl History {
         let mut fill = start.clone();
         let mut other = vec![0u32; total];
         let mut springs = vec![Springs::default(); total];
-        for (a, o, s) in entries {
+        visit(&mut |a, o, s| {
             let k = fill[a as usize] as usize;
             (other[k], springs[k]) = (o, s);
             fill[a as usize] += 1;
-        }
+        });
         drop(fill);
         // Runs are short: insertion sort, in place.
         for a in 0..keys {
@@ -653,11 +628,9 @@ impl History {
                 keyed.push((a, b, s));
             }
         }
-        Ok(History::from_entries(
-            n,
-            keyed.iter().map(|e| e.0),
-            keyed.iter().copied(),
-        ))
+        Ok(History::from_visits(n, |f| {
+            keyed.iter().for_each(|&(a, o, s)| f(a, o, s))
+        }))
     }
 
     /// Every entry, ordered by the first key and then by the other.
