@@ -7,7 +7,7 @@ use crate::integrate::Inertia;
 use crate::neighbours::CellGrid;
 use crate::particles::Particles;
 
-/// Kinetic energy, translational and rotational [J], for the density `rho[m]` of each
+/// Kinetic energy, translational and rotational \[J\], for the density `rho[m]` of each
 /// particle's material m.
 pub fn kinetic_energy(p: &Particles, rho: &[f64]) -> f64 {
     (0..p.len())
@@ -129,7 +129,7 @@ impl Default for ReposeWindow {
     }
 }
 
-/// One flank's angle of repose [degrees], with the standard error of the least-squares
+/// One flank's angle of repose \[degrees\], with the standard error of the least-squares
 /// slope, over `columns` surface columns one grain diameter wide.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Flank {
@@ -138,7 +138,7 @@ pub struct Flank {
     pub columns: usize,
 }
 
-/// The angles of a pile's two flanks, its height above the floor [m] and the grains at rest.
+/// The angles of a pile's two flanks, its height above the floor \[m\] and the grains at rest.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Repose {
     pub left: Flank,

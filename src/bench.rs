@@ -99,7 +99,7 @@ pub struct Measurement {
     pub ms_per_step: f64,
     /// N / (seconds per step).
     pub cundall: f64,
-    /// Peak resident memory of the processes [bytes], and its growth per particle.
+    /// Peak resident memory of the processes \[bytes\], and its growth per particle.
     pub peak_bytes: u64,
     pub bytes_per_particle: f64,
     /// Neighbour-list rebuilds per 100 timed steps.

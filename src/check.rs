@@ -384,7 +384,7 @@ pub fn free_space(dir: &Path) -> Option<u64> {
 pub struct Trial {
     /// Steps taken, the first included.
     pub steps: u64,
-    /// Wall time of the first step and of the steps after it [s].
+    /// Wall time of the first step and of the steps after it \[s\].
     pub first: f64,
     pub seconds: f64,
     /// Sum over the steps after the first of the particles stepped.

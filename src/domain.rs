@@ -24,7 +24,7 @@
 //! other at the image nearest it (a shift found from the two positions alone), so both
 //! processes of such a pair see it with the same bits. Positions are wrapped into the box
 //! at rebuilds, which rounds them: so the split run rebuilds at the steps the run in one
-//! process does (see [`Placement`]).
+//! process does (see `Placement`).
 
 use anyhow::{Result, bail};
 use glam::DVec3;

@@ -39,7 +39,7 @@ pub enum Primitive {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Face {
     pub shape: Primitive,
-    /// R_j [L], from the scenario's `mesh_radii`.
+    /// R_j \[L\], from the scenario's `mesh_radii`.
     pub radius: f64,
     /// The connected surface the face belongs to (an index unique within a [`Mesh`]).
     pub surface: u32,

@@ -864,7 +864,7 @@ impl Neighbours {
     /// the last rebuild.
     ///
     /// A lonely particle past its allowance that is still lonely is re-anchored where it
-    /// is instead (see [`Neighbours::reanchor`]), which costs one pass over the particles
+    /// is instead (see `Neighbours::reanchor`), which costs one pass over the particles
     /// rather than a rebuild.
     pub fn stale(&mut self, x: &[DVec3], radius: &[f64], faces: &[Face], mesh_drift: f64) -> bool {
         if x.len() != self.x_at_build.len() || mesh_drift >= 0.5 * self.skin {
@@ -1032,7 +1032,7 @@ impl Neighbours {
     /// neighbours in space are neighbours in memory; the springs of touching pairs are
     /// carried to their slots in the new lists (keyed by the particles' new storage
     /// indices, so that carrying them runs in spatial order too), and the lists are built
-    /// from the positions (see [`Neighbours::build`]).
+    /// from the positions (see `Neighbours::build`).
     pub fn rebuild(&mut self, particles: &mut Particles, faces: &[Face], face_grid: &CellGrid) {
         self.rebuild_without(particles, &[], faces, face_grid);
     }

@@ -14,9 +14,9 @@ pub struct Particles {
     pub id: Vec<u32>,
     /// The id the next particle created gets.
     pub next_id: u32,
-    /// R [L]
+    /// R \[L\]
     pub radius: Vec<f64>,
-    /// x [L]
+    /// x \[L\]
     pub x: Vec<DVec3>,
     /// v [L/T]
     pub v: Vec<DVec3>,

@@ -6,7 +6,7 @@ use image::{Rgb, RgbImage};
 
 use crate::text::{self, put};
 
-/// The axis titles of a plot, units included ("time [s]", "kinetic_energy [J]").
+/// The axis titles of a plot, units included (`time [s]`, `kinetic_energy [J]`).
 #[derive(Clone, Debug)]
 pub struct Axes<'a> {
     pub x: &'a str,

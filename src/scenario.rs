@@ -64,18 +64,18 @@ pub enum MeshSource {
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Geometry {
-    /// R_min [L]
+    /// R_min \[L\]
     pub radius_min: f64,
-    /// R_max [L]
+    /// R_max \[L\]
     pub radius_max: f64,
     pub mesh: MeshSource,
-    /// R_mesh [L], selected per face by the OFF colour index.
+    /// R_mesh \[L\], selected per face by the OFF colour index.
     pub mesh_radii: Vec<f64>,
     /// Contacts with the main mesh: merged per surface, or one per face.
     pub mesh_contacts: Contacts,
     /// The material of the main mesh's faces.
     pub mesh_material: u16,
-    /// s_min, s_max [L]: the spawn box.
+    /// s_min, s_max \[L\]: the spawn box.
     pub spawn_min: DVec3,
     pub spawn_max: DVec3,
 }
@@ -113,7 +113,7 @@ pub struct Kinetics {
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Simulation {
-    /// Δt [T]
+    /// Δt \[T\]
     pub timestep: f64,
     /// N_max
     pub max_particles: u64,
@@ -245,7 +245,7 @@ pub struct SpawnRegion {
     pub count: Option<u64>,
     /// Particles per second (None: as fast as `spawn_attempts` per step allow).
     pub rate: Option<f64>,
-    /// When it is active [s], from `start` until `stop`.
+    /// When it is active \[s\], from `start` until `stop`.
     pub start: f64,
     pub stop: f64,
     pub radius: RadiusDistribution,

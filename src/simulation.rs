@@ -253,7 +253,7 @@ impl Stage {
     }
 }
 
-/// Wall time spent in each stage of the step so far [s].
+/// Wall time spent in each stage of the step so far \[s\].
 #[derive(Clone, Debug, Default)]
 pub struct StageTimes {
     seconds: [f64; Stage::ALL.len()],
@@ -410,7 +410,7 @@ impl std::error::Error for Unstable {}
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Outflow {
     pub count: u64,
-    /// [M]
+    /// \[M\]
     pub mass: f64,
 }
 
@@ -493,10 +493,10 @@ pub struct ContactRecord {
     pub with: Partner,
     /// Where the two touch: x_i - r_i n (Eq. 29).
     pub point: DVec3,
-    /// The force on particle `id`: its normal and tangential parts [N].
+    /// The force on particle `id`: its normal and tangential parts \[N\].
     pub f_n: DVec3,
     pub f_t: DVec3,
-    /// δ [L]
+    /// δ \[L\]
     pub overlap: f64,
 }
 
@@ -504,7 +504,7 @@ pub struct ContactRecord {
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Thermo {
     pub particles: usize,
-    /// Kinetic energy, translational and rotational [J], and its rotational part.
+    /// Kinetic energy, translational and rotational \[J\], and its rotational part.
     pub kinetic_energy: f64,
     pub rotational_energy: f64,
     /// Touching particle pairs and particle-face contacts in the last step.
@@ -584,7 +584,7 @@ pub struct Simulation {
     mesh_drift: f64,
     /// Step of the last neighbour-list rebuild.
     pub(crate) built_at: u64,
-    /// Simulated time [T] and number of steps taken.
+    /// Simulated time \[T\] and number of steps taken.
     pub time: f64,
     pub steps: u64,
     /// Wall time per stage.

@@ -7,7 +7,7 @@ use image::{Rgb, RgbImage};
 /// Width of a glyph cell at scale 1 [px] (the font's 8, less the blank column most glyphs
 /// end with, so that text does not look spaced out).
 const ADVANCE: i64 = 7;
-/// Height of a line at scale 1 [px].
+/// Height of a line at scale 1 \[px\].
 pub const LINE: i64 = 8;
 
 fn glyph(c: char) -> [u8; 8] {
@@ -18,7 +18,7 @@ fn glyph(c: char) -> [u8; 8] {
         .unwrap_or([0; 8])
 }
 
-/// The width of `s` at `scale` [px].
+/// The width of `s` at `scale` \[px\].
 pub fn width(s: &str, scale: u32) -> i64 {
     s.chars().count() as i64 * ADVANCE * scale as i64
 }

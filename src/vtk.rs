@@ -254,7 +254,7 @@ pub fn write_mesh(path: &Path, mesh: &Mesh) -> Result<()> {
 
 /// Writes the contact network as `.vtp` lines: particle centre to particle centre for a
 /// pair, centre to contact point for a face, with the cell arrays `normal_force` and
-/// `tangential_force` (magnitudes [N]), `overlap` [m] and `face` (-1 for pairs).
+/// `tangential_force` (magnitudes \[N\]), `overlap` \[m\] and `face` (-1 for pairs).
 pub fn write_contacts(path: &Path, p: &Particles, contacts: &[ContactRecord]) -> Result<()> {
     use Section::*;
     let mut at = vec![u32::MAX; p.next_id as usize];
