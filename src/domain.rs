@@ -584,9 +584,10 @@ impl Simulation {
                 (a.len() == self.particles.len()).then(|| a.to_vec())
             }
         };
-        let (anchors_missing, restore_clock) = (anchors.is_none(), anchors.is_some());
+        // Carried along with the particles, if any.
+        let carry = anchors.is_some();
         let clock = (self.steps, self.time);
-        if anchors.is_some() {
+        if carry {
             self.steps = self.built_at;
             self.time = self.built_at as f64 * self.scenario.simulation.timestep;
             self.slide_images();
@@ -607,9 +608,7 @@ impl Simulation {
         self.neighbours.clear_lists();
         let old = std::mem::take(&mut self.particles);
         let p = &old;
-        // Where each particle is placed: at its anchor (which it carries along), or where
-        // it is now.
-        let carry = anchors.is_some();
+        // Where each particle is placed: at its anchor, or where it is now.
         let place: std::borrow::Cow<[DVec3]> = match anchors {
             Some(a) => a.into(),
             None => p.x.as_slice().into(),
@@ -797,7 +796,7 @@ impl Simulation {
             &self.mesh.faces,
             &self.face_grid,
         );
-        if placement == Placement::Anchors && anchors_missing {
+        if placement == Placement::Anchors && !carry {
             // Never built in one process: stale at the first step, as there.
             self.neighbours.forget_anchors();
         }
@@ -818,7 +817,7 @@ impl Simulation {
         d.owned = owned;
         self.domain = Some(d);
         self.built();
-        if restore_clock {
+        if carry {
             (self.steps, self.time) = clock;
             self.move_meshes();
         }
@@ -896,17 +895,18 @@ impl Simulation {
         // In a periodic domain, also the particles whose images are near (the spawner sees
         // them through the sides).
         let periodic = self.spawner.periodic;
-        let near = |x: DVec3| match periodic {
+        let mut images = Vec::new();
+        let mut near = |x: DVec3| match periodic {
             None => in_reach(x),
             Some(periodic) => {
                 let x = periodic.wrap(x);
-                let mut images = Vec::new();
                 periodic.image_shifts(x, margin.x, &mut images);
                 in_reach(x) || images.iter().any(|&(s, _)| in_reach(x + s))
             }
         };
+        let picked: Vec<bool> = (0..p.len()).map(|i| d.owned[i] && near(p.x[i])).collect();
         let old_next = p.next_id;
-        let mut around = gather_by_id(&*d.comm, p, |i| d.owned[i] && near(p.x[i]));
+        let mut around = gather_by_id(&*d.comm, p, |i| picked[i]);
         self.spawner.spawn(
             s,
             &mut around,

@@ -611,25 +611,30 @@ impl History {
         pairs: bool,
         skip_absent: bool,
     ) -> Result<History, String> {
-        let at = |id: u32| match index.get(id as usize) {
-            Some(&k) if k != NONE => Ok(Some(k)),
-            _ if skip_absent => Ok(None),
-            _ => Err(format!(
-                "contact of particle id {id}, which the checkpoint lacks"
-            )),
-        };
-        let mut keyed = Vec::with_capacity(entries.len());
-        for &(a, b, s) in entries {
-            let Some(a) = at(a)? else { continue };
-            if pairs {
-                let Some(b) = at(b)? else { continue };
-                keyed.push((a.min(b), a.max(b), s));
-            } else {
-                keyed.push((a, b, s));
+        let at = |id: u32| index.get(id as usize).copied().filter(|&k| k != NONE);
+        if !skip_absent {
+            let named = |e: &(u32, u32, Springs)| [Some(e.0), pairs.then_some(e.1)];
+            if let Some(id) = entries
+                .iter()
+                .flat_map(named)
+                .flatten()
+                .find(|&id| at(id).is_none())
+            {
+                return Err(format!(
+                    "contact of particle id {id}, which the checkpoint lacks"
+                ));
             }
         }
         Ok(History::from_visits(n, |f| {
-            keyed.iter().for_each(|&(a, o, s)| f(a, o, s))
+            for &(a, b, s) in entries {
+                let Some(a) = at(a) else { continue };
+                if pairs {
+                    let Some(b) = at(b) else { continue };
+                    f(a.min(b), a.max(b), s);
+                } else {
+                    f(a, b, s);
+                }
+            }
         }))
     }
 
@@ -1576,6 +1581,28 @@ mod tests {
             assert_eq!(p.x[k], x[p.id[k] as usize]);
         }
         assert!(nb.pairs.pieces.len() > 3, "{:?}", nb.pairs.pieces);
+    }
+
+    /// A checkpoint's springs naming a particle it lacks are refused with the id; a split
+    /// run's history leaves out the springs of particles another process holds.
+    #[test]
+    fn histories_by_id_name_or_skip_the_particles_absent() {
+        let x = vec![DVec3::ZERO, DVec3::X, DVec3::Y];
+        let p = particles(&x, &[0.1; 3]);
+        let s = |u_t: f64| Springs {
+            u_t,
+            ..Springs::default()
+        };
+        let entries = [(0, 2, s(1.0)), (1, 7, s(2.0)), (2, 1, s(3.0))];
+        let err = History::in_storage(&p, &entries, true).unwrap_err();
+        assert!(err.contains("id 7"), "{err}");
+        let index = storage_index(&p);
+        let h = History::of_present(&index, p.len(), &entries, true);
+        assert_eq!(
+            h.entries(),
+            vec![(0, 2, s(1.0)), (1, 2, s(3.0))],
+            "the pair with 7 left out, the others keyed low to high"
+        );
     }
 
     #[test]
