@@ -2,12 +2,13 @@
 """The default hourglass run over many spawning seeds (issue 10's measurement; not a test).
 
 For each seed it runs the paper's default simulation (Table 2, the built-in hourglass) with
-`[simulation] seed = N` and the mesh-contact mode asked for, and reports whether the run
+`[simulation] seed = N`, the mesh-contact mode and the friction springs' order asked for, and reports whether the run
 completed, how many pairs overlapped past the smaller radius (warnings), and the share of
 grains below the throat (z < 0.15 m) at frame 20 (t = 0.6 s) and at the last frame.
 
     python3 bench/seeds.py --seeds 1-100 --mode merged --jobs 2
     python3 bench/seeds.py --seeds 1-20 --mode per_face --binary /tmp/old/tinydem
+    python3 bench/seeds.py --seeds 1-20 --springs paper
 
 Standard library only. Each run uses one thread; --jobs runs that many at once.
 """
@@ -40,7 +41,7 @@ def share_below(path):
     return sum(1 for v in z if v < THROAT) / len(z) if z else float("nan")
 
 
-def run(binary, mode, seed, frames):
+def run(binary, mode, springs, seed, frames):
     with tempfile.TemporaryDirectory() as tmp:
         scenario = os.path.join(tmp, "s.toml")
         with open(scenario, "w") as f:
@@ -49,6 +50,7 @@ def run(binary, mode, seed, frames):
                 f"mesh_radii = [0.002, 0.02, 0.01]\n"
                 + (f'mesh_contacts = "{mode}"\n' if mode else "")
                 + f"[simulation]\nseed = {seed}\nframes = {frames}\n"
+                + (f'friction_springs = "{springs}"\n' if springs else "")
             )
         out = os.path.join(tmp, "out")
         p = subprocess.run(
@@ -73,12 +75,14 @@ def main():
     ap.add_argument("--seeds", default="1-20", help="e.g. 1-100 or 1,5,58")
     ap.add_argument("--mode", choices=["merged", "per_face", ""], default="merged",
                     help="mesh_contacts ('' writes no key, for builds that predate it)")
+    ap.add_argument("--springs", choices=["advance_first", "paper", ""], default="",
+                    help="friction_springs ('' writes no key: the build's default)")
     ap.add_argument("--binary", default=os.path.join(ROOT, "target", "release", "tinydem"))
     ap.add_argument("--frames", type=int, default=100)
     ap.add_argument("--jobs", type=int, default=2)
     a = ap.parse_args()
     with concurrent.futures.ThreadPoolExecutor(a.jobs) as pool:
-        rows = list(pool.map(lambda s: run(a.binary, a.mode, s, a.frames), seeds(a.seeds)))
+        rows = list(pool.map(lambda s: run(a.binary, a.mode, a.springs, s, a.frames), seeds(a.seeds)))
     print("seed completed warnings frame20_below final_below")
     for r in rows:
         print(f"{r['seed']:4d} {str(r['completed']):9s} {r['warnings']:8d} {r['frame20']:14.3f} "
@@ -86,7 +90,7 @@ def main():
     done = [r for r in rows if r["completed"]]
     stat = lambda k: (statistics.mean(r[k] for r in done), statistics.stdev(r[k] for r in done)
                       if len(done) > 1 else 0.0)
-    print(f"mode {a.mode or '(none)'}: {len(done)} of {len(rows)} runs completed; "
+    print(f"mode {a.mode or '(none)'}, springs {a.springs or '(default)'}: {len(done)} of {len(rows)} runs completed; "
           f"{sum(r['warnings'] for r in rows)} pairs warned of in "
           f"{sum(1 for r in rows if r['warnings'])} runs")
     if done:

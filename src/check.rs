@@ -13,7 +13,7 @@ use crate::contact::ContactLaw;
 use crate::integrate::Inertia;
 use crate::mesh::Contacts;
 use crate::run::{OUTLETS, WALLS};
-use crate::scenario::Scenario;
+use crate::scenario::{FrictionSprings, Scenario};
 use crate::simulation::Simulation;
 
 /// The derived quantities `tinydem check` prints.
@@ -27,7 +27,7 @@ fn describe_start(s: &Scenario, out: &Path, sim: Simulation) -> Result<String> {
     let g = &s.geometry;
     let m = &s.material;
     let dt = s.simulation.timestep;
-    let law = ContactLaw::new(m, dt);
+    let law = ContactLaw::new(m, dt, s.simulation.friction_springs);
     let densities = s.materials.iter().map(|m| m.properties.density);
     let m_min = Inertia::mass(
         g.radius_min,
@@ -173,6 +173,7 @@ fn describe_start(s: &Scenario, out: &Path, sim: Simulation) -> Result<String> {
          {bounds}\
          initial particles      {}\n\
          time step              {dt:.6e} s ({:.3} x Eq. 50)\n\
+         friction springs       {}\n\
          particle mass          {m_min:.6e} .. {m_max:.6e} kg\n\
          stiffness k_n at 10%   {k_10:.6e} N/m (two R_min particles, delta = 0.1 R_min)\n\
          half contact period    {period:.6e} s = {:.1} time steps\n\
@@ -182,6 +183,11 @@ fn describe_start(s: &Scenario, out: &Path, sim: Simulation) -> Result<String> {
          {}",
         sim.particles.len(),
         dt / default_dt,
+        match s.simulation.friction_springs {
+            FrictionSprings::AdvanceFirst => "advance_first (advanced, then their force taken)",
+            FrictionSprings::Paper =>
+                "paper (the force of the previous step's spring, Eqs. 53-55; the original program's)",
+        },
         period / dt,
         s.total_time(),
         s.simulation.frames,

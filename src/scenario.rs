@@ -7,7 +7,8 @@
 //! [material]   density, youngs_modulus, poisson_ratio, restitution, friction_sliding,
 //!              friction_rolling, friction_twisting, cohesion, viscosity
 //! [kinetics]   initial_velocity, initial_angular_velocity, gravity
-//! [simulation] timestep, max_particles, frames, steps_per_frame, spawn_attempts, seed, skin
+//! [simulation] timestep, max_particles, frames, steps_per_frame, spawn_attempts, seed, skin,
+//!              friction_springs = "advance_first" | "paper"
 //! [[meshes]]   file, radii, contacts, motion = { type = "harmonic", amplitude, frequency, direction,
 //!              phase } | { type = "velocity", velocity } | { type = "rotation", center, axis,
 //!              angular_velocity }   (any number of these)
@@ -129,6 +130,30 @@ pub struct Simulation {
     /// skin and are rebuilt when a particle has moved half of it. It sets how often the
     /// lists are rebuilt, and so the speed, not the result.
     pub skin: f64,
+    /// The order of the friction springs' update, Sec. 2.3.
+    pub friction_springs: FrictionSprings,
+}
+
+/// When a friction spring is advanced by Δt v relative to the force taken from it
+/// (`[simulation] friction_springs`; the derivation is at `coulomb_spring` in `contact.rs`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum FrictionSprings {
+    /// Advance the spring, then take its force: symplectic, creates no energy (the default).
+    #[default]
+    AdvanceFirst,
+    /// The paper's Eqs. (53)-(55): the force of the previous step's spring, then advance.
+    /// It creates energy at Eq. (50)'s time step; the original program's order.
+    Paper,
+}
+
+impl FrictionSprings {
+    /// The value of the scenario key.
+    pub fn key(self) -> &'static str {
+        match self {
+            FrictionSprings::AdvanceFirst => "advance_first",
+            FrictionSprings::Paper => "paper",
+        }
+    }
 }
 
 impl Simulation {
@@ -636,6 +661,7 @@ struct RawSimulation {
     spawn_attempts: Option<u64>,
     seed: Option<u64>,
     skin: Option<f64>,
+    friction_springs: Option<String>,
 }
 
 #[derive(Deserialize, Default)]
@@ -927,6 +953,17 @@ fn contacts(key: &str, value: Option<String>) -> Result<Contacts> {
     }
 }
 
+/// The value of `[simulation] friction_springs` (default "advance_first").
+fn friction_springs(value: Option<String>) -> Result<FrictionSprings> {
+    match value.as_deref() {
+        None | Some("advance_first") => Ok(FrictionSprings::AdvanceFirst),
+        Some("paper") => Ok(FrictionSprings::Paper),
+        Some(other) => bail!(
+            "[simulation] friction_springs = \"{other}\" is not allowed: it must be \"advance_first\" (advance the spring, then take its force: no energy created) or \"paper\" (the paper's Eqs. 53-55 in their order, as the original program)"
+        ),
+    }
+}
+
 /// Validates one `[[meshes]]` entry.
 fn mesh_spec(k: usize, m: RawMesh, base: &Path) -> Result<MeshSpec> {
     let key = |name: &str| format!("[[meshes]] #{} {name}", k + 1);
@@ -1183,6 +1220,7 @@ impl Scenario {
             spawn_attempts: s.spawn_attempts.unwrap_or(100),
             seed: s.seed.unwrap_or(1),
             skin: check("[simulation] skin", s.skin.unwrap_or(0.5), Range::Positive)?,
+            friction_springs: friction_springs(s.friction_springs)?,
         };
         if simulation.spawn_attempts > 1_000_000_000 {
             bail!(
@@ -1482,6 +1520,7 @@ impl Scenario {
             let _ = writeln!(o, "{key} = {n}");
         }
         let _ = writeln!(o, "skin = {}", f(s.skin));
+        let _ = writeln!(o, "friction_springs = {}", text(s.friction_springs.key()));
         for mesh in &self.meshes {
             o += "\n[[meshes]]\n";
             let _ = writeln!(o, "file = {}", path(&mesh.file));

@@ -184,9 +184,25 @@ fn check_prints_derived_quantities() {
         "stiffness",
         "total simulated time",
         "output",
+        "friction springs       advance_first",
     ] {
         assert!(out.contains(key), "missing {key} in\n{out}");
     }
+}
+
+#[test]
+fn check_says_the_order_of_the_friction_springs() {
+    let t = tempfile::tempdir().unwrap();
+    write(
+        t.path(),
+        "s.toml",
+        "[simulation]\nframes = 1\nfriction_springs = \"paper\"\n",
+    );
+    let o = tinydem(&["check", "s.toml"], t.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    let line = "friction springs       paper (the force of the previous step's spring";
+    assert!(out.contains(line), "missing {line} in\n{out}");
 }
 
 #[test]

@@ -258,9 +258,13 @@ fn a_sphere_rolling_over_a_convex_ridge_feels_one_contact_and_no_kick() {
         "merged: {most} contact, upward {up} m/s^2, jump {jump} m/s^2; per face: {most_per_face}, upward {up_per_face}"
     );
     assert_eq!(most, 1);
-    assert!(up <= 1e-9 * G, "kicked up at {up} m/s^2");
-    // The rolling sphere's tangential spring oscillates by about 0.9 m/s^2 step to step on
-    // a flat plate too; the crossing adds no jump beyond it.
+    // Where the sphere has rolled round the edge onto the slope its path straightens, the
+    // load grows by m v^2 / R and the springs ring: 0.18 m/s^2 up for a few steps (the
+    // springs advanced first; none in the paper's order). The edge's own kick, per face, is
+    // ten times that.
+    assert!(up <= 0.05 * G, "kicked up at {up} m/s^2");
+    // The crossing changes the acceleration smoothly: by at most 0.48 m/s^2 from one step
+    // to the next (measured; 0.9 m/s^2 with the paper's order of the springs).
     assert!(jump < 0.1 * G, "acceleration jumps by {jump} m/s^2");
     // Per face, the edge is a second contact that pushes the sphere up.
     assert_eq!(most_per_face, 2);

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use tinydem::mesh::Contacts;
-use tinydem::scenario::Scenario;
+use tinydem::scenario::{FrictionSprings, Scenario};
 use tinydem::simulation::Simulation;
 
 fn files(kind: &str) -> Vec<PathBuf> {
@@ -44,6 +44,7 @@ fn full_scenario_sets_every_key() {
     assert_eq!(s.particles, Some(dir.join("two.csv")));
     assert_eq!(s.output_dir, dir.join("out"));
     assert_eq!(s.geometry.mesh_contacts, Contacts::PerFace);
+    assert_eq!(s.simulation.friction_springs, FrictionSprings::Paper);
     assert_eq!(s.meshes[0].contacts, Contacts::Merged);
     assert_eq!(s.domain.unwrap().max, glam::DVec3::splat(0.5));
     assert_eq!(s.outlets.len(), 1);
