@@ -5,7 +5,7 @@
 
 mod common;
 
-use glam::{DQuat, DVec3};
+use glam::DVec3;
 use tinydem::integrate::Inertia;
 use tinydem::mesh::Mesh;
 use tinydem::particles::{Particle, Particles};
@@ -42,15 +42,7 @@ enum Mode {
 }
 
 fn particle(x: DVec3, v: DVec3, w: DVec3) -> Particle {
-    Particle {
-        x,
-        radius: R,
-        v,
-        q: DQuat::IDENTITY,
-        w,
-        tag: 0,
-        material: 0,
-    }
+    common::sphere(R, x, v, w)
 }
 
 /// A simulation of `particles` with the `[material]` lines `material`, the time step

@@ -4,7 +4,7 @@
 
 mod common;
 
-use glam::{DQuat, DVec3};
+use glam::DVec3;
 use tinydem::integrate::Inertia;
 use tinydem::mesh::{Contacts, Mesh};
 use tinydem::particles::{Particle, Particles};
@@ -33,15 +33,7 @@ fn sim(material: &str, g: DVec3, off: &str, contacts: Contacts, p: Particle) -> 
 }
 
 fn sphere(x: DVec3, v: DVec3, w: DVec3) -> Particle {
-    Particle {
-        x,
-        radius: R,
-        v,
-        q: DQuat::IDENTITY,
-        w,
-        tag: 0,
-        material: 0,
-    }
+    common::sphere(R, x, v, w)
 }
 
 /// Overlap of a sphere of radius `R` pressed onto a flat rigid wall with force `f`: Hertz,

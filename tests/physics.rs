@@ -17,15 +17,7 @@ const E: f64 = 1e6;
 const NU: f64 = 0.3;
 
 fn particle(x: DVec3, v: DVec3, w: DVec3) -> Particle {
-    Particle {
-        x,
-        radius: R,
-        v,
-        q: DQuat::IDENTITY,
-        w,
-        tag: 0,
-        material: 0,
-    }
+    common::sphere(R, x, v, w)
 }
 
 /// A simulation of `particles` with material keys `material` (TOML lines), gravity `g`

@@ -4,6 +4,8 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+use glam::{DQuat, DVec3};
+use tinydem::particles::Particle;
 use tinydem::scenario::Scenario;
 use tinydem::simulation::Simulation;
 
@@ -16,6 +18,20 @@ pub fn data(path: &str) -> PathBuf {
 /// A scenario from TOML text; relative paths resolve against `tests/data`.
 pub fn scenario(text: &str) -> Scenario {
     Scenario::parse(text, &data("inline.toml")).expect("valid test scenario")
+}
+
+/// A sphere of radius `radius` at `x` with velocity `v` and spin `w`, unrotated, tag and
+/// material 0.
+pub fn sphere(radius: f64, x: DVec3, v: DVec3, w: DVec3) -> Particle {
+    Particle {
+        x,
+        radius,
+        v,
+        q: DQuat::IDENTITY,
+        w,
+        tag: 0,
+        material: 0,
+    }
 }
 
 /// Runs `steps` steps of a scenario given as TOML text.
