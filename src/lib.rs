@@ -15,6 +15,7 @@ pub mod exact;
 pub mod geometry;
 pub mod integrate;
 pub mod lanes;
+pub mod lock;
 pub mod mesh;
 pub mod motion;
 pub mod neighbours;

@@ -11,6 +11,7 @@ use anyhow::{Context, Result};
 use crate::checkpoint;
 use crate::comm::Comm;
 use crate::csv::{Extra, frame_name, write_frame};
+use crate::lock::Lock;
 use crate::scenario::{Formats, Scenario};
 use crate::simulation::{Simulation, StageTimes, Thermo};
 
@@ -168,11 +169,13 @@ impl Frames<'_> {
     }
 }
 
-/// Fails early, before simulating, if the output directory cannot be written, and removes
-/// temporary files a killed run may have left.
-fn prepare_output(dir: &Path) -> Result<()> {
+/// Takes the output directory (creating it): its lock first, so that a refused run
+/// changes nothing there; then removes temporary files a killed run may have left and fails
+/// early, before simulating, if the directory cannot be written.
+fn take_output(dir: &Path) -> Result<Lock> {
     std::fs::create_dir_all(dir)
         .with_context(|| format!("cannot create output directory {}", dir.display()))?;
+    let lock = Lock::take(dir)?;
     if let Ok(entries) = std::fs::read_dir(dir) {
         for e in entries.flatten() {
             let name = e.file_name();
@@ -186,55 +189,7 @@ fn prepare_output(dir: &Path) -> Result<()> {
     std::fs::write(&probe, b"")
         .with_context(|| format!("output directory {} is not writable", dir.display()))?;
     let _ = std::fs::remove_file(&probe);
-    Ok(())
-}
-
-/// The name of the lock file a running run keeps in its output directory.
-pub const LOCK: &str = ".tinydem.lock";
-
-/// A run's claim on its output directory: a lock file with its process id, removed when
-/// the run ends (a lock whose process is gone, after a kill, is taken over).
-struct Lock(PathBuf);
-
-impl Lock {
-    fn take(dir: &Path) -> Result<Lock> {
-        let path = dir.join(LOCK);
-        for _ in 0..2 {
-            match std::fs::OpenOptions::new()
-                .write(true)
-                .create_new(true)
-                .open(&path)
-            {
-                Ok(mut f) => {
-                    use std::io::Write;
-                    let _ = writeln!(f, "{}", std::process::id());
-                    return Ok(Lock(path));
-                }
-                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
-                    let pid = std::fs::read_to_string(&path).unwrap_or_default();
-                    let pid = pid.trim();
-                    let alive = !pid.is_empty() && Path::new("/proc").join(pid).exists();
-                    if alive && pid != std::process::id().to_string() {
-                        anyhow::bail!(
-                            "another tinydem run (process {pid}) is writing into {}: wait for it, or choose another directory with --output",
-                            dir.display()
-                        );
-                    }
-                    let _ = std::fs::remove_file(&path); // left by a run that was killed
-                }
-                Err(e) => {
-                    return Err(e).with_context(|| format!("cannot create {}", path.display()));
-                }
-            }
-        }
-        anyhow::bail!("cannot take the lock {}", path.display())
-    }
-}
-
-impl Drop for Lock {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_file(&self.0);
-    }
+    Ok(lock)
 }
 
 /// Whether a file name is output a run writes (frames, logs, checkpoints, its scenario).
@@ -351,8 +306,7 @@ pub fn run_on(
     let _lock = sim.agree(
         writer
             .then(|| -> Result<Lock> {
-                prepare_output(output_dir)?;
-                let lock = Lock::take(output_dir)?;
+                let lock = take_output(output_dir)?;
                 if options.resume.is_none() {
                     claim_output(output_dir, options.overwrite)?;
                 }

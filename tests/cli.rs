@@ -713,17 +713,122 @@ fn output_of_another_run_is_not_mixed_in() {
         !out.join(".tinydem.lock").exists(),
         "the lock goes with the run"
     );
-    // A live process holds the directory (this test's own), then a dead one.
-    std::fs::write(
-        out.join(".tinydem.lock"),
-        format!("{}\n", std::process::id()),
+    // A live process holds the directory (this test, with the lock), then nobody: the file
+    // left by a killed run names a process that lives (this test's, a reused id) or not.
+    let held = tinydem::lock::Lock::take(&out).unwrap();
+    let o = tinydem(&["run", "short.toml", "-q", "--overwrite"], t.path());
+    fails_with(&o, &["another tinydem run (process", "is writing into"]);
+    drop(held);
+    for pid in [std::process::id(), 999_999_999] {
+        std::fs::write(out.join(".tinydem.lock"), format!("{pid}\n")).unwrap();
+        let o = tinydem(&["run", "short.toml", "-q", "--overwrite"], t.path());
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+}
+
+/// A run of 300 grains for `frames` frames of 100 steps (about 0.1 s a frame).
+fn busy_scenario(frames: u32) -> String {
+    format!(
+        "[geometry]\nspawn_min = [-0.05, -0.05, 0.0]\nspawn_max = [0.05, 0.05, 0.3]\n\
+         [simulation]\nmax_particles = 300\nframes = {frames}\nsteps_per_frame = 100\n"
     )
-    .unwrap();
-    let o = tinydem(&["run", "short.toml", "-q", "--overwrite"], t.path());
-    fails_with(&o, &["another tinydem run", "is writing into"]);
-    std::fs::write(out.join(".tinydem.lock"), "999999999\n").unwrap();
-    let o = tinydem(&["run", "short.toml", "-q", "--overwrite"], t.path());
+}
+
+/// Frame files of a directory and their bytes.
+fn frames_of(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut files: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().to_string())
+        .filter(|n| n.starts_with("particles"))
+        .map(|n| (n.clone(), std::fs::read(dir.join(&n)).unwrap()))
+        .collect();
+    files.sort();
+    files
+}
+
+/// Runs refused by the lock, one after another beside a running run, harm it in nothing:
+/// it completes with the frames of a run alone (they used to clear its temporary files).
+#[test]
+fn refused_runs_beside_a_running_one_leave_it_whole() {
+    let t = tempfile::tempdir().unwrap();
+    write(t.path(), "s.toml", &busy_scenario(30));
+    let o = tinydem(&["run", "s.toml", "-q", "-o", "alone"], t.path());
     assert!(o.status.success(), "{}", stderr(&o));
+    let mut first = std::process::Command::new(env!("CARGO_BIN_EXE_tinydem"))
+        .args(["run", "s.toml", "-q", "-o", "same"])
+        .current_dir(t.path())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let started = std::time::Instant::now();
+    while !t.path().join("same/.tinydem.lock").exists() {
+        assert!(
+            started.elapsed().as_secs() < 30,
+            "the first run does not start"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    let mut refused = 0;
+    while first.try_wait().unwrap().is_none() {
+        let o = tinydem(
+            &["run", "s.toml", "-q", "-o", "same", "--overwrite"],
+            t.path(),
+        );
+        if o.status.success() {
+            break; // started after the first had ended
+        }
+        fails_with(&o, &["another tinydem run"]);
+        refused += 1;
+    }
+    let status = first.wait().unwrap();
+    assert!(
+        status.success(),
+        "the first run failed beside {refused} refused ones"
+    );
+    assert!(refused >= 5, "only {refused} runs were refused");
+    assert!(
+        frames_of(&t.path().join("same")) == frames_of(&t.path().join("alone")),
+        "the frames differ from a run alone"
+    );
+}
+
+/// Two runs started together into one fresh directory: one runs, the other is refused,
+/// and the one that runs writes the frames of a run alone.
+#[test]
+fn of_two_runs_started_together_exactly_one_runs() {
+    let t = tempfile::tempdir().unwrap();
+    write(t.path(), "s.toml", &busy_scenario(3));
+    let o = tinydem(&["run", "s.toml", "-q", "-o", "alone"], t.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let alone = frames_of(&t.path().join("alone"));
+    for k in 0..20 {
+        let dir = format!("together{k}");
+        let start = || {
+            std::process::Command::new(env!("CARGO_BIN_EXE_tinydem"))
+                .args(["run", "s.toml", "-q", "-o", &dir])
+                .current_dir(t.path())
+                .stderr(std::process::Stdio::piped())
+                .spawn()
+                .unwrap()
+        };
+        let (a, b) = (start(), start());
+        let outputs = [a.wait_with_output().unwrap(), b.wait_with_output().unwrap()];
+        let ran = outputs.iter().filter(|o| o.status.success()).count();
+        for o in outputs.iter().filter(|o| !o.status.success()) {
+            let err = stderr(o);
+            assert!(
+                err.contains("another tinydem run")
+                    || err.contains("holds the output of an earlier run"),
+                "try {k}: {err}"
+            );
+        }
+        assert_eq!(ran, 1, "try {k}");
+        assert!(
+            frames_of(&t.path().join(&dir)) == alone,
+            "try {k}: frames differ"
+        );
+    }
 }
 
 /// `log.csv` carries what the status line shows, frame by frame: the kinetic energy agrees
