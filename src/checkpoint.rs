@@ -23,7 +23,7 @@ use glam::{DQuat, DVec3};
 use crate::contact::Springs;
 use crate::mesh::Mesh;
 use crate::particles::{Particle, Particles};
-use crate::scenario::Scenario;
+use crate::scenario::{FrictionSprings, Scenario};
 use crate::simulation::{Outflow, Removed, Snapshot, Wrench};
 use crate::spawn::{RegionState, SpawnerState};
 
@@ -70,6 +70,12 @@ pub fn fingerprint(s: &Scenario, mesh: &Mesh) -> u64 {
         format!("{text}|cohesion {:?}", m.cohesion)
     } else {
         text
+    };
+    // The springs' order: checkpoints written before it was a choice are in the paper's,
+    // and resume in it only.
+    let text = match s.simulation.friction_springs {
+        FrictionSprings::Paper => text,
+        FrictionSprings::AdvanceFirst => format!("{text}|springs advance_first"),
     };
     // Named materials (absent from older checkpoints, which stay valid without them).
     let text = if s.uses_materials() {
@@ -487,8 +493,11 @@ mod tests {
 
     #[test]
     fn the_fingerprint_of_the_default_scenario_is_that_of_format_2() {
-        // As written by the build of 2026-12-02 (format 2), so its checkpoints resume.
-        let s = Scenario::default();
+        // As written by the build of 2026-12-02 (format 2), so its checkpoints resume in
+        // the order of the springs they were made with (the paper's); in the default order
+        // they are another scenario.
+        let mut s = Scenario::default();
+        s.simulation.friction_springs = crate::scenario::FrictionSprings::Paper;
         let mesh = crate::mesh::Mesh::parse_off(
             crate::scenario::HOURGLASS_OFF,
             "hourglass",
@@ -497,6 +506,8 @@ mod tests {
         .unwrap()
         .with_contacts(s.geometry.mesh_contacts);
         assert_eq!(fingerprint(&s, &mesh), FORMAT_2_DEFAULT);
+        let default = Scenario::default();
+        assert_ne!(fingerprint(&default, &mesh), FORMAT_2_DEFAULT);
     }
 
     #[test]

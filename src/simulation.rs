@@ -685,10 +685,14 @@ impl Simulation {
     /// Continues a run from a snapshot taken by [`Simulation::snapshot`] with the same
     /// scenario: the result is bitwise the same as if the run had not stopped.
     pub fn restore(scenario: Scenario, snapshot: Snapshot) -> Result<Simulation> {
+        let input = scenario.particles.clone();
         let mut sim = Simulation::new(Scenario {
             particles: None,
             ..scenario
         })?;
+        // The particles come from the snapshot; the scenario keeps its input file, so that
+        // its `run.toml` reruns the run.
+        sim.scenario.particles = input;
         let misfit = |what: String| anyhow::anyhow!("the checkpoint does not fit: {what}");
         let built = !snapshot.anchors.is_empty();
         if built && snapshot.anchors.len() != snapshot.particles.len() {

@@ -277,6 +277,31 @@ fn checkpoints_of_another_scenario_or_damaged_are_refused() {
         "{err}"
     );
 
+    // The other order of the friction springs is another scenario too (checkpoints from
+    // before the choice are in the paper's order and resume only in it).
+    let paper = std::fs::read_to_string(t.path().join("s.toml"))
+        .unwrap()
+        .replace(
+            "[simulation]\n",
+            "[simulation]\nfriction_springs = \"paper\"\n",
+        );
+    std::fs::write(t.path().join("paper.toml"), paper).unwrap();
+    let o = tinydem(
+        &[
+            "run",
+            "paper.toml",
+            "-q",
+            "--resume",
+            "output/checkpoint.bin",
+        ],
+        t.path(),
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("different scenario"),
+        "{err}"
+    );
+
     let mut bytes = std::fs::read(&ckpt).unwrap();
     let mid = bytes.len() / 2;
     bytes[mid] ^= 0xff;
@@ -288,6 +313,53 @@ fn checkpoints_of_another_scenario_or_damaged_are_refused() {
         "{err}"
     );
     assert!(!err.contains("panicked"));
+}
+
+/// The `run.toml` of a resumed run reruns its scenario: it keeps `[input] particles` (it
+/// lost them, and a rerun had no particles).
+#[test]
+fn the_run_toml_of_a_resumed_run_reruns_it() {
+    let t = tempfile::tempdir().unwrap();
+    let d = t.path();
+    std::fs::write(
+        d.join("two.csv"),
+        "x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz\n\
+         0,0,0.01,0.004,0,0,0,1,0,0,0,0,0,0\n0.0085,0,0.01,0.004,-0.1,0,0,1,0,0,0,0,0,0\n",
+    )
+    .unwrap();
+    std::fs::write(
+        d.join("s.toml"),
+        "[geometry]\nradius_min = 0.004\nradius_max = 0.004\n\
+         [kinetics]\ngravity = [0.0, 0.0, 0.0]\n\
+         [simulation]\nmax_particles = 0\nspawn_attempts = 0\nframes = 3\nsteps_per_frame = 50\n\
+         [input]\nparticles = \"two.csv\"\n[output]\ncheckpoint_every = 1\n",
+    )
+    .unwrap();
+    let run = |args: &[&str]| {
+        let o = tinydem(args, d);
+        assert!(
+            o.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    };
+    run(&["run", "s.toml", "-q", "-o", "first"]);
+    std::fs::copy(d.join("first/checkpoint.bin"), d.join("at_end.bin")).unwrap();
+    run(&[
+        "run",
+        "s.toml",
+        "-q",
+        "-o",
+        "first",
+        "--resume",
+        "at_end.bin",
+    ]);
+    let text = std::fs::read_to_string(d.join("first/run.toml")).unwrap();
+    assert!(text.contains("[input]\nparticles = "), "{text}");
+    run(&["run", "first/run.toml", "-q", "-o", "again"]);
+    let (first, again) = (frames_of(&d.join("first")), frames_of(&d.join("again")));
+    assert_eq!(first.len(), 4);
+    assert!(first == again, "the rerun differs");
 }
 
 #[test]
