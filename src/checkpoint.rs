@@ -251,6 +251,39 @@ impl Reader<'_> {
     }
 }
 
+/// The largest magnitude a coordinate of a checkpoint's state may have (SI units): far
+/// beyond any run, and small enough that its squares and products stay finite.
+const STATE_BOUND: f64 = 1e30;
+
+/// Checks the particles of a checkpoint as any input is checked: finite states within
+/// [`STATE_BOUND`], radii > 0, unit quaternions. A checksum only says the bytes are those
+/// written, not that what was written is a state.
+fn check_states(ids: &[u32], p: &Particles) -> Result<()> {
+    for (k, &id) in ids.iter().enumerate() {
+        let fields = [
+            ("position", p.x[k]),
+            ("velocity", p.v[k]),
+            ("angular velocity", p.w[k]),
+        ];
+        for (what, x) in fields {
+            if !x.is_finite() || x.abs().max_element() > STATE_BOUND {
+                bail!("corrupt checkpoint: particle {id} has the {what} {x}");
+            }
+        }
+        let r = p.radius[k];
+        if !(r > 0.0 && r < STATE_BOUND) {
+            bail!("corrupt checkpoint: particle {id} has the radius {r}");
+        }
+        let q = p.q[k];
+        if !q.is_finite() || (q.length() - 1.0).abs() > 1e-9 {
+            bail!(
+                "corrupt checkpoint: particle {id} has the orientation {q}, not a unit quaternion"
+            );
+        }
+    }
+    Ok(())
+}
+
 /// Decodes a checkpoint, checking magic, version, checksum and, if given, the fingerprint
 /// (a resume needs the scenario it was written with; a staged run does not).
 pub fn decode(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<Snapshot> {
@@ -314,6 +347,7 @@ pub fn decode(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<Snapsho
         0 => Vec::new(),
         _ => (0..n).map(|_| r.vec3()).collect::<Result<_>>()?,
     };
+    check_states(&ids, &particles)?;
     let mut sorted = ids.clone();
     sorted.sort_unstable();
     if sorted.windows(2).any(|w| w[0] == w[1]) || sorted.last().is_some_and(|&m| m >= next_id) {

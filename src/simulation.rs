@@ -698,6 +698,8 @@ impl Simulation {
         if built && snapshot.anchors.len() != snapshot.particles.len() {
             return Err(misfit("one anchor per particle".into()));
         }
+        check_materials(&snapshot.particles, &sim.scenario)
+            .map_err(|e| misfit(format!("{e:#}")))?;
         sim.particles = snapshot.particles;
         sim.spawner = Spawner::resume(sim.scenario.simulation.seed, snapshot.spawner);
         if snapshot.removed.outlets.len() > sim.removed.outlets.len() {

@@ -315,6 +315,63 @@ fn checkpoints_of_another_scenario_or_damaged_are_refused() {
     assert!(!err.contains("panicked"));
 }
 
+/// Checkpoints forged with a valid checksum but impossible content are refused on
+/// `--resume` with the field named, never a panic.
+#[test]
+fn forged_checkpoints_are_refused_by_their_content() {
+    let t = tempfile::tempdir().unwrap();
+    pile(t.path(), 1);
+    let o = tinydem(&["run", "s.toml", "-q"], t.path());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let bytes = std::fs::read(t.path().join("output/checkpoint.bin")).unwrap();
+    // The fingerprint follows the magic (12 bytes) and the version (4).
+    let fingerprint = u64::from_le_bytes(bytes[16..24].try_into().unwrap());
+    let good = checkpoint::decode(&bytes, Some(fingerprint)).unwrap();
+    assert!(good.particles.len() > 10);
+    type Forge = fn(&mut tinydem::particles::Particles);
+    let forgeries: [(Forge, &str); 5] = [
+        (
+            |p| p.material[0] = 7,
+            "has material 7, but the scenario has 1 material",
+        ),
+        (
+            |p| p.q[0] = glam::DQuat::from_xyzw(0.0, 0.0, 0.0, 0.0),
+            "not a unit quaternion",
+        ),
+        (|p| p.x[0].x = 1e300, "has the position"),
+        (|p| p.v[0].y = f64::NAN, "has the velocity"),
+        (|p| p.radius[0] = -0.004, "has the radius"),
+    ];
+    for (k, (forge, expected)) in forgeries.iter().enumerate() {
+        let mut snapshot = good.clone();
+        forge(&mut snapshot.particles);
+        let name = format!("forged{k}.bin");
+        std::fs::write(
+            t.path().join(&name),
+            checkpoint::encode(&snapshot, fingerprint),
+        )
+        .unwrap();
+        let o = tinydem(
+            &[
+                "run",
+                "s.toml",
+                "-q",
+                "-o",
+                &format!("out{k}"),
+                "--resume",
+                &name,
+            ],
+            t.path(),
+        );
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            !o.status.success() && err.contains(expected),
+            "{expected}: {err}"
+        );
+        assert!(!err.contains("panicked"), "{err}");
+    }
+}
+
 /// The `run.toml` of a resumed run reruns its scenario: it keeps `[input] particles` (it
 /// lost them, and a rerun had no particles).
 #[test]
