@@ -34,8 +34,27 @@ fn pool(threads: Option<usize>) -> PyResult<Arc<rayon::ThreadPool>> {
         .map_err(|e| PyRuntimeError::new_err(format!("cannot start the thread pool: {e}")))
 }
 
-/// Steps between checks for Ctrl-C while stepping.
-const SIGNAL_CHECK_STEPS: u64 = 200;
+/// Wall time between checks for Ctrl-C while stepping.
+const SIGNAL_CHECK: std::time::Duration = std::time::Duration::from_millis(100);
+
+/// A panic of the engine (a bug) as a RuntimeError, which `except Exception` catches,
+/// rather than PyO3's PanicException, which it does not.
+fn panic_error(payload: Box<dyn std::any::Any + Send>) -> PyErr {
+    let what = payload
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "a panic".to_string());
+    PyRuntimeError::new_err(format!(
+        "internal error of tinydem (a bug: please report it): {what}"
+    ))
+}
+
+/// Runs `f`, turning a panic into a RuntimeError.
+fn guarded<T>(f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(f))
+        .unwrap_or_else(|p| Err(panic_error(p)))
+}
 
 /// A simulation of a scenario file, stepped from Python.
 ///
@@ -111,30 +130,36 @@ impl Simulation {
         }
         let pool = pool(threads)?;
         let s = Scenario::load(&scenario).map_err(error)?;
-        let (sim, _) = pool
-            .install(|| tinydem::run::open(s, resume.as_deref(), from_checkpoint.as_deref()))
-            .map_err(error)?;
+        let (sim, _) = guarded(|| {
+            pool.install(|| tinydem::run::open(s, resume.as_deref(), from_checkpoint.as_deref()))
+                .map_err(error)
+        })?;
         Ok(Simulation { sim, pool })
     }
 
     /// Advances the simulation by `n` time steps (the GIL is released meanwhile; Ctrl-C
-    /// stops it between steps). Raises RuntimeError when the run becomes unstable.
+    /// stops it between steps, seen within 0.1 s). Raises RuntimeError when the run
+    /// becomes unstable.
     #[pyo3(signature = (n=1))]
     fn step(&mut self, py: Python<'_>, n: u64) -> PyResult<()> {
         let mut left = n;
         while left > 0 {
-            let chunk = left.min(SIGNAL_CHECK_STEPS);
             let (sim, pool) = (&mut self.sim, &self.pool);
-            py.detach(|| {
-                pool.install(|| {
-                    for _ in 0..chunk {
-                        sim.step()?;
-                    }
-                    Ok::<(), tinydem::simulation::Unstable>(())
+            let done = guarded(|| {
+                py.detach(|| {
+                    pool.install(|| {
+                        let start = std::time::Instant::now();
+                        let mut done = 0;
+                        while done < left && (done == 0 || start.elapsed() < SIGNAL_CHECK) {
+                            sim.step()?;
+                            done += 1;
+                        }
+                        Ok::<u64, tinydem::simulation::Unstable>(done)
+                    })
                 })
-            })
-            .map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
-            left -= chunk;
+                .map_err(|e| PyRuntimeError::new_err(e.to_string()))
+            })?;
+            left -= done;
             py.check_signals()?;
         }
         Ok(())
@@ -337,8 +362,12 @@ fn run(
                 interrupt.get_or_insert(e);
             }
         }
-        running.join().expect("the run does not panic")
+        running.join()
     });
+    let result = match result {
+        Ok(result) => result,
+        Err(panic) => return Err(panic_error(panic)),
+    };
     match (result, interrupt) {
         (Ok(_), _) => Ok(out),
         (Err(e), Some(signal)) => {
@@ -482,12 +511,20 @@ fn read_csv<'py>(
     Ok((header, array.into_pyarray(py)))
 }
 
+/// Panics inside the engine's guard: for the test that a panic reaches Python as a
+/// RuntimeError.
+#[pyfunction]
+fn _internal_panic() -> PyResult<()> {
+    guarded(|| panic!("the test's own panic"))
+}
+
 #[pymodule]
 fn _tinydem(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Simulation>()?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(read_csv, m)?)?;
     m.add_function(wrap_pyfunction!(render, m)?)?;
+    m.add_function(wrap_pyfunction!(_internal_panic, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -272,3 +272,9 @@ def test_ctrl_c_stops_a_run_with_a_checkpoint_that_resumes(tmp_path):
     assert (out / "checkpoint.bin").is_file() and (out / "interrupted.csv").is_file()
     steps = tinydem.Simulation(tmp_path / "long.toml", resume=out / "checkpoint.bin").steps
     assert STEPS_PER_FRAME <= steps < 10000 * STEPS_PER_FRAME
+
+
+def test_a_panic_of_the_engine_is_a_runtime_error():
+    # PyO3's PanicException derives from BaseException: `except Exception` would miss it.
+    with pytest.raises(RuntimeError, match="internal error of tinydem"):
+        tinydem._tinydem._internal_panic()
