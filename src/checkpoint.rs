@@ -453,7 +453,7 @@ pub fn save(path: &Path, snapshot: &Snapshot, fingerprint: u64) -> Result<()> {
 
 /// Reads a checkpoint, for the scenario and mesh of `fingerprint` if given.
 pub fn load(path: &Path, fingerprint: Option<u64>) -> Result<Snapshot> {
-    let bytes = std::fs::read(path)
+    let bytes = crate::files::read(path)
         .with_context(|| format!("cannot read checkpoint {}", path.display()))?;
     decode(&bytes, fingerprint).with_context(|| format!("cannot resume from {}", path.display()))
 }

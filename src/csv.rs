@@ -290,7 +290,7 @@ pub fn read_particles(input: impl Read, file: &str) -> Result<Particles> {
 
 /// Reads a particle CSV file.
 pub fn load_particles(path: &Path) -> Result<Particles> {
-    let f = std::fs::File::open(path)
+    let f = crate::files::open(path)
         .with_context(|| format!("cannot read particle file {}", path.display()))?;
     read_particles(f, &path.display().to_string())
 }

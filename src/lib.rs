@@ -12,6 +12,7 @@ pub mod contact;
 pub mod csv;
 pub mod domain;
 pub mod exact;
+pub mod files;
 pub mod geometry;
 pub mod integrate;
 pub mod lanes;

@@ -368,7 +368,7 @@ impl Mesh {
 
     /// Reads a mesh file: STL (ASCII or binary) if its name ends in `.stl`, else OFF.
     pub fn load(path: &std::path::Path, radii: &[f64]) -> Result<Mesh> {
-        let bytes = std::fs::read(path)
+        let bytes = crate::files::read(path)
             .map_err(|e| anyhow::anyhow!("cannot read mesh file {}: {e}", path.display()))?;
         let name = path.display().to_string();
         let is_stl = path

@@ -1034,7 +1034,7 @@ impl Default for Scenario {
 impl Scenario {
     /// Reads and validates a scenario file.
     pub fn load(path: &Path) -> Result<Scenario> {
-        let text = std::fs::read_to_string(path)
+        let text = crate::files::read_to_string(path)
             .with_context(|| format!("cannot read scenario file {}", path.display()))?;
         Scenario::parse(&text, path)
     }

@@ -932,3 +932,39 @@ fn check_warns_and_run_refuses_what_would_fail() {
     );
     assert!(o.status.success(), "{}", stderr(&o));
 }
+
+/// A FIFO named as a mesh (or as particles) is refused at once; it used to block the run
+/// for good, deaf to SIGTERM and SIGINT.
+#[test]
+fn a_fifo_as_an_input_file_is_refused_without_blocking() {
+    let t = tempfile::tempdir().unwrap();
+    let made = std::process::Command::new("mkfifo")
+        .arg(t.path().join("fifo"))
+        .status()
+        .unwrap();
+    assert!(made.success());
+    for (name, text) in [
+        ("mesh.toml", "[geometry]\nmesh = \"fifo\"\n"),
+        ("csv.toml", "[input]\nparticles = \"fifo\"\n"),
+    ] {
+        write(t.path(), name, text);
+        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_tinydem"))
+            .args(["run", name, "-q", "-o", "out"])
+            .current_dir(t.path())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let start = std::time::Instant::now();
+        while child.try_wait().unwrap().is_none() {
+            if start.elapsed().as_secs() > 20 {
+                child.kill().unwrap();
+                panic!("{name}: the run blocks on the FIFO");
+            }
+            std::thread::sleep(std::time::Duration::from_millis(10));
+        }
+        fails_with(
+            &child.wait_with_output().unwrap(),
+            &["fifo", "not a regular file"],
+        );
+    }
+}
