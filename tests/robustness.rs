@@ -257,50 +257,33 @@ fn checkpoints_of_another_scenario_or_damaged_are_refused() {
     let ckpt = t.path().join("output/checkpoint.bin");
     assert!(ckpt.exists(), "periodic checkpoint written");
 
-    let other = std::fs::read_to_string(t.path().join("s.toml"))
-        .unwrap()
-        .replace("max_particles = 400", "max_particles = 401");
-    std::fs::write(t.path().join("other.toml"), other).unwrap();
-    let o = tinydem(
-        &[
-            "run",
-            "other.toml",
-            "-q",
-            "--resume",
-            "output/checkpoint.bin",
-        ],
-        t.path(),
-    );
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(
-        !o.status.success() && err.contains("different scenario"),
-        "{err}"
-    );
-
-    // The other order of the friction springs is another scenario too (checkpoints from
-    // before the choice are in the paper's order and resume only in it).
-    let paper = std::fs::read_to_string(t.path().join("s.toml"))
-        .unwrap()
-        .replace(
+    // Another spawning, or the other order of the friction springs (checkpoints from before
+    // the choice are in the paper's order and resume only in it): another scenario.
+    let scenario = std::fs::read_to_string(t.path().join("s.toml")).unwrap();
+    for (from, to) in [
+        ("max_particles = 400", "max_particles = 401"),
+        (
             "[simulation]\n",
             "[simulation]\nfriction_springs = \"paper\"\n",
+        ),
+    ] {
+        std::fs::write(t.path().join("other.toml"), scenario.replace(from, to)).unwrap();
+        let o = tinydem(
+            &[
+                "run",
+                "other.toml",
+                "-q",
+                "--resume",
+                "output/checkpoint.bin",
+            ],
+            t.path(),
         );
-    std::fs::write(t.path().join("paper.toml"), paper).unwrap();
-    let o = tinydem(
-        &[
-            "run",
-            "paper.toml",
-            "-q",
-            "--resume",
-            "output/checkpoint.bin",
-        ],
-        t.path(),
-    );
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(
-        !o.status.success() && err.contains("different scenario"),
-        "{err}"
-    );
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            !o.status.success() && err.contains("different scenario"),
+            "{to}: {err}"
+        );
+    }
 
     let mut bytes = std::fs::read(&ckpt).unwrap();
     let mid = bytes.len() / 2;
