@@ -264,6 +264,8 @@ pub fn run_on(
     let frames = scenario.simulation.frames;
     let steps_per_frame = scenario.simulation.steps_per_frame;
     let checkpoint_every = scenario.checkpoint_every;
+    let checkpoint_interval =
+        std::time::Duration::from_secs_f64(scenario.checkpoint_minutes * 60.0);
     let opened = open(scenario, options.resume, options.from);
     let (mut sim, notes) = match comm.filter(|c| c.size() > 1) {
         Some(comm) => {
@@ -468,6 +470,7 @@ pub fn run_on(
         status(&mut sim, 0, &th);
     }
 
+    let mut last_checkpoint = Instant::now();
     while sim.steps < total_steps {
         if let Err(unstable) = sim.step() {
             let last = sim.steps.saturating_sub(1) / steps_per_frame.max(1);
@@ -498,8 +501,18 @@ pub fn run_on(
             status(&mut sim, frame, &th);
             if checkpoint_every > 0 && frame.is_multiple_of(checkpoint_every) {
                 save_checkpoint(output_dir, &sim)?;
+                last_checkpoint = Instant::now();
             }
             output_seconds += t.elapsed().as_secs_f64();
+        }
+        // Checkpoints by wall time: the clock of any process decides, every 100 steps (the
+        // same steps on all).
+        if !checkpoint_interval.is_zero()
+            && sim.steps.is_multiple_of(100)
+            && sim.any(last_checkpoint.elapsed() >= checkpoint_interval)
+        {
+            save_checkpoint(output_dir, &sim)?;
+            last_checkpoint = Instant::now();
         }
         if let Some(bar) = bar.as_ref().filter(|_| sim.steps.is_multiple_of(100)) {
             bar.set_position(sim.steps);

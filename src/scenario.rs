@@ -21,7 +21,7 @@
 //! [[materials]] name, density, youngs_modulus, poisson_ratio, restitution, friction_*
 //! [[interactions]] materials = [a, b], restitution, friction_*
 //! [input]      particles
-//! [output]     dir, checkpoint_every, formats, wall_forces, contacts
+//! [output]     dir, checkpoint_every, checkpoint_minutes, formats, wall_forces, contacts
 //! ```
 //! Paths are relative to the scenario file. Unknown keys and values outside Table 2's
 //! "Requirements" column are errors naming the key and the allowed range.
@@ -334,6 +334,9 @@ pub struct Scenario {
     pub output_dir: PathBuf,
     /// Write a checkpoint every this many frames (0: only when interrupted).
     pub checkpoint_every: u64,
+    /// Also write one when this many minutes of wall time have passed since the last (0:
+    /// never), so that a job killed without warning loses at most that.
+    pub checkpoint_minutes: f64,
     /// Frame formats to write.
     pub formats: Formats,
     /// Write `walls.csv`: the force and torque the particles exert on each mesh file.
@@ -675,6 +678,7 @@ struct RawInput {
 struct RawOutput {
     dir: Option<PathBuf>,
     checkpoint_every: Option<u64>,
+    checkpoint_minutes: Option<f64>,
     formats: Option<Vec<String>>,
     wall_forces: Option<bool>,
     contacts: Option<bool>,
@@ -1415,6 +1419,11 @@ impl Scenario {
                 .dir
                 .map_or_else(|| base.join("output"), |d| base.join(d)),
             checkpoint_every: raw.output.checkpoint_every.unwrap_or(0),
+            checkpoint_minutes: check(
+                "[output] checkpoint_minutes",
+                raw.output.checkpoint_minutes.unwrap_or(0.0),
+                Range::NonNegative,
+            )?,
             formats: Formats::parse(raw.output.formats)?,
             wall_forces: raw.output.wall_forces.unwrap_or(false),
             contact_network: raw.output.contacts.unwrap_or(false),
@@ -1655,6 +1664,7 @@ impl Scenario {
         o += "\n[output]\n";
         let _ = writeln!(o, "dir = {}", path(&self.output_dir));
         let _ = writeln!(o, "checkpoint_every = {}", self.checkpoint_every);
+        let _ = writeln!(o, "checkpoint_minutes = {}", f(self.checkpoint_minutes));
         let mut formats = Vec::new();
         if self.formats.csv {
             formats.push("\"csv\"");

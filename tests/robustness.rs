@@ -534,3 +534,59 @@ fn a_pair_squeezed_past_the_smaller_radius_goes_on_with_one_warning() {
     );
     assert!(sim.particles.v[0].x < 0.0, "the grain rebounds");
 }
+
+/// `[output] checkpoint_minutes`: a run killed without warning (SIGKILL) leaves a
+/// checkpoint at most that old, which resumes to the frames of an uninterrupted run.
+#[test]
+fn a_run_killed_without_warning_resumes_from_its_timed_checkpoint() {
+    let t = tempfile::tempdir().unwrap();
+    pile(t.path(), 6);
+    let scenario = std::fs::read_to_string(t.path().join("s.toml")).unwrap();
+    std::fs::write(
+        t.path().join("s.toml"),
+        scenario + "[output]\ncheckpoint_minutes = 0.0005\n", // 30 ms
+    )
+    .unwrap();
+    let o = tinydem(&["run", "s.toml", "-q", "-o", "whole"], t.path());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tinydem"))
+        .args(["run", "s.toml", "-q", "-o", "out"])
+        .current_dir(t.path())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while !t.path().join("out/particles000002.csv").exists() {
+        assert!(start.elapsed() < Duration::from_secs(60), "run too slow");
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    child.kill().unwrap(); // SIGKILL: no stop checkpoint
+    child.wait().unwrap();
+    let ckpt = t.path().join("out/checkpoint.bin");
+    let snapshot = checkpoint::decode(&std::fs::read(&ckpt).unwrap(), None).unwrap();
+    assert!(
+        snapshot.steps > 0 && snapshot.steps < 6 * 2000,
+        "a timed checkpoint at step {}",
+        snapshot.steps
+    );
+    let o = tinydem(
+        &[
+            "run",
+            "s.toml",
+            "-q",
+            "-o",
+            "out",
+            "--resume",
+            "out/checkpoint.bin",
+        ],
+        t.path(),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (whole, resumed) = (
+        frames_of(&t.path().join("whole")),
+        frames_of(&t.path().join("out")),
+    );
+    assert_eq!(whole.len(), resumed.len());
+    for ((name, x), (_, y)) in whole.iter().zip(&resumed) {
+        assert!(x == y, "{name} differs after resuming");
+    }
+}
