@@ -237,15 +237,22 @@ impl Reader<'_> {
         let n = self.count(8 + 56)?;
         (0..n)
             .map(|_| {
-                Ok((
-                    self.u32()?,
-                    self.u32()?,
-                    Springs {
-                        u_s: self.vec3()?,
-                        u_r: self.vec3()?,
-                        u_t: self.f64()?,
-                    },
-                ))
+                let (i, j) = (self.u32()?, self.u32()?);
+                let s = Springs {
+                    u_s: self.vec3()?,
+                    u_r: self.vec3()?,
+                    u_t: self.f64()?,
+                };
+                let bounded = |x: f64| x.is_finite() && x.abs() <= STATE_BOUND;
+                if !(s.u_s.to_array().into_iter().chain(s.u_r.to_array()))
+                    .chain([s.u_t])
+                    .all(bounded)
+                {
+                    bail!(
+                        "corrupt checkpoint: the friction springs of contact ({i}, {j}) are {s:?}"
+                    );
+                }
+                Ok((i, j, s))
             })
             .collect()
     }

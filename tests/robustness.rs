@@ -353,6 +353,35 @@ fn forged_checkpoints_are_refused_by_their_content() {
         );
         assert!(!err.contains("panicked"), "{err}");
     }
+    let mut snapshot = good.clone();
+    let history = if snapshot.pair_history.is_empty() {
+        &mut snapshot.face_history
+    } else {
+        &mut snapshot.pair_history
+    };
+    history.first_mut().expect("a contact").2.u_t = f64::INFINITY;
+    std::fs::write(
+        t.path().join("springs.bin"),
+        checkpoint::encode(&snapshot, fingerprint),
+    )
+    .unwrap();
+    let o = tinydem(
+        &[
+            "run",
+            "s.toml",
+            "-q",
+            "-o",
+            "out",
+            "--resume",
+            "springs.bin",
+        ],
+        t.path(),
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("the friction springs of contact"),
+        "{err}"
+    );
 }
 
 /// The `run.toml` of a resumed run reruns its scenario: it keeps `[input] particles` (it
