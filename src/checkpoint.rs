@@ -243,11 +243,7 @@ impl Reader<'_> {
                     u_r: self.vec3()?,
                     u_t: self.f64()?,
                 };
-                let bounded = |x: f64| x.is_finite() && x.abs() <= STATE_BOUND;
-                if !(s.u_s.to_array().into_iter().chain(s.u_r.to_array()))
-                    .chain([s.u_t])
-                    .all(bounded)
-                {
+                if !(bounded(s.u_s) && bounded(s.u_r) && bounded(DVec3::splat(s.u_t))) {
                     bail!(
                         "corrupt checkpoint: the friction springs of contact ({i}, {j}) are {s:?}"
                     );
@@ -262,6 +258,11 @@ impl Reader<'_> {
 /// beyond any run, and small enough that its squares and products stay finite.
 const STATE_BOUND: f64 = 1e30;
 
+/// Whether every component of `x` is finite and within [`STATE_BOUND`].
+fn bounded(x: DVec3) -> bool {
+    x.is_finite() && x.abs().max_element() <= STATE_BOUND
+}
+
 /// Checks the particles of a checkpoint as any input is checked: finite states within
 /// [`STATE_BOUND`], radii > 0, unit quaternions. A checksum only says the bytes are those
 /// written, not that what was written is a state.
@@ -273,7 +274,7 @@ fn check_states(ids: &[u32], p: &Particles) -> Result<()> {
             ("angular velocity", p.w[k]),
         ];
         for (what, x) in fields {
-            if !x.is_finite() || x.abs().max_element() > STATE_BOUND {
+            if !bounded(x) {
                 bail!("corrupt checkpoint: particle {id} has the {what} {x}");
             }
         }

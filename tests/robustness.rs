@@ -35,6 +35,25 @@ fn assert_contains(text: &str, expected: &[&str]) {
     }
 }
 
+/// Resumes `checkpoint` with `scenario` in `dir`, into `out`, and asserts that it is refused
+/// with a message holding each of `expected`, and no panic.
+fn assert_resume_refused(
+    dir: &Path,
+    scenario: &str,
+    checkpoint: &str,
+    out: &str,
+    expected: &[&str],
+) {
+    let o = tinydem(
+        &["run", scenario, "-q", "-o", out, "--resume", checkpoint],
+        dir,
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{checkpoint} resumed");
+    assert!(!err.contains("panicked"), "{err}");
+    assert_contains(&err, expected);
+}
+
 #[test]
 fn too_large_timestep_is_warned_of_once_with_advice() {
     // Two equal spheres at 20 x Eq. 50's step pass halfway through each other in one step:
@@ -268,20 +287,12 @@ fn checkpoints_of_another_scenario_or_damaged_are_refused() {
         ),
     ] {
         std::fs::write(t.path().join("other.toml"), scenario.replace(from, to)).unwrap();
-        let o = tinydem(
-            &[
-                "run",
-                "other.toml",
-                "-q",
-                "--resume",
-                "output/checkpoint.bin",
-            ],
+        assert_resume_refused(
             t.path(),
-        );
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert!(
-            !o.status.success() && err.contains("different scenario"),
-            "{to}: {err}"
+            "other.toml",
+            "output/checkpoint.bin",
+            "output",
+            &["different scenario"],
         );
     }
 
@@ -289,13 +300,13 @@ fn checkpoints_of_another_scenario_or_damaged_are_refused() {
     let mid = bytes.len() / 2;
     bytes[mid] ^= 0xff;
     std::fs::write(t.path().join("bad.bin"), &bytes).unwrap();
-    let o = tinydem(&["run", "s.toml", "-q", "--resume", "bad.bin"], t.path());
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(
-        !o.status.success() && err.contains("checksum") && err.contains("bad.bin"),
-        "{err}"
+    assert_resume_refused(
+        t.path(),
+        "s.toml",
+        "bad.bin",
+        "output",
+        &["checksum", "bad.bin"],
     );
-    assert!(!err.contains("panicked"));
 }
 
 /// Checkpoints forged with a valid checksum but impossible content are refused on
@@ -334,24 +345,7 @@ fn forged_checkpoints_are_refused_by_their_content() {
             checkpoint::encode(&snapshot, fingerprint),
         )
         .unwrap();
-        let o = tinydem(
-            &[
-                "run",
-                "s.toml",
-                "-q",
-                "-o",
-                &format!("out{k}"),
-                "--resume",
-                &name,
-            ],
-            t.path(),
-        );
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert!(
-            !o.status.success() && err.contains(expected),
-            "{expected}: {err}"
-        );
-        assert!(!err.contains("panicked"), "{err}");
+        assert_resume_refused(t.path(), "s.toml", &name, &format!("out{k}"), &[expected]);
     }
     let mut snapshot = good.clone();
     let history = if snapshot.pair_history.is_empty() {
@@ -365,22 +359,12 @@ fn forged_checkpoints_are_refused_by_their_content() {
         checkpoint::encode(&snapshot, fingerprint),
     )
     .unwrap();
-    let o = tinydem(
-        &[
-            "run",
-            "s.toml",
-            "-q",
-            "-o",
-            "out",
-            "--resume",
-            "springs.bin",
-        ],
+    assert_resume_refused(
         t.path(),
-    );
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(
-        !o.status.success() && err.contains("the friction springs of contact"),
-        "{err}"
+        "s.toml",
+        "springs.bin",
+        "out",
+        &["the friction springs of contact"],
     );
 }
 
