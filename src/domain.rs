@@ -323,14 +323,6 @@ fn get_entry(r: &mut Reader) -> (u32, u32, Springs) {
     )
 }
 
-/// Entries sorted by their pair of keys, each once (copies from two processes are the same
-/// bits: both evaluated the pair from the same states).
-fn dedup(mut entries: Vec<(u32, u32, Springs)>) -> Vec<(u32, u32, Springs)> {
-    entries.sort_unstable_by_key(|e| (e.0, e.1));
-    entries.dedup_by_key(|e| (e.0, e.1));
-    entries
-}
-
 /// Every process's contacts (collective), in the order of `Simulation::contact_network`.
 pub(crate) fn gather_contacts(comm: &dyn Comm, mine: Vec<ContactRecord>) -> Vec<ContactRecord> {
     let mut w = Writer::default();
@@ -440,6 +432,11 @@ impl Simulation {
         self.domain.as_ref().is_none_or(|d| d.comm.rank() == 0)
     }
 
+    /// This process's place among the processes of a split run: (rank, count).
+    pub fn process(&self) -> Option<(usize, usize)> {
+        self.domain.as_ref().map(|d| d.rank())
+    }
+
     /// [`agree`] over the processes of a split run; `r` in one process.
     pub fn agree<T>(&self, r: Result<T>) -> Result<T> {
         match &self.domain {
@@ -461,66 +458,53 @@ impl Simulation {
         }
     }
 
-    /// The snapshot of a split run (collective): all particles in id order, the anchors of
-    /// the last rebuild, and the springs of every contact once.
-    pub(crate) fn snapshot_split(&self) -> Snapshot {
+    /// The snapshot of a split run (collective): the pieces of all processes, joined
+    /// (`checkpoint::join`) as the parts of a stop checkpoint are, so that both give the
+    /// same checkpoint. An error if some process's state is not one a checkpoint may hold.
+    pub(crate) fn snapshot_split(&self) -> Result<Snapshot> {
+        let d = self.domain.as_ref().expect("a split run");
+        let mine = crate::checkpoint::encode(&self.snapshot_piece(), 0);
+        let pieces = d
+            .comm
+            .all_gather(mine)
+            .iter()
+            .map(|bytes| crate::checkpoint::decode(bytes, Some(0)))
+            .collect::<Result<Vec<_>>>()?;
+        crate::checkpoint::join(pieces)
+    }
+
+    /// This process's piece of the state of a split run: its own particles (with their
+    /// anchors of the last rebuild), the springs of every contact one of them is in, and the
+    /// state all processes share. `checkpoint::join` makes the snapshot of the pieces.
+    pub fn snapshot_piece(&self) -> Snapshot {
         let d = self.domain.as_ref().expect("a split run");
         let p = &self.particles;
-        let history = self.neighbours.history(&p.id, p.next_id as usize);
+        let (mut pairs, mut faces) = self.neighbours.entries_by_id(&p.id);
         let (anchors, _) = self.neighbours.anchors();
-        let own: FxHashSet<u32> = (0..p.len())
+        let own_ids: FxHashSet<u32> = (0..p.len())
             .filter(|&k| d.owned[k])
             .map(|k| p.id[k])
             .collect();
-        let mut w = Writer::default();
-        let pairs: Vec<_> = history
-            .pairs
-            .entries()
-            .into_iter()
-            .filter(|e| own.contains(&e.0) || own.contains(&e.1))
-            .collect();
-        let faces: Vec<_> = history
-            .faces
-            .entries()
-            .into_iter()
-            .filter(|e| own.contains(&e.0))
-            .collect();
-        w.u64(pairs.len() as u64);
-        pairs.iter().for_each(|e| put_entry(&mut w, e));
-        w.u64(faces.len() as u64);
-        faces.iter().for_each(|e| put_entry(&mut w, e));
-        let own_anchors: Vec<(u32, DVec3)> = (0..p.len())
-            .filter(|&k| d.owned[k])
-            .map(|k| (p.id[k], anchors.get(k).copied().unwrap_or(p.x[k])))
-            .collect();
-        w.u64(own_anchors.len() as u64);
-        for &(id, x) in &own_anchors {
-            w.u32(id);
-            w.vec3(x);
+        let mut own = Particles {
+            next_id: p.next_id,
+            ..Particles::default()
+        };
+        let mut own_anchors = Vec::with_capacity(own_ids.len());
+        for k in (0..p.len()).filter(|&k| d.owned[k]) {
+            own.insert(p.id[k], p.get(k));
+            own_anchors.push(anchors.get(k).copied().unwrap_or(p.x[k]));
         }
-        let (mut all_pairs, mut all_faces, mut all_anchors) = (Vec::new(), Vec::new(), Vec::new());
-        for m in d.comm.all_gather(w.0) {
-            let mut r = Reader::new(&m);
-            for _ in 0..r.u64() {
-                all_pairs.push(get_entry(&mut r));
-            }
-            for _ in 0..r.u64() {
-                all_faces.push(get_entry(&mut r));
-            }
-            for _ in 0..r.u64() {
-                all_anchors.push((r.u32(), r.vec3()));
-            }
-        }
-        all_anchors.sort_unstable_by_key(|a| a.0);
+        pairs.retain(|e| own_ids.contains(&e.0) || own_ids.contains(&e.1));
+        faces.retain(|e| own_ids.contains(&e.0));
         Snapshot {
             steps: self.steps,
             built_at: self.built_at,
-            particles: self.gather_particles(),
+            particles: own,
             spawner: self.spawner.state(),
-            anchors: all_anchors.into_iter().map(|a| a.1).collect(),
+            anchors: own_anchors,
             lonely: Vec::new(),
-            pair_history: dedup(all_pairs),
-            face_history: dedup(all_faces),
+            pair_history: pairs,
+            face_history: faces,
             removed: self.removed.clone(),
             wall_sums: self.wall_sums.clone(),
             scenario: self.scenario.to_toml(),

@@ -12,7 +12,7 @@ use glam::DVec3;
 use tinydem::check::{describe, describe_stage};
 use tinydem::comm::Comm;
 use tinydem::render::{Animation, ColorBy, Fixed, Style, View};
-use tinydem::run::{Interrupted, Options, Summary, Verbosity, run_on};
+use tinydem::run::{Interrupted, Options, Requests, Summary, Verbosity, run_on};
 use tinydem::scenario::Scenario;
 use tinydem::simulation::Stage;
 
@@ -184,8 +184,12 @@ enum Command {
     },
 }
 
-/// Set on SIGINT or SIGTERM: the run stops after the current step with a checkpoint.
-static STOP: AtomicBool = AtomicBool::new(false);
+/// Set by signals: the run stops after the current step with a checkpoint, or writes one
+/// and goes on (see `catch_signals`).
+static REQUESTS: Requests = Requests {
+    stop: AtomicBool::new(false),
+    checkpoint: AtomicBool::new(false),
+};
 
 /// Large allocations (1 MiB and up) go straight to the operating system and back. glibc
 /// otherwise raises that threshold to the size of the largest block freed: the neighbour
@@ -218,12 +222,8 @@ fn main() -> ExitCode {
 fn last_words(first: bool, outcome: Result<()>) -> ExitCode {
     match outcome {
         Ok(()) => ExitCode::SUCCESS,
-        Err(e) if e.downcast_ref::<Interrupted>().is_some() => {
-            if first {
-                eprintln!("{e:#}");
-            }
-            ExitCode::from(130)
-        }
+        // Said by the run as soon as its checkpoint was complete.
+        Err(e) if e.downcast_ref::<Interrupted>().is_some() => ExitCode::from(130),
         Err(e) => {
             if first {
                 eprintln!("error: {e:#}");
@@ -264,10 +264,35 @@ fn world() -> Result<(Option<Box<dyn Comm>>, Finalize)> {
     }
 }
 
-/// Installs the handler that turns SIGINT/SIGTERM into a clean stop.
+/// Installs the handlers of the signals a run answers: SIGINT, SIGTERM, SIGHUP and SIGUSR1
+/// stop it after the current step with a checkpoint (SIGUSR1 is the one `mpirun` passes on
+/// to the processes without killing them a second later); a second such signal ends the
+/// process at once (a run blocked in a write or a read), keeping the last complete
+/// checkpoint. SIGCONT, which `mpirun` and Slurm send a second before SIGTERM, writes a
+/// checkpoint after the current step.
 fn catch_signals() -> Result<()> {
-    ctrlc::set_handler(|| STOP.store(true, Ordering::Relaxed))
-        .context("cannot install the signal handler")
+    use signal_hook::consts::{SIGCONT, SIGHUP, SIGINT, SIGTERM, SIGUSR1};
+    let mut signals =
+        signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP, SIGUSR1, SIGCONT])
+            .context("cannot install the signal handlers")?;
+    std::thread::Builder::new()
+        .name("signals".into())
+        .spawn(move || {
+            let mut asked = false;
+            for signal in signals.forever() {
+                if signal == SIGCONT {
+                    REQUESTS.checkpoint.store(true, Ordering::Relaxed);
+                } else if asked {
+                    eprintln!("a second signal: stopping now; the last complete checkpoint stays");
+                    std::process::exit(130);
+                } else {
+                    asked = true;
+                    REQUESTS.stop.store(true, Ordering::Relaxed);
+                }
+            }
+        })
+        .context("cannot start the signal thread")?;
+    Ok(())
 }
 
 fn real_main(cli: Cli, world: Option<Box<dyn Comm>>) -> Result<()> {
@@ -313,7 +338,7 @@ fn execute(
                 from: None,
                 overwrite: overwrite_default,
                 force: force_default,
-                stop: Some(&STOP),
+                requests: Some(&REQUESTS),
             };
             let summary = run_on(s, &out, options, world)?;
             if first {
@@ -343,7 +368,7 @@ fn execute(
                 from: from.as_deref(),
                 overwrite,
                 force,
-                stop: Some(&STOP),
+                requests: Some(&REQUESTS),
             };
             let summary = run_on(s, &out, options, world)?;
             match (first, quiet) {

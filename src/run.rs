@@ -57,8 +57,20 @@ pub struct Options<'a> {
     /// Run even when the scenario's time step is far past Eq. 50 or its output may not fit
     /// the free space (`check::refusals`).
     pub force: bool,
-    /// Set (by a signal handler) to stop after the current step with a checkpoint.
-    pub stop: Option<&'a AtomicBool>,
+    /// What signals ask of the run, seen after every step.
+    pub requests: Option<&'a Requests>,
+}
+
+/// What signals ask of a running run (set by signal handlers, seen after every step, on
+/// every process: one asked of any process is done by all at the same step).
+#[derive(Debug, Default)]
+pub struct Requests {
+    /// Stop after the current step with a checkpoint (SIGINT, SIGTERM, SIGHUP, SIGUSR1).
+    pub stop: AtomicBool,
+    /// Write a checkpoint after the current step and go on (SIGCONT: mpirun and Slurm send
+    /// it before SIGTERM, so the checkpoint is on disk before the stop is asked; a stop in
+    /// the same step writes no other).
+    pub checkpoint: AtomicBool,
 }
 
 /// Summary of a finished run.
@@ -201,6 +213,7 @@ fn is_run_output(name: &str) -> bool {
         })
     };
     frame("particles")
+        || checkpoint::is_part(name)
         || frame("contacts")
         || frame("mesh")
         || [
@@ -471,6 +484,8 @@ pub fn run_on(
     }
 
     let mut last_checkpoint = Instant::now();
+    // The step of the last checkpoint this run wrote.
+    let mut checkpointed_at = None;
     while sim.steps < total_steps {
         if let Err(unstable) = sim.step() {
             let last = sim.steps.saturating_sub(1) / steps_per_frame.max(1);
@@ -501,7 +516,7 @@ pub fn run_on(
             status(&mut sim, frame, &th);
             if checkpoint_every > 0 && frame.is_multiple_of(checkpoint_every) {
                 save_checkpoint(output_dir, &sim)?;
-                last_checkpoint = Instant::now();
+                (last_checkpoint, checkpointed_at) = (Instant::now(), Some(sim.steps));
             }
             output_seconds += t.elapsed().as_secs_f64();
         }
@@ -512,31 +527,34 @@ pub fn run_on(
             && sim.any(last_checkpoint.elapsed() >= checkpoint_interval)
         {
             save_checkpoint(output_dir, &sim)?;
-            last_checkpoint = Instant::now();
+            (last_checkpoint, checkpointed_at) = (Instant::now(), Some(sim.steps));
         }
         if let Some(bar) = bar.as_ref().filter(|_| sim.steps.is_multiple_of(100)) {
             bar.set_position(sim.steps);
         }
-        // A stop asked of any process stops all, at the same step.
-        if sim.any(options.stop.is_some_and(|s| s.load(Ordering::Relaxed))) {
-            let path = save_checkpoint(output_dir, &sim)?;
-            let particles = sim.particles_in_domain();
-            let written = if writer {
-                crate::csv::write_frame_as(output_dir, INTERRUPTED, &particles, out.extra)
-                    .map(|_| ())
-            } else {
-                Ok(())
-            };
-            sim.agree(written)?;
+        // Asked by signals: a checkpoint now, a stop (any process asks, all do it).
+        let asked = |flag: fn(&Requests) -> &AtomicBool| {
+            options
+                .requests
+                .is_some_and(|r| flag(r).swap(false, Ordering::Relaxed))
+        };
+        if sim.any(asked(|r| &r.checkpoint)) && checkpointed_at != Some(sim.steps) {
+            let path = save_pieces(output_dir, &sim)?;
+            checkpointed_at = Some(sim.steps);
+            if writer {
+                eprintln!(
+                    "SIGCONT: checkpoint of step {} written to {} (a launcher stopping the run sends SIGCONT before SIGTERM)",
+                    sim.steps,
+                    path.display()
+                );
+            }
+        }
+        if sim.any(asked(|r| &r.stop)) {
             if let Some(bar) = &bar {
                 bar.abandon();
             }
-            return Err(Interrupted {
-                step: sim.steps,
-                time: sim.time,
-                checkpoint: path,
-            }
-            .into());
+            let written = checkpointed_at == Some(sim.steps);
+            return Err(stop(output_dir, &sim, out.extra, written)?.into());
         }
     }
     if let Some(bar) = bar {
@@ -687,6 +705,61 @@ pub fn open(
     }
 }
 
+/// Stops a run on request (collective): the checkpoint first (unless one of this step is
+/// `written`), said as soon as it is complete (a launcher may send SIGKILL a second after
+/// SIGTERM), then the state as a CSV frame. In a split run the first process joins the
+/// parts of the checkpoint into the one file after saying it.
+fn stop(dir: &Path, sim: &Simulation, extra: Extra, written: bool) -> Result<Interrupted> {
+    let path = if written {
+        dir.join(CHECKPOINT)
+    } else {
+        save_pieces(dir, sim)?
+    };
+    let stop = Interrupted {
+        step: sim.steps,
+        time: sim.time,
+        checkpoint: path.clone(),
+    };
+    let writer = sim.is_writer();
+    if writer {
+        eprintln!("{stop}");
+    }
+    if writer && sim.process().is_some() && checkpoint::newer_parts(&path).is_some() {
+        let fp = fingerprint(sim);
+        let joined =
+            checkpoint::load(&path, Some(fp)).and_then(|s| checkpoint::save(&path, &s, fp));
+        if let Err(e) = joined {
+            eprintln!("warning: {e:#}; its parts hold the checkpoint, and --resume reads them");
+        }
+    }
+    let particles = sim.particles_in_domain();
+    let written = if writer {
+        crate::csv::write_frame_as(dir, INTERRUPTED, &particles, extra).map(|_| ())
+    } else {
+        Ok(())
+    };
+    sim.agree(written)?;
+    Ok(stop)
+}
+
+/// Writes the checkpoint of `sim` into `dir` at once (collective), returning its path: in
+/// a split run each process its own part, with no gather (see `checkpoint::parts`).
+fn save_pieces(dir: &Path, sim: &Simulation) -> Result<PathBuf> {
+    let path = dir.join(CHECKPOINT);
+    match sim.process() {
+        Some((k, n)) => {
+            let piece = sim.snapshot_piece();
+            let saved = checkpoint::save_part(&path, k, n, &piece, fingerprint(sim));
+            sim.agree(saved)?;
+            if sim.is_writer() {
+                checkpoint::remove_parts(&path, Some(sim.steps));
+            }
+        }
+        None => write_checkpoint(&path, sim)?,
+    }
+    Ok(path)
+}
+
 /// Writes the checkpoint of `sim` into `dir`, returning its path.
 fn save_checkpoint(dir: &Path, sim: &Simulation) -> Result<PathBuf> {
     let path = dir.join(CHECKPOINT);
@@ -698,7 +771,7 @@ fn save_checkpoint(dir: &Path, sim: &Simulation) -> Result<PathBuf> {
 /// starts a stage from it). In a split run: collective, one file (as of one process)
 /// written by the first.
 pub fn write_checkpoint(path: &Path, sim: &Simulation) -> Result<()> {
-    let snapshot = sim.snapshot();
+    let snapshot = sim.snapshot()?;
     let saved = if sim.is_writer() {
         checkpoint::save(path, &snapshot, fingerprint(sim))
     } else {

@@ -876,15 +876,16 @@ impl Simulation {
         Ok((sim, notes))
     }
 
-    /// The complete state of the run.
-    pub fn snapshot(&self) -> Snapshot {
+    /// The complete state of the run (collective in a split run, where it fails if the
+    /// state of some process is not one a checkpoint may hold).
+    pub fn snapshot(&self) -> Result<Snapshot> {
         if self.domain.is_some() {
             return self.snapshot_split();
         }
         let p = &self.particles;
         let history = self.neighbours.history(&p.id, p.next_id as usize);
         let (anchors, lonely) = self.neighbours.anchors();
-        Snapshot {
+        Ok(Snapshot {
             steps: self.steps,
             built_at: self.built_at,
             particles: p.clone(),
@@ -897,7 +898,7 @@ impl Simulation {
             wall_sums: self.wall_sums.clone(),
             scenario: self.scenario.to_toml(),
             mesh_files: self.mesh_signatures(),
-        }
+        })
     }
 
     /// Sets up a simulation from a mesh and particles already in memory.

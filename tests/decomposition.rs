@@ -284,17 +284,27 @@ fn checkpoint_on_2_resumes_on_3(
                 for _ in 0..first {
                     sim.step().unwrap();
                 }
-                sim.snapshot()
+                (sim.snapshot().unwrap(), sim.snapshot_piece())
             })
         })
         .collect();
-    let snapshots: Vec<_> = handles.into_iter().map(|h| h.join().unwrap()).collect();
+    let (snapshots, pieces): (Vec<_>, Vec<_>) =
+        handles.into_iter().map(|h| h.join().unwrap()).unzip();
     assert!(
         snapshots[0] == snapshots[1],
         "both processes should see the same snapshot"
     );
     let snapshot = snapshots[0].clone();
     assert!(!snapshot.pair_history.is_empty());
+    // The pieces each process writes on a stop, read back as the checkpoint: the snapshot.
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("checkpoint.bin");
+    for (k, piece) in pieces.iter().enumerate() {
+        assert!(piece.particles.len() < snapshot.particles.len());
+        tinydem::checkpoint::save_part(&path, k, 2, piece, 7).unwrap();
+    }
+    let joined = tinydem::checkpoint::load(&path, Some(7)).unwrap();
+    assert!(joined == snapshot, "the parts should join to the snapshot");
     // Resumed on 3 processes, and in one.
     let resumed = {
         let (snapshot, make) = (snapshot.clone(), make.clone());
@@ -359,7 +369,7 @@ fn the_output_of_a_split_run_is_that_of_one_process_byte_for_byte() {
         from: None,
         overwrite: false,
         force: true,
-        stop: None,
+        requests: None,
     };
     let one = tempfile::tempdir().unwrap();
     tinydem::run::run(common::scenario(&text), one.path(), options).unwrap();

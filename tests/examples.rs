@@ -52,7 +52,7 @@ fn run_briefly(files: &[PathBuf]) -> usize {
             from: from.as_deref(),
             overwrite: false,
             force: false,
-            stop: None,
+            requests: None,
         };
         let summary =
             run(s, &stage, options).unwrap_or_else(|e| panic!("{}: {e:#}", file.display()));

@@ -160,5 +160,5 @@ fn sample_snapshot() -> tinydem::simulation::Snapshot {
         read_particles(CSV.as_bytes(), "fuzz.csv").unwrap(),
     )
     .unwrap();
-    sim.snapshot()
+    sim.snapshot().unwrap()
 }

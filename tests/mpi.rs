@@ -242,3 +242,164 @@ fn commands_that_do_not_step_run_once_under_mpirun() {
     assert_eq!(two.matches("scenario is valid").count(), 1, "{two}");
     assert_eq!(two.lines().count(), one.lines().count(), "{two}");
 }
+
+/// A settled bed of 10^6 grains (the benchmark's 10^5 packing, 5 x 2 tiles) in an open box,
+/// for `frames` frames of `steps` steps: its checkpoint is 300 MB, 3-5 s to gather and
+/// write on the 2-core CI machine.
+fn million(dir: &Path, frames: u64, steps: u64) -> PathBuf {
+    use std::io::{BufRead, Write};
+    let bench = Path::new(env!("CARGO_MANIFEST_DIR")).join("bench/data/n100000");
+    let edge: f64 = std::fs::read_to_string(bench.join("edge.txt"))
+        .unwrap()
+        .trim()
+        .parse()
+        .unwrap();
+    let gz =
+        flate2::read::GzDecoder::new(std::fs::File::open(bench.join("settled.csv.gz")).unwrap());
+    let lines: Vec<String> = std::io::BufReader::new(gz)
+        .lines()
+        .map(|l| l.unwrap())
+        .collect();
+    let mut csv = std::io::BufWriter::new(std::fs::File::create(dir.join("bed.csv")).unwrap());
+    writeln!(csv, "{}", lines[0]).unwrap();
+    for (ix, iy) in (0..5).flat_map(|ix| (0..2).map(move |iy| (ix, iy))) {
+        for line in &lines[1..] {
+            let (x, rest) = line.split_once(',').unwrap();
+            let (y, rest) = rest.split_once(',').unwrap();
+            let x: f64 = x.parse::<f64>().unwrap() + ix as f64 * edge;
+            let y: f64 = y.parse::<f64>().unwrap() + iy as f64 * edge;
+            writeln!(csv, "{x:?},{y:?},{rest}").unwrap();
+        }
+    }
+    csv.into_inner().unwrap().sync_all().unwrap();
+    let (lx, ly, lz) = (5.0 * edge, 2.0 * edge, edge);
+    std::fs::write(
+        dir.join("box.off"),
+        format!(
+            "OFF\n8 5 0\n0 0 0\n{lx} 0 0\n{lx} {ly} 0\n0 {ly} 0\n0 0 {lz}\n{lx} 0 {lz}\n{lx} {ly} {lz}\n0 {ly} {lz}\n\
+             4 0 1 2 3\n4 0 3 7 4\n4 1 2 6 5\n4 0 1 5 4\n4 3 2 6 7\n"
+        ),
+    )
+    .unwrap();
+    let path = dir.join("bed.toml");
+    std::fs::write(
+        &path,
+        format!(
+            "[geometry]\nradius_min = 0.004\nradius_max = 0.005\nmesh = \"box.off\"\nmesh_radii = [0.0]\n\
+             [material]\nyoungs_modulus = 1e6\nrestitution = 0.5\nfriction_sliding = 0.3\nfriction_rolling = 0.3\n\
+             [simulation]\nmax_particles = 0\nspawn_attempts = 0\nframes = {frames}\nsteps_per_frame = {steps}\n\
+             [input]\nparticles = \"bed.csv\"\n"
+        ),
+    )
+    .unwrap();
+    path
+}
+
+/// The lines of `dir/frames.csv` (0 while it is not there).
+fn frames_out(dir: &Path) -> usize {
+    std::fs::read_to_string(dir.join("frames.csv")).map_or(0, |t| t.lines().count())
+}
+
+/// Waits until `dir/frames.csv` has `lines` lines.
+fn wait_for_frames(dir: &Path, lines: usize) {
+    let start = Instant::now();
+    while frames_out(dir) < lines {
+        assert!(start.elapsed() < Duration::from_secs(120), "no frames");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+#[test]
+fn sigterm_to_mpirun_keeps_a_checkpoint_that_takes_seconds_to_gather() {
+    // mpirun answers SIGTERM with SIGCONT to the processes, SIGTERM a second later and
+    // SIGKILL a second after that: far less than the gathered checkpoint of 10^6 grains
+    // takes. The processes write their parts of it at once on SIGCONT, stop at SIGTERM in
+    // the same step, and the parts resume exactly (here in one process).
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = million(dir.path(), 2, 20);
+    let name = scenario.to_str().unwrap();
+    let child = mpirun(2, &["run", name, "-o", "cut", "-q"], dir.path())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let cut = dir.path().join("cut");
+    wait_for_frames(&cut, 2);
+    std::thread::sleep(Duration::from_millis(1500));
+    let asked = Instant::now();
+    unsafe { libc::kill(child.id() as i32, libc::SIGTERM) };
+    let out = child.wait_with_output().unwrap();
+    let ended = asked.elapsed();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(ended < Duration::from_secs(5), "mpirun took {ended:?}");
+    assert_eq!(err.matches("interrupted after step").count(), 1, "{err}");
+    assert!(frames_out(&cut) < 4, "stopped after the run: {err}");
+    run(
+        1,
+        &[
+            "run",
+            name,
+            "-o",
+            "cut",
+            "-q",
+            "--resume",
+            "cut/checkpoint.bin",
+        ],
+        dir.path(),
+    );
+    run(1, &["run", name, "-o", "whole", "-q"], dir.path());
+    for file in ["particles000002.csv", "log.csv"] {
+        let a = std::fs::read(dir.path().join("whole").join(file)).unwrap();
+        let b = std::fs::read(cut.join(file)).unwrap();
+        assert!(a == b, "{file} differs after the stop and resume");
+    }
+}
+
+#[test]
+fn sigusr1_to_mpirun_stops_the_run_with_a_checkpoint_and_exit_130() {
+    // mpirun passes SIGUSR1 on and waits: the way to stop a split run with no deadline.
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = silo(dir.path(), 600);
+    let name = scenario.to_str().unwrap();
+    let child = mpirun(2, &["run", name, "-o", "cut", "-q"], dir.path())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let cut = dir.path().join("cut");
+    wait_for_frames(&cut, 20);
+    unsafe { libc::kill(child.id() as i32, libc::SIGUSR1) };
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{err}");
+    assert_eq!(err.matches("interrupted after step").count(), 1, "{err}");
+    // The parts were joined into the one file, and the run resumes from it.
+    let names: Vec<String> = std::fs::read_dir(&cut)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    assert!(names.iter().all(|n| !n.contains(".part-")), "{names:?}");
+    assert!(
+        names.iter().any(|n| n == "checkpoint.bin") && names.iter().any(|n| n == "interrupted.csv")
+    );
+    let resumed = mpirun(
+        3,
+        &[
+            "run",
+            name,
+            "-o",
+            "cut",
+            "-q",
+            "--resume",
+            "cut/checkpoint.bin",
+        ],
+        dir.path(),
+    )
+    .output()
+    .unwrap();
+    assert!(
+        resumed.status.success(),
+        "{}",
+        String::from_utf8_lossy(&resumed.stderr)
+    );
+    assert_eq!(frames_out(&cut), 602);
+}

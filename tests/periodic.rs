@@ -164,7 +164,7 @@ fn a_periodic_run_resumes_bit_for_bit() {
         whole.step().unwrap();
         first.step().unwrap();
     }
-    let snapshot = first.snapshot();
+    let snapshot = first.snapshot().unwrap();
     let mut resumed = Simulation::restore(first.scenario.clone(), snapshot).unwrap();
     for _ in 0..1500 {
         whole.step().unwrap();

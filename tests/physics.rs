@@ -423,7 +423,7 @@ fn contacts_forget_their_springs_when_they_end() {
     let mut touched = (false, false);
     for _ in 0..20_000 {
         s.step().unwrap();
-        let snapshot = s.snapshot();
+        let snapshot = s.snapshot().unwrap();
         touched.0 |= !snapshot.pair_history.is_empty();
         touched.1 |= !snapshot.face_history.is_empty();
     }
@@ -433,7 +433,7 @@ fn contacts_forget_their_springs_when_they_end() {
         pairs > 0 && faces > 0,
         "still listed: {pairs} pairs, {faces} faces"
     );
-    let snapshot = s.snapshot();
+    let snapshot = s.snapshot().unwrap();
     assert!(
         snapshot.pair_history.is_empty(),
         "{:?}",

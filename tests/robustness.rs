@@ -603,3 +603,96 @@ fn a_run_killed_without_warning_resumes_from_its_timed_checkpoint() {
         assert!(x == y, "{name} differs after resuming");
     }
 }
+
+/// Starts `tinydem run s.toml -q -o out` in `dir`, its stderr piped, and waits for the
+/// frame file `first`.
+fn start_run(dir: &Path, first: &str) -> std::process::Child {
+    let child = Command::new(env!("CARGO_BIN_EXE_tinydem"))
+        .args(["run", "s.toml", "-q", "-o", "out"])
+        .current_dir(dir)
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while !dir.join("out").join(first).exists() {
+        assert!(start.elapsed() < Duration::from_secs(60), "run too slow");
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    child
+}
+
+fn signal(child: &std::process::Child, signal: i32) {
+    // SAFETY: kill sends a signal to the child's process id; nothing else.
+    assert_eq!(unsafe { libc::kill(child.id() as i32, signal) }, 0);
+}
+
+/// SIGCONT (which launchers send a second before SIGTERM) writes a checkpoint and the run
+/// goes on; SIGUSR1 (which mpirun passes on and waits for) stops it like SIGTERM.
+#[test]
+fn sigcont_checkpoints_and_goes_on_and_sigusr1_stops() {
+    let t = tempfile::tempdir().unwrap();
+    pile(t.path(), 60);
+    let child = start_run(t.path(), "particles000001.csv");
+    signal(&child, libc::SIGCONT);
+    let ckpt = t.path().join("out/checkpoint.bin");
+    let start = Instant::now();
+    while !ckpt.exists() {
+        assert!(start.elapsed() < Duration::from_secs(30), "no checkpoint");
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    let first = checkpoint::decode(&std::fs::read(&ckpt).unwrap(), None).unwrap();
+    // Still running: more frames come.
+    let next = format!("particles{:06}.csv", first.steps / 2000 + 2);
+    while !t.path().join("out").join(&next).exists() {
+        assert!(start.elapsed() < Duration::from_secs(60), "the run stopped");
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    signal(&child, libc::SIGUSR1);
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{err}");
+    assert_contains(
+        &err,
+        &[
+            &format!("SIGCONT: checkpoint of step {} written", first.steps),
+            "interrupted after step",
+        ],
+    );
+    let last = checkpoint::decode(&std::fs::read(&ckpt).unwrap(), None).unwrap();
+    assert!(last.steps > first.steps + 2000 && last.steps < 60 * 2000);
+}
+
+/// A run blocked in a write (here: a FIFO where the next frame's temporary file goes, as a
+/// hung network file system would) cannot see the stop it is asked for; a second signal
+/// ends it at once.
+#[test]
+fn a_second_signal_ends_a_blocked_run_at_once() {
+    let t = tempfile::tempdir().unwrap();
+    pile(t.path(), 60);
+    let child = start_run(t.path(), "particles000000.csv");
+    let fifo = t.path().join("out/.particles000003.csv.tmp");
+    let made = Command::new("mkfifo").arg(&fifo).status().unwrap();
+    assert!(made.success());
+    let frames = t.path().join("out/frames.csv");
+    let start = Instant::now();
+    while std::fs::read_to_string(&frames).map_or(0, |f| f.lines().count()) < 4 {
+        assert!(start.elapsed() < Duration::from_secs(60), "run too slow");
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    // Frame 2 is out; frame 3 cannot be written.
+    std::thread::sleep(Duration::from_millis(500));
+    signal(&child, libc::SIGTERM);
+    std::thread::sleep(Duration::from_millis(500));
+    let mut child = child;
+    assert!(
+        child.try_wait().unwrap().is_none(),
+        "blocked, it cannot stop"
+    );
+    let asked = Instant::now();
+    signal(&child, libc::SIGTERM);
+    let out = child.wait_with_output().unwrap();
+    assert!(asked.elapsed() < Duration::from_secs(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{err}");
+    assert_contains(&err, &["a second signal: stopping now"]);
+}

@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::Ordering;
 
 use glam::{DQuat, DVec3};
 use numpy::ndarray::{Array1, Array2};
@@ -337,7 +337,7 @@ fn run(
     let s = Scenario::load(&scenario).map_err(error)?;
     let out = output.unwrap_or_else(|| s.output_dir.clone());
     let pool = pool(threads)?;
-    let stop = AtomicBool::new(false);
+    let requests = tinydem::run::Requests::default();
     let options = Options {
         verbosity: if quiet {
             Verbosity::Quiet
@@ -348,7 +348,7 @@ fn run(
         from: from_checkpoint.as_deref(),
         overwrite,
         force,
-        stop: Some(&stop),
+        requests: Some(&requests),
     };
     // The run on a thread of its own; this one watches for Ctrl-C, which stops the run
     // after its current step with a checkpoint (as on the command line).
@@ -358,7 +358,7 @@ fn run(
         while !running.is_finished() {
             py.detach(|| std::thread::sleep(std::time::Duration::from_millis(20)));
             if let Err(e) = py.check_signals() {
-                stop.store(true, Ordering::Relaxed);
+                requests.stop.store(true, Ordering::Relaxed);
                 interrupt.get_or_insert(e);
             }
         }
@@ -371,7 +371,10 @@ fn run(
     match (result, interrupt) {
         (Ok(_), _) => Ok(out),
         (Err(e), Some(signal)) => {
-            eprintln!("{e:#}");
+            // A stop with its checkpoint is said by the run itself.
+            if e.downcast_ref::<tinydem::run::Interrupted>().is_none() {
+                eprintln!("{e:#}");
+            }
             Err(signal)
         }
         (Err(e), None) => Err(error(e)),

@@ -27,6 +27,9 @@ use crate::scenario::{FrictionSprings, Scenario};
 use crate::simulation::{Outflow, Removed, Snapshot, Wrench};
 use crate::spawn::{RegionState, SpawnerState};
 
+pub mod parts;
+pub use parts::{is_part, join, load_parts, newer_parts, part_path, remove_parts, save_part};
+
 const MAGIC: &[u8; 12] = b"TINYDEM CKPT";
 const VERSION: u32 = 3;
 /// The oldest version this program reads.
@@ -116,8 +119,29 @@ fn put_history(out: &mut Vec<u8>, h: &[(u32, u32, Springs)]) {
 
 /// Encodes a snapshot.
 pub fn encode(snapshot: &Snapshot, fingerprint: u64) -> Vec<u8> {
+    let mut out = Vec::new();
+    encode_into(&mut out, snapshot, fingerprint);
+    out
+}
+
+/// The bytes a checkpoint of `snapshot` takes (a bound).
+fn encoded_size(s: &Snapshot) -> usize {
+    let records = s.particles.len() * (122 + 24)
+        + s.lonely.len() * 12
+        + (s.pair_history.len() + s.face_history.len()) * 64;
+    256 + records
+        + s.scenario.len()
+        + 16 * s.mesh_files.len()
+        + 48 * s.wall_sums.len()
+        + 16 * s.removed.outlets.len()
+        + 17 * s.spawner.regions.len()
+}
+
+/// Appends the checkpoint of `snapshot` to `out` (its checksum covers what it appends).
+pub fn encode_into(out: &mut Vec<u8>, snapshot: &Snapshot, fingerprint: u64) {
+    let start = out.len();
+    out.reserve(encoded_size(snapshot));
     let p = &snapshot.particles;
-    let mut out = Vec::with_capacity(64 + p.len() * 144);
     out.extend_from_slice(MAGIC);
     out.extend_from_slice(&VERSION.to_le_bytes());
     out.extend_from_slice(&fingerprint.to_le_bytes());
@@ -125,13 +149,13 @@ pub fn encode(snapshot: &Snapshot, fingerprint: u64) -> Vec<u8> {
     out.extend_from_slice(&snapshot.built_at.to_le_bytes());
     out.extend_from_slice(&snapshot.spawner.word_pos.to_le_bytes());
     out.push(snapshot.spawner.pending_radius.is_some() as u8);
-    put_f64s(&mut out, &[snapshot.spawner.pending_radius.unwrap_or(0.0)]);
+    put_f64s(out, &[snapshot.spawner.pending_radius.unwrap_or(0.0)]);
     out.extend_from_slice(&p.next_id.to_le_bytes());
     out.extend_from_slice(&(p.len() as u64).to_le_bytes());
     for (k, q) in p.iter().enumerate() {
         out.extend_from_slice(&p.id[k].to_le_bytes());
         put_f64s(
-            &mut out,
+            out,
             &[
                 q.x.x, q.x.y, q.x.z, q.radius, q.v.x, q.v.y, q.v.z, q.q.w, q.q.x, q.q.y, q.q.z,
                 q.w.x, q.w.y, q.w.z,
@@ -144,29 +168,29 @@ pub fn encode(snapshot: &Snapshot, fingerprint: u64) -> Vec<u8> {
     out.push(built as u8);
     if built {
         for a in &snapshot.anchors {
-            put_f64s(&mut out, &[a.x, a.y, a.z]);
+            put_f64s(out, &[a.x, a.y, a.z]);
         }
     }
     out.extend_from_slice(&(snapshot.lonely.len() as u64).to_le_bytes());
     for &(i, allowance) in &snapshot.lonely {
         out.extend_from_slice(&i.to_le_bytes());
-        put_f64s(&mut out, &[allowance]);
+        put_f64s(out, &[allowance]);
     }
-    put_history(&mut out, &snapshot.pair_history);
-    put_history(&mut out, &snapshot.face_history);
+    put_history(out, &snapshot.pair_history);
+    put_history(out, &snapshot.face_history);
     let removed = &snapshot.removed;
     let put_outflow = |out: &mut Vec<u8>, o: &Outflow| {
         out.extend_from_slice(&o.count.to_le_bytes());
         put_f64s(out, &[o.mass]);
     };
-    put_outflow(&mut out, &removed.domain);
+    put_outflow(out, &removed.domain);
     out.extend_from_slice(&(removed.outlets.len() as u64).to_le_bytes());
     for o in &removed.outlets {
-        put_outflow(&mut out, o);
+        put_outflow(out, o);
     }
     out.extend_from_slice(&(snapshot.wall_sums.len() as u64).to_le_bytes());
     for w in &snapshot.wall_sums {
-        put_f64s(&mut out, &[w.f.x, w.f.y, w.f.z, w.tau.x, w.tau.y, w.tau.z]);
+        put_f64s(out, &[w.f.x, w.f.y, w.f.z, w.tau.x, w.tau.y, w.tau.z]);
     }
     out.extend_from_slice(&(snapshot.scenario.len() as u64).to_le_bytes());
     out.extend_from_slice(snapshot.scenario.as_bytes());
@@ -180,11 +204,10 @@ pub fn encode(snapshot: &Snapshot, fingerprint: u64) -> Vec<u8> {
     for r in regions {
         out.extend_from_slice(&r.inserted.to_le_bytes());
         out.push(r.pending_radius.is_some() as u8);
-        put_f64s(&mut out, &[r.pending_radius.unwrap_or(0.0)]);
+        put_f64s(out, &[r.pending_radius.unwrap_or(0.0)]);
     }
-    let crc = crc32fast::hash(&out);
+    let crc = crc32fast::hash(&out[start..]);
     out.extend_from_slice(&crc.to_le_bytes());
-    out
 }
 
 /// A cursor over the checkpoint bytes that reports truncation clearly.
@@ -443,24 +466,40 @@ pub fn decode(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<Snapsho
     })
 }
 
-/// Writes a checkpoint atomically (temporary file, then rename).
-pub fn save(path: &Path, snapshot: &Snapshot, fingerprint: u64) -> Result<()> {
+/// Writes `bytes` to `path` atomically: into a temporary file beside it (`.NAME.tmp`,
+/// removed on failure), synced, then renamed over `path`. The file at `path` is the old one
+/// or the new one, never a part of either.
+fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     let name = path
         .file_name()
         .map_or_else(|| "checkpoint".into(), |n| n.to_string_lossy());
     let tmp = path.with_file_name(format!(".{name}.tmp"));
     let write = || -> std::io::Result<()> {
-        let file = std::fs::File::create(&tmp)?;
-        let mut w = std::io::BufWriter::new(file);
-        std::io::Write::write_all(&mut w, &encode(snapshot, fingerprint))?;
-        w.into_inner().map_err(|e| e.into_error())?.sync_all()?;
+        let mut file = std::fs::File::create(&tmp)?;
+        std::io::Write::write_all(&mut file, bytes)?;
+        file.sync_all()?;
         std::fs::rename(&tmp, path)
     };
-    write().with_context(|| format!("cannot write checkpoint {}", path.display()))
+    write().inspect_err(|_| {
+        let _ = std::fs::remove_file(&tmp);
+    })
 }
 
-/// Reads a checkpoint, for the scenario and mesh of `fingerprint` if given.
+/// Writes a checkpoint atomically (temporary file, then rename), and then removes the parts
+/// of an earlier one at `path` (see [`parts`]).
+pub fn save(path: &Path, snapshot: &Snapshot, fingerprint: u64) -> Result<()> {
+    write_atomically(path, &encode(snapshot, fingerprint))
+        .with_context(|| format!("cannot write checkpoint {}", path.display()))?;
+    remove_parts(path, None);
+    Ok(())
+}
+
+/// Reads a checkpoint, for the scenario and mesh of `fingerprint` if given: the file at
+/// `path`, or the parts beside it if a stop wrote them later (see [`parts`]).
 pub fn load(path: &Path, fingerprint: Option<u64>) -> Result<Snapshot> {
+    if let Some(parts) = newer_parts(path) {
+        return load_parts(&parts, fingerprint);
+    }
     let bytes = crate::files::read(path)
         .with_context(|| format!("cannot read checkpoint {}", path.display()))?;
     decode(&bytes, fingerprint).with_context(|| format!("cannot resume from {}", path.display()))
@@ -470,7 +509,7 @@ pub fn load(path: &Path, fingerprint: Option<u64>) -> Result<Snapshot> {
 mod tests {
     use super::*;
 
-    fn snapshot() -> Snapshot {
+    pub(super) fn snapshot() -> Snapshot {
         let mut particles = Particles::default();
         particles.push(Particle {
             x: DVec3::new(0.1, 0.2, 0.3),
