@@ -82,14 +82,8 @@ pub fn write_frame(dir: &Path, k: u64, p: &Particles, extra: Extra) -> Result<Pa
 /// Writes particles atomically to `dir/name`.
 pub fn write_frame_as(dir: &Path, name: &str, p: &Particles, extra: Extra) -> Result<PathBuf> {
     let path = dir.join(name);
-    let tmp = dir.join(format!(".{name}.tmp"));
-    let write = || -> std::io::Result<()> {
-        let mut w = std::io::BufWriter::with_capacity(1 << 20, std::fs::File::create(&tmp)?);
-        write_particles(&mut w, p, extra)?;
-        w.into_inner().map_err(|e| e.into_error())?.sync_data()?;
-        std::fs::rename(&tmp, &path)
-    };
-    write().with_context(|| format!("cannot write frame {}", path.display()))?;
+    crate::files::write_atomically(&path, |w| write_particles(w, p, extra))
+        .with_context(|| format!("cannot write frame {}", path.display()))?;
     Ok(path)
 }
 
@@ -100,9 +94,7 @@ pub const CONTACT_COLUMNS: &str = "id_i,id_j,face,x,y,z,fn_x,fn_y,fn_z,ft_x,ft_y
 /// `face` -1 where it does not apply.
 pub fn write_contacts(dir: &Path, name: &str, contacts: &[ContactRecord]) -> Result<PathBuf> {
     let path = dir.join(name);
-    let tmp = dir.join(format!(".{name}.tmp"));
-    let write = || -> std::io::Result<()> {
-        let mut w = std::io::BufWriter::with_capacity(1 << 20, std::fs::File::create(&tmp)?);
+    let write = |w: &mut std::io::BufWriter<std::fs::File>| -> std::io::Result<()> {
         writeln!(w, "{CONTACT_COLUMNS}")?;
         let mut buf = ryu::Buffer::new();
         let mut line = String::with_capacity(256);
@@ -127,10 +119,10 @@ pub fn write_contacts(dir: &Path, name: &str, contacts: &[ContactRecord]) -> Res
             line.push('\n');
             w.write_all(line.as_bytes())?;
         }
-        w.into_inner().map_err(|e| e.into_error())?.sync_data()?;
-        std::fs::rename(&tmp, &path)
+        Ok(())
     };
-    write().with_context(|| format!("cannot write {}", path.display()))?;
+    crate::files::write_atomically(&path, write)
+        .with_context(|| format!("cannot write {}", path.display()))?;
     Ok(path)
 }
 

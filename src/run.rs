@@ -594,9 +594,7 @@ fn write_run_toml(dir: &Path, s: &Scenario) -> Result<()> {
         s.absolute().to_toml()
     );
     let path = dir.join(RUN_TOML);
-    let tmp = dir.join(format!(".{RUN_TOML}.tmp"));
-    std::fs::write(&tmp, text)
-        .and_then(|()| std::fs::rename(&tmp, &path))
+    crate::files::write_bytes_atomically(&path, text.as_bytes())
         .with_context(|| format!("cannot write {}", path.display()))
 }
 

@@ -168,19 +168,8 @@ impl Vtu {
 
 /// Writes `parts` to a temporary file and renames it to `path`.
 fn atomic_write(path: &Path, parts: &[&[u8]]) -> Result<()> {
-    let name = path
-        .file_name()
-        .map_or_else(|| "vtk".into(), |n| n.to_string_lossy());
-    let tmp = path.with_file_name(format!(".{name}.tmp"));
-    let write = || -> std::io::Result<()> {
-        let mut w = std::io::BufWriter::with_capacity(1 << 20, std::fs::File::create(&tmp)?);
-        for p in parts {
-            w.write_all(p)?;
-        }
-        w.into_inner().map_err(|e| e.into_error())?.sync_data()?;
-        std::fs::rename(&tmp, path)
-    };
-    write().with_context(|| format!("cannot write {}", path.display()))
+    crate::files::write_atomically(path, |w| parts.iter().try_for_each(|p| w.write_all(p)))
+        .with_context(|| format!("cannot write {}", path.display()))
 }
 
 /// Writes the particles as a `.vtu` file, in id order.

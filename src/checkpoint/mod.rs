@@ -466,29 +466,10 @@ pub fn decode(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<Snapsho
     })
 }
 
-/// Writes `bytes` to `path` atomically: into a temporary file beside it (`.NAME.tmp`,
-/// removed on failure), synced, then renamed over `path`. The file at `path` is the old one
-/// or the new one, never a part of either.
-fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let name = path
-        .file_name()
-        .map_or_else(|| "checkpoint".into(), |n| n.to_string_lossy());
-    let tmp = path.with_file_name(format!(".{name}.tmp"));
-    let write = || -> std::io::Result<()> {
-        let mut file = std::fs::File::create(&tmp)?;
-        std::io::Write::write_all(&mut file, bytes)?;
-        file.sync_all()?;
-        std::fs::rename(&tmp, path)
-    };
-    write().inspect_err(|_| {
-        let _ = std::fs::remove_file(&tmp);
-    })
-}
-
 /// Writes a checkpoint atomically (temporary file, then rename), and then removes the parts
 /// of an earlier one at `path` (see [`parts`]).
 pub fn save(path: &Path, snapshot: &Snapshot, fingerprint: u64) -> Result<()> {
-    write_atomically(path, &encode(snapshot, fingerprint))
+    crate::files::write_bytes_atomically(path, &encode(snapshot, fingerprint))
         .with_context(|| format!("cannot write checkpoint {}", path.display()))?;
     remove_parts(path, None);
     Ok(())

@@ -19,7 +19,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail, ensure};
 use glam::DVec3;
 
-use super::{decode, encode_into, write_atomically};
+use super::{decode, encode_into};
 use crate::contact::Springs;
 use crate::particles::{Particle, Particles};
 use crate::simulation::Snapshot;
@@ -90,7 +90,7 @@ pub fn save_part(
     bytes.extend_from_slice(&(n as u32).to_le_bytes());
     encode_into(&mut bytes, piece, fingerprint);
     let part = part_path(path, piece.steps, k, n);
-    write_atomically(&part, &bytes)
+    crate::files::write_bytes_atomically(&part, &bytes)
         .with_context(|| format!("cannot write checkpoint part {}", part.display()))
 }
 
