@@ -701,6 +701,18 @@ impl Simulation {
         check_materials(&snapshot.particles, &sim.scenario)
             .map_err(|e| misfit(format!("{e:#}")))?;
         sim.particles = snapshot.particles;
+        let (regions, spawn) = (snapshot.spawner.regions.len(), sim.scenario.spawn.len());
+        if regions > spawn {
+            return Err(misfit(format!(
+                "it counts the insertions of {regions} [[spawn]] regions, the scenario has {spawn}"
+            )));
+        }
+        let (sums, files) = (snapshot.wall_sums.len(), sim.mesh_files.len());
+        if sums != 0 && sums != files {
+            return Err(misfit(format!(
+                "it sums the loads on {sums} mesh files, the scenario has {files}"
+            )));
+        }
         sim.spawner = Spawner::resume(sim.scenario.simulation.seed, snapshot.spawner);
         if snapshot.removed.outlets.len() > sim.removed.outlets.len() {
             return Err(misfit(format!(

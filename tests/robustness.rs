@@ -366,6 +366,33 @@ fn forged_checkpoints_are_refused_by_their_content() {
         "out",
         &["the friction springs of contact"],
     );
+    // Counts that do not fit the scenario: spawn regions, mesh files, outlets.
+    type Recount = fn(&mut tinydem::simulation::Snapshot);
+    let recounts: [(Recount, &str); 3] = [
+        (
+            |s| s.spawner.regions = vec![Default::default(); 2],
+            "the insertions of 2 [[spawn]] regions, the scenario has 0",
+        ),
+        (
+            |s| s.wall_sums = vec![Default::default(); 3],
+            "the loads on 3 mesh files, the scenario has 1",
+        ),
+        (
+            |s| s.removed.outlets = vec![Default::default(); 1],
+            "it counts 1 outlets, the scenario has 0",
+        ),
+    ];
+    for (k, (recount, expected)) in recounts.iter().enumerate() {
+        let mut snapshot = good.clone();
+        recount(&mut snapshot);
+        let name = format!("recounted{k}.bin");
+        std::fs::write(
+            t.path().join(&name),
+            checkpoint::encode(&snapshot, fingerprint),
+        )
+        .unwrap();
+        assert_resume_refused(t.path(), "s.toml", &name, &format!("count{k}"), &[expected]);
+    }
 }
 
 /// The `run.toml` of a resumed run reruns its scenario: it keeps `[input] particles` (it
