@@ -12,7 +12,7 @@ use crate::checkpoint;
 use crate::contact::ContactLaw;
 use crate::integrate::Inertia;
 use crate::mesh::Contacts;
-use crate::run::{OUTLETS, WALLS};
+use crate::output::{OUTLETS, WALLS};
 use crate::scenario::{FrictionSprings, Scenario};
 use crate::simulation::Simulation;
 

@@ -20,6 +20,7 @@ pub mod lock;
 pub mod mesh;
 pub mod motion;
 pub mod neighbours;
+pub mod output;
 pub mod particles;
 pub mod plot;
 pub mod render;

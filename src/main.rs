@@ -629,12 +629,6 @@ fn bench(
     Ok(())
 }
 
-/// The `run.toml` an output directory holds, if any: the scenario of the run that wrote it.
-fn run_toml(dir: &std::path::Path) -> Option<PathBuf> {
-    let p = dir.join(tinydem::run::RUN_TOML);
-    p.is_file().then_some(p)
-}
-
 /// `tinydem analyze`: a table of measurements, one row per frame.
 fn analyze_command(
     dir: &std::path::Path,
@@ -646,7 +640,7 @@ fn analyze_command(
     plot: Option<(PathBuf, String)>,
 ) -> Result<()> {
     use tinydem::analyze::*;
-    let s = match scenario.or_else(|| run_toml(dir)) {
+    let s = match scenario.or_else(|| tinydem::output::run_toml(dir)) {
         Some(p) => Scenario::load(&p)?,
         None => Scenario::parse("", std::path::Path::new("defaults"))?,
     };

@@ -590,12 +590,6 @@ pub struct Rendered {
     pub notes: Vec<String>,
 }
 
-/// The `run.toml` beside a frame or in a directory.
-fn run_toml(dir: &Path) -> Option<PathBuf> {
-    let p = dir.join(crate::run::RUN_TOML);
-    p.is_file().then_some(p)
-}
-
 /// The number of a frame file `particlesNNNNNN.csv`.
 fn frame_number(p: &Path) -> Option<u64> {
     let name = p.file_stem()?.to_str()?;
@@ -604,7 +598,7 @@ fn frame_number(p: &Path) -> Option<u64> {
 
 /// The times of the frames listed in a directory's `frames.csv`, by frame number.
 fn frame_times(dir: &Path) -> std::collections::HashMap<u64, f64> {
-    let Ok(text) = std::fs::read_to_string(dir.join(crate::run::FRAMES)) else {
+    let Ok(text) = std::fs::read_to_string(dir.join(crate::output::FRAMES)) else {
         return Default::default();
     };
     text.lines()
@@ -635,7 +629,9 @@ pub fn render_path(
     } else {
         path.parent().unwrap_or(Path::new(".")).to_path_buf()
     };
-    let scenario = scenario.map(Path::to_path_buf).or_else(|| run_toml(&dir));
+    let scenario = scenario
+        .map(Path::to_path_buf)
+        .or_else(|| crate::output::run_toml(&dir));
     let mut sim = match &scenario {
         Some(s) => Some(Simulation::new(Scenario {
             particles: None,

@@ -292,20 +292,22 @@ impl Simulation {
         let name = path
             .file_name()
             .ok_or_else(|| PyValueError::new_err("write_frame needs a file name"))?;
-        tinydem::csv::write_frame_as(
-            dir.unwrap_or(std::path::Path::new(".")),
-            &name.to_string_lossy(),
-            &self.sim.particles_in_domain(),
-            extra,
-        )
-        .map(|_| ())
-        .map_err(error)
+        guarded(|| {
+            tinydem::csv::write_frame_as(
+                dir.unwrap_or(std::path::Path::new(".")),
+                &name.to_string_lossy(),
+                &self.sim.particles_in_domain(),
+                extra,
+            )
+            .map(|_| ())
+            .map_err(error)
+        })
     }
 
     /// Writes a checkpoint: `tinydem run --resume` (or `Simulation(..., resume=path)`)
     /// continues it exactly; `--from` starts a new stage from it.
     fn checkpoint(&self, path: PathBuf) -> PyResult<()> {
-        tinydem::run::write_checkpoint(&path, &self.sim).map_err(error)
+        guarded(|| tinydem::run::write_checkpoint(&path, &self.sim).map_err(error))
     }
 
     fn __repr__(&self) -> String {
@@ -447,8 +449,8 @@ fn render<'py>(
         bounds: bounds.map(|(a, b)| (DVec3::from_array(a), DVec3::from_array(b))),
     };
     let animation = Animation::of(gif, movie);
-    let done = py
-        .detach(|| {
+    let done = guarded(|| {
+        py.detach(|| {
             tinydem::render::render_path(
                 &path,
                 output.as_deref(),
@@ -459,7 +461,8 @@ fn render<'py>(
                 animation,
             )
         })
-        .map_err(error)?;
+        .map_err(error)
+    })?;
     let d = PyDict::new(py);
     d.set_item("pictures", done.pictures)?;
     d.set_item("animation", done.animation)?;
@@ -474,7 +477,7 @@ fn read_csv<'py>(
     py: Python<'py>,
     path: PathBuf,
 ) -> PyResult<(Vec<String>, Bound<'py, PyArray2<f64>>)> {
-    let text = std::fs::read_to_string(&path)
+    let text = tinydem::files::read_to_string(&path)
         .map_err(|e| PyRuntimeError::new_err(format!("cannot read {}: {e}", path.display())))?;
     let mut lines = text.lines();
     let header: Vec<String> = lines
