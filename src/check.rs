@@ -354,7 +354,7 @@ impl OutputEstimate {
             per_frame += (1 + s.meshes.len() as u64) * (2 * WHOLE + 7 * FLOAT);
         }
         // The checkpoint: the state of each particle and the springs of its contacts, twice.
-        let springs = std::mem::size_of::<crate::contact::Springs>() as u64 + 8;
+        let springs = std::mem::size_of::<crate::springs::Springs>() as u64 + 8;
         once += 2 * (n * (14 * 8 + 10) + n * CONTACTS_PER_PARTICLE * springs);
         OutputEstimate {
             files: files + files_per_frame * frames,

@@ -24,15 +24,7 @@ use glam::DVec3;
 use crate::lanes::{Displacement, Gather, Lanes};
 use crate::motion::RigidVelocity;
 use crate::scenario::{FrictionSprings, Material, PairCoefficients, Scenario};
-
-/// Displacements of the three static friction springs of one contact (Table 3):
-/// sliding `u_s`, rolling `u_r` and twisting `u_t`. Zero at first touch.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Springs<T: Lanes = f64> {
-    pub u_s: T::Vec,
-    pub u_r: T::Vec,
-    pub u_t: T,
-}
+pub use crate::springs::Springs;
 
 /// The constants of the contact law for one pair of materials (a particle's with another
 /// particle's, or with a wall's), derived once: one per pair, or one per lane of a group.

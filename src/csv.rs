@@ -10,7 +10,7 @@ use anyhow::{Context, Result, bail};
 use glam::{DQuat, DVec3};
 
 use crate::particles::{Particle, Particles};
-use crate::simulation::{ContactRecord, Partner};
+use crate::records::{ContactRecord, Partner};
 
 pub const COLUMNS: [&str; 14] = [
     "x", "y", "z", "R", "vx", "vy", "vz", "q0", "q1", "q2", "q3", "wx", "wy", "wz",

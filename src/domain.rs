@@ -31,13 +31,14 @@ use glam::DVec3;
 use rustc_hash::{FxHashMap, FxHashSet};
 
 use crate::comm::{Comm, Reader, Writer};
-use crate::contact::Springs;
 use crate::exact::Sum6;
 use crate::integrate::Inertia;
 use crate::neighbours::face_grid;
 use crate::particles::{Particle, Particles};
-use crate::simulation::{ContactRecord, Outflow, Partner, Simulation, Snapshot};
+use crate::records::{ContactRecord, Outflow, Partner, Snapshot};
+use crate::simulation::Simulation;
 use crate::spawn::Spawner;
+use crate::springs::Springs;
 
 /// Past this ratio of the largest process's particle count to the mean, the boxes are cut
 /// anew at the next rebuild.

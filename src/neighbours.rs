@@ -17,9 +17,9 @@ use glam::{DVec3, IVec3};
 use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 
-use crate::contact::Springs;
 use crate::mesh::Face;
 use crate::particles::Particles;
+use crate::springs::Springs;
 
 /// Below this many items a parallel loop runs on one thread (spawn overhead dominates).
 pub const MIN_PARALLEL_LEN: usize = 64;

@@ -75,7 +75,7 @@ pub struct Summary {
     pub warnings: usize,
     pub advice: String,
     /// Particles removed by the outlets and the domain bounds.
-    pub removed: crate::simulation::Removed,
+    pub removed: crate::records::Removed,
 }
 
 /// Per-pair warning lines shown during a run; further pairs are only counted.

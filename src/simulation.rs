@@ -13,7 +13,7 @@ use anyhow::{Result, bail};
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::contact::{Body, Coefficients, ContactLaw, Kinematics, Other, Springs};
+use crate::contact::{Body, Coefficients, ContactLaw, Kinematics, Other};
 use crate::domain::Domain;
 use crate::exact::{Scale, Scales8, Sum6, pack};
 use crate::integrate::{Density, Inertia, Response, State, advance};
@@ -25,8 +25,10 @@ use crate::neighbours::{
     Store, cut, face_grid,
 };
 use crate::particles::Particles;
+pub use crate::records::{ContactRecord, Outflow, Partner, Removed, Snapshot, Wrench};
 use crate::scenario::{MeshSource, Scenario};
 use crate::spawn::{Spawner, SpawnerState};
+use crate::springs::Springs;
 use crate::surface::{self, Candidate, Fate};
 
 /// Contacts per group evaluated together: 8 doubles fill an AVX-512 register, two AVX ones.
@@ -277,41 +279,6 @@ impl StageTimes {
     }
 }
 
-/// Everything needed to continue a run bit for bit: particles (in storage order, with their
-/// ids), step count, the spawner's place in its random stream, the contact history (the
-/// friction springs of every touching pair, Table 3, by particle id), and what rebuilds the
-/// neighbour lists of the last rebuild exactly: its step, the positions it anchored the
-/// particles at and its lonely particles.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Snapshot {
-    pub steps: u64,
-    pub built_at: u64,
-    pub particles: Particles,
-    pub spawner: SpawnerState,
-    pub anchors: Vec<DVec3>,
-    pub lonely: Vec<(u32, f64)>,
-    /// Particle pairs by (lower id, higher id) and particle-face contacts by (id, face).
-    pub pair_history: Vec<(u32, u32, Springs)>,
-    pub face_history: Vec<(u32, u32, Springs)>,
-    /// The particles removed so far.
-    pub removed: Removed,
-    /// The loads on the mesh files summed since the last frame (`[output] wall_forces`).
-    pub wall_sums: Vec<Wrench>,
-    /// The resolved scenario of the run (`Scenario::to_toml`), to tell what a staged run
-    /// changes.
-    pub scenario: String,
-    /// Face count and a hash of the faces of each mesh file, to find them in the mesh of a
-    /// staged run.
-    pub mesh_files: Vec<(u64, u64)>,
-}
-
-/// The partner of a particle in a contact.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub enum Partner {
-    Particle(usize),
-    Face(usize),
-}
-
 /// An overlap deeper than `limit`, the smaller radius (the particle's, against a face):
 /// a warning; deeper than twice that, a sign of instability.
 #[derive(Clone, Copy, Debug)]
@@ -406,44 +373,6 @@ impl std::fmt::Display for Unstable {
 
 impl std::error::Error for Unstable {}
 
-/// Particles removed, and their mass.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Outflow {
-    pub count: u64,
-    /// \[M\]
-    pub mass: f64,
-}
-
-/// The particles removed so far: by each `[[outlets]]` box, and for leaving the `[domain]`.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Removed {
-    pub outlets: Vec<Outflow>,
-    pub domain: Outflow,
-}
-
-impl Removed {
-    /// All particles removed so far.
-    pub fn count(&self) -> u64 {
-        self.domain.count + self.outlets.iter().map(|o| o.count).sum::<u64>()
-    }
-}
-
-/// The force and torque that particles exert on a body (a mesh file).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Wrench {
-    /// [ML/T²]
-    pub f: DVec3,
-    /// [ML²/T²], about the body's reference point.
-    pub tau: DVec3,
-}
-
-impl std::ops::AddAssign for Wrench {
-    fn add_assign(&mut self, o: Wrench) {
-        self.f += o.f;
-        self.tau += o.tau;
-    }
-}
-
 /// The reports of every process of a split run, in the order they are told.
 fn gather_told(
     comm: &dyn crate::comm::Comm,
@@ -482,22 +411,6 @@ fn check_materials(p: &Particles, s: &Scenario) -> Result<()> {
         );
     }
     Ok(())
-}
-
-/// A contact of the network (`Simulation::contact_network`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ContactRecord {
-    /// The particle (its id; the lower one of a pair).
-    pub id: u32,
-    /// The other particle (its id) or the face (its index in the mesh).
-    pub with: Partner,
-    /// Where the two touch: x_i - r_i n (Eq. 29).
-    pub point: DVec3,
-    /// The force on particle `id`: its normal and tangential parts \[N\].
-    pub f_n: DVec3,
-    pub f_t: DVec3,
-    /// δ \[L\]
-    pub overlap: f64,
 }
 
 /// The state in numbers (`Simulation::thermo`), for the status line and `log.csv`.
@@ -996,7 +909,7 @@ impl Simulation {
                     .iter()
                     .map(|f| format!("{:?}{:?}{:?};", f.shape, f.radius, f.contacts))
                     .collect();
-                (faces.len() as u64, crate::checkpoint::hash(&text))
+                (faces.len() as u64, crate::records::hash(&text))
             })
             .collect()
     }

@@ -12,7 +12,7 @@ use anyhow::{Context, Result};
 
 use crate::mesh::{Mesh, Primitive};
 use crate::particles::Particles;
-use crate::simulation::{ContactRecord, Partner};
+use crate::records::{ContactRecord, Partner};
 
 /// Where an array goes in the file.
 #[derive(Clone, Copy)]

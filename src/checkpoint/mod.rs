@@ -20,12 +20,13 @@ use std::path::Path;
 use anyhow::{Context, Result, bail};
 use glam::{DQuat, DVec3};
 
-use crate::contact::Springs;
 use crate::mesh::Mesh;
 use crate::particles::{Particle, Particles};
+pub use crate::records::hash;
+use crate::records::{Outflow, Removed, Snapshot, Wrench};
 use crate::scenario::{FrictionSprings, Scenario};
-use crate::simulation::{Outflow, Removed, Snapshot, Wrench};
 use crate::spawn::{RegionState, SpawnerState};
+use crate::springs::Springs;
 
 pub mod parts;
 pub use parts::{is_part, join, load_parts, newer_parts, part_path, remove_parts, save_part};
@@ -90,13 +91,6 @@ pub fn fingerprint(s: &Scenario, mesh: &Mesh) -> u64 {
         text
     };
     hash(&text)
-}
-
-/// FNV-1a, 64 bit, of `text`.
-pub fn hash(text: &str) -> u64 {
-    text.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
-        (h ^ b as u64).wrapping_mul(0x100_0000_01b3)
-    })
 }
 
 fn put_f64s(out: &mut Vec<u8>, values: &[f64]) {

@@ -20,9 +20,9 @@ use anyhow::{Context, Result, bail, ensure};
 use glam::DVec3;
 
 use super::{decode, encode_into};
-use crate::contact::Springs;
 use crate::particles::{Particle, Particles};
-use crate::simulation::Snapshot;
+use crate::records::Snapshot;
+use crate::springs::Springs;
 
 const MAGIC: &[u8; 12] = b"TINYDEM PART";
 /// The bytes before a part's checkpoint.
