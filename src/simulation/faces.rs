@@ -1,0 +1,285 @@
+//! Stage 4 of the step: the contacts of particles with the faces of the mesh, one contact per
+//! touch of a surface (`surface.rs`), pieces of the particle-face list in parallel.
+
+use super::*;
+
+/// A face within reach of a particle, in stage 4.
+struct Near {
+    /// The particle, and the face's slot in the piece of the particle-face list.
+    owner: u32,
+    slot: usize,
+    kin: Kinematics,
+    /// Separation x - p_F and whether p_F counts as inside the face (see `surface::snap`).
+    d: DVec3,
+    interior: bool,
+}
+
+/// Buffers of one piece of the mesh-contact stage.
+#[derive(Default)]
+struct MeshScratch {
+    /// The piece's faces within reach.
+    near: Vec<Near>,
+    /// Which of `near` are contacts of their own, for the law.
+    contacts: Vec<u32>,
+    /// One particle's faces within reach as candidates, and what becomes of them.
+    candidates: Vec<Candidate>,
+    order: Vec<usize>,
+    fates: Vec<Fate>,
+}
+
+impl Simulation {
+    /// Stage 4 (Sections 2.2, 3.3): the force of every particle-face contact. Returns the
+    /// overlaps deeper than the particle's radius.
+    ///
+    /// Each piece of the list holds whole runs of owners. For each particle it finds the
+    /// faces within reach (closest point, kinematics), decides which of them are contacts
+    /// of their own (one per touch of a connected surface, `surface.rs`; with `per_face`
+    /// every face is a surface of its own), hands the springs of the others to the contact
+    /// that absorbs them, then evaluates the law for `WIDTH` contacts at a time in SIMD
+    /// lanes (bit for bit as alone).
+    #[inline(never)] // a stage of its own in profiles
+    pub(super) fn mesh_contacts(&mut self) -> Vec<Deep> {
+        let deep = Mutex::new(Vec::new());
+        let beyond = AtomicBool::new(false);
+        let scales = &self.scales;
+        let p = &self.particles;
+        let law = &self.law;
+        let faces = &self.mesh.faces;
+        let (face_part, moving) = (&self.face_part, &self.moving);
+        let (densities, face_material) = (&self.densities, &self.face_material);
+        let uniform = law.uniform();
+        let one_wall: Coefficients<Group> = law.with_wall(0, 0).splat();
+        let ContactList {
+            start,
+            partner,
+            contact,
+            pieces: bounds,
+            stores,
+        } = &mut self.neighbours.faces;
+        let (start, partner) = (&*start, &*partner);
+        thread_local! {
+            static SCRATCH: std::cell::RefCell<MeshScratch> = Default::default();
+        }
+        let (face_file, files, about) = (&self.face_file, self.wall_sums.len(), &self.mesh_files);
+        let wall_scales = &self.wall_scales;
+        let owned = self.domain.as_ref().map(|d| &d.owned[..]);
+        let all = pieces(bounds, &mut self.loads, start, contact, stores);
+        let walls: Vec<(Vec<Sum6>, bool)> = all
+            .into_par_iter()
+            .with_min_len(MIN_PARALLEL_LEN.div_ceil(FACE_PIECE))
+            .map(|piece| {
+                SCRATCH.with_borrow_mut(|scratch| {
+                    let Piece {
+                        owners,
+                        first,
+                        loads,
+                        contact,
+                        store,
+                    } = piece;
+                    let MeshScratch {
+                        near,
+                        candidates,
+                        contacts,
+                        order,
+                        fates,
+                    } = scratch;
+                    // The faces within reach, each with its closest point and kinematics; the
+                    // slots of a particle are consecutive, so are its candidates.
+                    near.clear();
+                    for i in owners.clone() {
+                        let run = start[i] as usize..start[i + 1] as usize;
+                        if run.is_empty() {
+                            continue;
+                        }
+                        let body = Body {
+                            x: p.x[i],
+                            radius: p.radius[i],
+                            v: p.v[i],
+                            w: p.w[i],
+                        };
+                        for (k, &f) in run.clone().zip(&partner[run]) {
+                            let kl = k - first;
+                            let face = &faces[f as usize];
+                            let touch = if face.certainly_beyond(body.x, body.radius + face.radius)
+                            {
+                                None
+                            } else {
+                                let wall = match face_part[f as usize] {
+                                    STATIC => RigidVelocity::default(),
+                                    part => moving[part as usize].velocity,
+                                };
+                                let (d, feature) = face.separation_and_feature(body.x);
+                                let (d, interior) =
+                                    surface::snap(face, body.x, body.radius, d, feature);
+                                Kinematics::with_wall(&body, d, face.radius, &wall)
+                                    .map(|kin| (kin, d, interior))
+                            };
+                            match touch {
+                                Some((kin, d, interior)) => near.push(Near {
+                                    owner: i as u32,
+                                    slot: kl,
+                                    kin,
+                                    d,
+                                    interior,
+                                }),
+                                None if contact[kl] != NONE => {
+                                    // The contact ended: forget its history.
+                                    store.close(contact[kl]);
+                                    contact[kl] = NONE;
+                                }
+                                None => {}
+                            }
+                        }
+                    }
+                    // One contact per touch, particle by particle; the absorbed hand over
+                    // their springs and are treated as apart.
+                    contacts.clear();
+                    let mut a = 0;
+                    while a < near.len() {
+                        let i = near[a].owner as usize;
+                        let mut b = a + 1;
+                        while b < near.len() && near[b].owner as usize == i {
+                            b += 1;
+                        }
+                        let (x, radius) = (p.x[i], p.radius[i]);
+                        let several = b - a > 1;
+                        if several {
+                            candidates.clear();
+                            candidates.extend(near[a..b].iter().map(|c| Candidate {
+                                face: partner[first + c.slot],
+                                point: x - c.d,
+                                dist2: c.d.length_squared(),
+                                interior: c.interior,
+                            }));
+                            let tol = surface::tolerance(x, radius);
+                            surface::resolve(candidates, faces, tol, order, fates);
+                            for (c, fate) in near[a..b].iter().zip(fates.iter()) {
+                                let Fate::Absorbed(s) = *fate else { continue };
+                                let (k, s) = (c.slot, near[a + s].slot);
+                                let none = |e: u32| {
+                                    e == NONE || store.springs[e as usize] == Springs::default()
+                                };
+                                if none(contact[s]) && contact[k] != NONE {
+                                    if contact[s] == NONE {
+                                        // The absorbing contact takes over the entry.
+                                        (contact[s], contact[k]) = (contact[k], NONE);
+                                    } else {
+                                        let e = contact[k] as usize;
+                                        store.springs[contact[s] as usize] = store.springs[e];
+                                    }
+                                }
+                            }
+                        }
+                        for (c, near) in near[a..b].iter().enumerate() {
+                            let k = near.slot;
+                            if !several || fates[c] == Fate::Contact {
+                                if near.kin.delta > radius {
+                                    deep.lock().expect("not poisoned").push(Deep {
+                                        i,
+                                        other: Partner::Face(partner[first + k] as usize),
+                                        delta: near.kin.delta,
+                                        limit: radius,
+                                    });
+                                }
+                                if contact[k] == NONE {
+                                    contact[k] = store.open();
+                                }
+                                contacts.push((a + c) as u32);
+                            } else if contact[k] != NONE {
+                                store.close(contact[k]);
+                                contact[k] = NONE;
+                            }
+                        }
+                        a = b;
+                    }
+                    // The law, `WIDTH` contacts at a time (as for particle pairs), added to
+                    // the particles' loads, and their reactions (of own particles, in a split
+                    // run) to the piece's exact sum for each mesh file.
+                    let (mut wall, mut wall_fine) = (vec![Sum6::default(); files], true);
+                    for group in contacts.chunks(WIDTH) {
+                        let c: [&Near; WIDTH] =
+                            std::array::from_fn(|l| &near[group[l.min(group.len() - 1)] as usize]);
+                        let e = c.map(|c| contact[c.slot]);
+                        let i = c.map(|c| c.owner as usize);
+                        let scalar =
+                            |get: fn(&Kinematics) -> f64| Group::gather(c.map(|c| get(&c.kin)));
+                        let vector = |get: fn(&Kinematics) -> DVec3| {
+                            Group::gather_vec(c.map(|c| get(&c.kin)))
+                        };
+                        let kin = Kinematics::<Group> {
+                            n: vector(|k| k.n),
+                            delta: scalar(|k| k.delta),
+                            r_i: scalar(|k| k.r_i),
+                            r_j: scalar(|k| k.r_j),
+                            v: vector(|k| k.v),
+                            omega: vector(|k| k.omega),
+                        };
+                        let radius = Group::gather(i.map(|i| p.radius[i]));
+                        let (mass, coef) = if uniform {
+                            (
+                                Inertia::mass_with(radius, Group::splat(densities[0].mass_per_r3)),
+                                one_wall,
+                            )
+                        } else {
+                            let m = i.map(|i| p.material[i]);
+                            let f = c.map(|c| face_material[partner[first + c.slot] as usize]);
+                            (
+                                Inertia::mass_with(
+                                    radius,
+                                    Group::gather(m.map(|m| densities[m as usize].mass_per_r3)),
+                                ),
+                                Coefficients::gather(std::array::from_fn(|l| {
+                                    law.with_wall(m[l], f[l])
+                                })),
+                            )
+                        };
+                        let mut lanes = gather_springs(store, e);
+                        let force =
+                            law.evaluate(&coef, radius, mass, Other::Wall, &kin, &mut lanes);
+                        scatter_springs(lanes, store, &e[..group.len()]);
+                        let (f, tau) =
+                            (Group::scatter_vec(force.f), Group::scatter_vec(force.tau_i));
+                        let mut fine = true;
+                        for l in 0..group.len() {
+                            let load = &mut loads[i[l] - owners.start];
+                            fine &= load.add(pack(f[l], tau[l]), &scales.lanes);
+                        }
+                        if !fine {
+                            beyond.store(true, Ordering::Relaxed);
+                        }
+                        if files > 0 {
+                            // The reaction on the mesh file (Newton's third law for the
+                            // force and for the torque about the file's reference point).
+                            for l in (0..group.len()).filter(|&l| owned.is_none_or(|o| o[i[l]])) {
+                                let k = face_file[partner[first + c[l].slot] as usize] as usize;
+                                let arm = p.x[i[l]] - about[k].torque_about;
+                                let reaction = pack(-f[l], -(arm.cross(f[l]) + tau[l]));
+                                wall_fine &= wall[k].add(reaction, wall_scales);
+                            }
+                        }
+                    }
+                    (wall, wall_fine)
+                })
+            })
+            .collect();
+        if !self.wall_sums.is_empty() {
+            let mut step = vec![Sum6::default(); self.wall_sums.len()];
+            for (piece, fine) in walls {
+                self.beyond_range |= !fine;
+                for (sum, w) in step.iter_mut().zip(&piece) {
+                    sum.merge(w);
+                }
+            }
+            self.reduce_walls(&mut step);
+            for (sum, w) in self.wall_sums.iter_mut().zip(&step) {
+                let [fx, fy, fz, tx, ty, tz] = w.value(&self.wall_scales);
+                *sum += Wrench {
+                    f: DVec3::new(fx, fy, fz),
+                    tau: DVec3::new(tx, ty, tz),
+                };
+            }
+        }
+        self.beyond_range |= beyond.into_inner();
+        deep.into_inner().expect("not poisoned")
+    }
+}

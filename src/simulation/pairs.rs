@@ -1,0 +1,271 @@
+//! Stage 3 of the step: the contacts between particles, pieces of the pair list in parallel,
+//! the law evaluated for groups of pairs in lanes, the loads summed exactly; and the pairs
+//! across periodic sides.
+
+use super::*;
+
+/// Two distinct elements of a slice, mutably.
+fn pair_mut<T>(v: &mut [T], a: usize, b: usize) -> (&mut T, &mut T) {
+    assert_ne!(a, b);
+    if a < b {
+        let (lo, hi) = v.split_at_mut(b);
+        (&mut lo[a], &mut hi[0])
+    } else {
+        let (lo, hi) = v.split_at_mut(a);
+        (&mut hi[0], &mut lo[b])
+    }
+}
+
+impl Simulation {
+    /// Stage 3 (Section 2.2): the force of every touching particle pair, once per pair,
+    /// added to the loads of both particles (with the reactions of Eqs. 56-60). Returns the
+    /// overlaps deeper than the smaller radius.
+    ///
+    /// The owners are cut into slabs whose partners lie at most in the next slab
+    /// (`Neighbours::slabs`): the even slabs run at the same time, then the odd ones, so a
+    /// load is added to by one slab at a time, in an order that does not depend on the
+    /// number of threads. Each slab first sorts out its touching pairs (a pair that has just
+    /// parted forgets its springs), then evaluates them `WIDTH` at a time in SIMD lanes; a
+    /// lane gives the bits the pair would give alone. Body i of a pair is the particle of
+    /// the lower id, so a pair's force and springs do not depend on the storage order.
+    #[inline(never)] // a stage of its own in profiles
+    pub(super) fn particle_contacts(&mut self) -> Vec<Deep> {
+        let deep = Mutex::new(Vec::new());
+        let beyond = AtomicBool::new(false);
+        let scales = &self.scales;
+        let p = &self.particles;
+        let law = &self.law;
+        let densities = &self.densities;
+        // One material: the same coefficients and density in every lane, set up once.
+        let uniform = law.uniform();
+        let one_pair: Coefficients<Group> = law.pair(0, 0).splat();
+        let mass_per_r3 = |idx: &[usize; WIDTH]| {
+            if uniform {
+                Group::splat(densities[0].mass_per_r3)
+            } else {
+                Group::gather(idx.map(|k| densities[p.material[k] as usize].mass_per_r3))
+            }
+        };
+        let ContactList {
+            start,
+            partner,
+            contact,
+            pieces: slabs,
+            stores,
+        } = &mut self.neighbours.pairs;
+        let (start, partner, slabs) = (&*start, &*partner, &*slabs);
+        thread_local! {
+            static TOUCHING: std::cell::RefCell<Vec<[u32; 3]>> = Default::default();
+        }
+        for phase in 0..2 {
+            let mut all: Vec<Option<Piece>> =
+                pieces(slabs, &mut self.loads, start, contact, stores)
+                    .into_iter()
+                    .map(Some)
+                    .collect();
+            // A slab, with the loads of the next one.
+            let tasks: Vec<(Piece, Option<Piece>)> = (phase..all.len())
+                .step_by(2)
+                .map(|s| {
+                    let own = all[s].take().expect("each slab once");
+                    (own, all.get_mut(s + 1).and_then(Option::take))
+                })
+                .collect();
+            tasks.into_par_iter().for_each(|(slab, next)| {
+                TOUCHING.with_borrow_mut(|touching| {
+                    let Piece {
+                        owners,
+                        first,
+                        loads,
+                        contact,
+                        store,
+                    } = slab;
+                    let mut next_loads = next.map(|n| (n.owners.start, n.loads));
+                    // The touching pairs: the particle of the lower id (body i of the law,
+                    // whatever the storage order), the other, and the contact's entry in the
+                    // slab's store (opened at first touch, closed when the pair parts).
+                    touching.clear();
+                    for i in owners.clone() {
+                        let (xi, ri) = (p.x[i], p.radius[i]);
+                        let run = start[i] as usize - first..start[i + 1] as usize - first;
+                        for kl in run {
+                            let j = partner[first + kl] as usize;
+                            let reach = ri + p.radius[j];
+                            if (xi - p.x[j]).length_squared() < reach * reach {
+                                let (a, b) = if p.id[i] < p.id[j] { (i, j) } else { (j, i) };
+                                if contact[kl] == NONE {
+                                    contact[kl] = store.open();
+                                }
+                                touching.push([a as u32, b as u32, contact[kl]]);
+                            } else if contact[kl] != NONE {
+                                // The contact ended: forget its history.
+                                store.close(contact[kl]);
+                                contact[kl] = NONE;
+                            }
+                        }
+                    }
+                    let (base, owned) = (owners.start, owners.end);
+                    // The load of a particle of this slab or of the next one.
+                    fn load<'l>(
+                        idx: usize,
+                        (base, owned): (usize, usize),
+                        loads: &'l mut [Load],
+                        next: &'l mut Option<(usize, &mut [Load])>,
+                    ) -> &'l mut Load {
+                        if idx < owned {
+                            &mut loads[idx - base]
+                        } else {
+                            let (start, next) =
+                                next.as_mut().expect("partners reach the next slab only");
+                            &mut next[idx - *start]
+                        }
+                    }
+                    for group in touching.chunks(WIDTH) {
+                        // A short last group repeats its last pair in the spare lanes.
+                        let (mut i, mut j, mut c) = ([0; WIDTH], [0; WIDTH], [0; WIDTH]);
+                        for l in 0..WIDTH {
+                            let [a, b, e] = group[l.min(group.len() - 1)];
+                            (i[l], j[l], c[l]) = (a as usize, b as usize, e);
+                        }
+                        let body = |idx: [usize; WIDTH]| Body::<Group> {
+                            x: Group::gather_vec_at(&p.x, &idx),
+                            radius: Group::gather_at(&p.radius, &idx),
+                            v: Group::gather_vec_at(&p.v, &idx),
+                            w: Group::gather_vec_at(&p.w, &idx),
+                        };
+                        let (body_i, body_j) = (body(i), body(j));
+                        let d = body_i.x - body_j.x; // Eq. (8)
+                        let kin = Kinematics::of_touching_particles(
+                            &body_i,
+                            &body_j,
+                            d,
+                            Group::dot(d, d),
+                        );
+                        let mut lanes = gather_springs(store, c);
+                        let other = Other::Particle {
+                            r: body_j.radius,
+                            m: Inertia::mass_with(body_j.radius, mass_per_r3(&j)),
+                        };
+                        let m_i = Inertia::mass_with(body_i.radius, mass_per_r3(&i));
+                        let coef = if uniform {
+                            one_pair
+                        } else {
+                            Coefficients::gather(std::array::from_fn(|l| {
+                                law.pair(p.material[i[l]], p.material[j[l]])
+                            }))
+                        };
+                        let force =
+                            law.evaluate(&coef, body_i.radius, m_i, other, &kin, &mut lanes);
+                        scatter_springs(lanes, store, &c[..group.len()]);
+                        let (f, tau_i, tau_j) = (
+                            Group::scatter_vec(force.f),
+                            Group::scatter_vec(force.tau_i),
+                            Group::scatter_vec(force.tau_j),
+                        );
+                        let (at, lanes, mut fine) = ((base, owned), &scales.lanes, true);
+                        for l in 0..group.len() {
+                            let load_i = load(i[l], at, loads, &mut next_loads);
+                            fine &= load_i.add(pack(f[l], tau_i[l]), lanes);
+                            let load_j = load(j[l], at, loads, &mut next_loads);
+                            fine &= load_j.add(pack(-f[l], tau_j[l]), lanes); // Eqs. (56)-(60)
+                        }
+                        if !fine {
+                            beyond.store(true, Ordering::Relaxed);
+                        }
+                        if kin.delta.simd_gt(body_i.radius.min(body_j.radius)).any() {
+                            let delta = kin.delta.scatter();
+                            for l in 0..group.len() {
+                                let limit = p.radius[i[l]].min(p.radius[j[l]]);
+                                if delta[l] > limit {
+                                    deep.lock().expect("not poisoned").push(Deep {
+                                        i: i[l],
+                                        other: Partner::Particle(j[l]),
+                                        delta: delta[l],
+                                        limit,
+                                    });
+                                }
+                            }
+                        }
+                    }
+                });
+            });
+        }
+        let mut deep = deep.into_inner().expect("not poisoned");
+        self.beyond_range |= beyond.into_inner();
+        self.wrapped_contacts(&mut deep);
+        deep
+    }
+
+    /// Stage 3, across periodic sides: the pairs of `Neighbours::wrapped`, partner j seen at
+    /// its image x_j + shift, one by one in slot order (they are few: those at the sides),
+    /// after the slabs; the law as for any pair, body i the lower id.
+    pub(super) fn wrapped_contacts(&mut self, deep: &mut Vec<Deep>) {
+        let p = &self.particles;
+        let law = &self.law;
+        let nb = &mut self.neighbours;
+        let images: Vec<(DVec3, DVec3)> = (0..nb.shift.len()).map(|k| nb.image(k)).collect();
+        let ContactList {
+            start,
+            partner,
+            contact,
+            pieces,
+            stores,
+        } = &mut nb.wrapped;
+        let mass = |k: usize| {
+            Inertia::mass_with(
+                p.radius[k],
+                self.densities[p.material[k] as usize].mass_per_r3,
+            )
+        };
+        for piece in 0..pieces.len().saturating_sub(1) {
+            let store = &mut stores[piece];
+            for a in pieces[piece] as usize..pieces[piece + 1] as usize {
+                for k in start[a] as usize..start[a + 1] as usize {
+                    let b = partner[k] as usize;
+                    // Seen from the lower id: the other at its image (and its velocity), as
+                    // `Neighbours::across`.
+                    let (shift, dv) = images[k];
+                    let (i, j) = if p.id[a] < p.id[b] { (a, b) } else { (b, a) };
+                    let body = |k: usize, x: DVec3, dv: DVec3| Body {
+                        x,
+                        radius: p.radius[k],
+                        v: p.v[k] + dv,
+                        w: p.w[k],
+                    };
+                    let (bi, bj) = (body(i, p.x[i], DVec3::ZERO), body(j, p.x[j] + shift, dv));
+                    let Some(kin) = Kinematics::between_particles(&bi, &bj) else {
+                        if contact[k] != NONE {
+                            store.close(contact[k]);
+                            contact[k] = NONE;
+                        }
+                        continue;
+                    };
+                    if contact[k] == NONE {
+                        contact[k] = store.open();
+                    }
+                    let springs = &mut store.springs[contact[k] as usize];
+                    let other = Other::Particle {
+                        r: p.radius[j],
+                        m: mass(j),
+                    };
+                    let coef = law.pair(p.material[i], p.material[j]);
+                    let force = law.evaluate(coef, p.radius[i], mass(i), other, &kin, springs);
+                    let scales = &self.scales;
+                    let (load_i, load_j) = pair_mut(&mut self.loads, i, j);
+                    let fine = load_i.add(pack(force.f, force.tau_i), &scales.lanes)
+                        & load_j.add(pack(-force.f, force.tau_j), &scales.lanes); // Eqs. (56)-(60)
+                    self.beyond_range |= !fine;
+                    let limit = p.radius[i].min(p.radius[j]);
+                    if kin.delta > limit {
+                        deep.push(Deep {
+                            i,
+                            other: Partner::Particle(j),
+                            delta: kin.delta,
+                            limit,
+                        });
+                    }
+                }
+            }
+        }
+    }
+}
