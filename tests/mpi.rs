@@ -36,6 +36,20 @@ fn run(np: usize, args: &[&str], dir: &Path) -> Output {
     out
 }
 
+/// Resumes the run of scenario `name` in `dir/cut` from its checkpoint on `np` processes.
+fn resume(np: usize, name: &str, dir: &Path) {
+    let args = [
+        "run",
+        name,
+        "-o",
+        "cut",
+        "-q",
+        "--resume",
+        "cut/checkpoint.bin",
+    ];
+    run(np, &args, dir);
+}
+
 /// The files of an output directory that a run writes the same on any process count (all
 /// but the checkpoint, which holds the storage order, and run.toml, which names the
 /// command line).
@@ -170,19 +184,7 @@ fn ctrl_c_on_2_processes_checkpoints_and_3_resume_with_the_same_bytes() {
         done < 600,
         "interrupted after {done} frames: too late to tell"
     );
-    run(
-        3,
-        &[
-            "run",
-            name,
-            "-o",
-            "cut",
-            "-q",
-            "--resume",
-            "cut/checkpoint.bin",
-        ],
-        dir.path(),
-    );
+    resume(3, name, dir.path());
     let (one, resumed) = (outputs(&dir.path().join("one")), outputs(&cut));
     for (file, a) in &one {
         let b = resumed.iter().find(|e| &e.0 == file).map(|e| &e.1);
@@ -300,6 +302,18 @@ fn frames_out(dir: &Path) -> usize {
     std::fs::read_to_string(dir.join("frames.csv")).map_or(0, |t| t.lines().count())
 }
 
+/// Starts the run of scenario `name` on 2 processes into `dir/cut`, its stderr piped, and
+/// waits until its `frames.csv` has `lines` lines.
+fn start_cut(name: &str, dir: &Path, lines: usize) -> (std::process::Child, PathBuf) {
+    let child = mpirun(2, &["run", name, "-o", "cut", "-q"], dir)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let cut = dir.join("cut");
+    wait_for_frames(&cut, lines);
+    (child, cut)
+}
+
 /// Waits until `dir/frames.csv` has `lines` lines.
 fn wait_for_frames(dir: &Path, lines: usize) {
     let start = Instant::now();
@@ -318,12 +332,7 @@ fn sigterm_to_mpirun_keeps_a_checkpoint_that_takes_seconds_to_gather() {
     let dir = tempfile::tempdir().unwrap();
     let scenario = million(dir.path(), 2, 20);
     let name = scenario.to_str().unwrap();
-    let child = mpirun(2, &["run", name, "-o", "cut", "-q"], dir.path())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let cut = dir.path().join("cut");
-    wait_for_frames(&cut, 2);
+    let (child, cut) = start_cut(name, dir.path(), 2);
     std::thread::sleep(Duration::from_millis(1500));
     let asked = Instant::now();
     unsafe { libc::kill(child.id() as i32, libc::SIGTERM) };
@@ -334,19 +343,7 @@ fn sigterm_to_mpirun_keeps_a_checkpoint_that_takes_seconds_to_gather() {
     assert!(ended < Duration::from_secs(5), "mpirun took {ended:?}");
     assert_eq!(err.matches("interrupted after step").count(), 1, "{err}");
     assert!(frames_out(&cut) < 4, "stopped after the run: {err}");
-    run(
-        1,
-        &[
-            "run",
-            name,
-            "-o",
-            "cut",
-            "-q",
-            "--resume",
-            "cut/checkpoint.bin",
-        ],
-        dir.path(),
-    );
+    resume(1, name, dir.path());
     run(1, &["run", name, "-o", "whole", "-q"], dir.path());
     for file in ["particles000002.csv", "log.csv"] {
         let a = std::fs::read(dir.path().join("whole").join(file)).unwrap();
@@ -361,12 +358,7 @@ fn sigusr1_to_mpirun_stops_the_run_with_a_checkpoint_and_exit_130() {
     let dir = tempfile::tempdir().unwrap();
     let scenario = silo(dir.path(), 600);
     let name = scenario.to_str().unwrap();
-    let child = mpirun(2, &["run", name, "-o", "cut", "-q"], dir.path())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let cut = dir.path().join("cut");
-    wait_for_frames(&cut, 20);
+    let (child, cut) = start_cut(name, dir.path(), 20);
     unsafe { libc::kill(child.id() as i32, libc::SIGUSR1) };
     let out = child.wait_with_output().unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
@@ -381,25 +373,6 @@ fn sigusr1_to_mpirun_stops_the_run_with_a_checkpoint_and_exit_130() {
     assert!(
         names.iter().any(|n| n == "checkpoint.bin") && names.iter().any(|n| n == "interrupted.csv")
     );
-    let resumed = mpirun(
-        3,
-        &[
-            "run",
-            name,
-            "-o",
-            "cut",
-            "-q",
-            "--resume",
-            "cut/checkpoint.bin",
-        ],
-        dir.path(),
-    )
-    .output()
-    .unwrap();
-    assert!(
-        resumed.status.success(),
-        "{}",
-        String::from_utf8_lossy(&resumed.stderr)
-    );
+    resume(3, name, dir.path());
     assert_eq!(frames_out(&cut), 602);
 }
