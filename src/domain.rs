@@ -433,6 +433,17 @@ impl Simulation {
         self.domain.as_ref().is_none_or(|d| d.comm.rank() == 0)
     }
 
+    /// Whether each of `flags` is set on any process (one collective in a split run).
+    pub fn any_each<const N: usize>(&self, flags: [bool; N]) -> [bool; N] {
+        match &self.domain {
+            Some(d) => {
+                let counts = d.comm.sum_i64(&flags.map(|f| f as i64));
+                std::array::from_fn(|k| counts[k] > 0)
+            }
+            None => flags,
+        }
+    }
+
     /// This process's place among the processes of a split run: (rank, count).
     pub fn process(&self) -> Option<(usize, usize)> {
         self.domain.as_ref().map(|d| d.rank())

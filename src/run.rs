@@ -87,21 +87,34 @@ pub struct Interrupted {
     pub step: u64,
     pub time: f64,
     pub checkpoint: PathBuf,
+    /// The step the checkpoint is of: `step`, or that of a checkpoint SIGCONT asked for
+    /// just before.
+    pub checkpoint_step: u64,
 }
 
 impl std::fmt::Display for Interrupted {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "interrupted after step {} (t = {:.6e} s); checkpoint written to {}: continue with --resume {} --output {}",
-            self.step,
-            self.time,
-            self.checkpoint.display(),
+        let (path, dir) = (
             self.checkpoint.display(),
             self.checkpoint
                 .parent()
-                .map_or_else(|| ".".into(), |d| d.display().to_string())
-        )
+                .map_or_else(|| ".".into(), |d| d.display().to_string()),
+        );
+        write!(
+            f,
+            "interrupted after step {} (t = {:.6e} s); ",
+            self.step, self.time
+        )?;
+        if self.checkpoint_step == self.step {
+            write!(f, "checkpoint written to {path}")?;
+        } else {
+            let step = self.checkpoint_step;
+            write!(
+                f,
+                "the checkpoint of step {step}, written on SIGCONT, is {path}"
+            )?;
+        }
+        write!(f, ": continue with --resume {path} --output {dir}")
     }
 }
 
@@ -391,6 +404,8 @@ pub fn run_on(
     let mut last_checkpoint = Instant::now();
     // The step of the last checkpoint this run wrote.
     let mut checkpointed_at = None;
+    // The step and time of the last checkpoint asked by SIGCONT.
+    let mut warned = None;
     while sim.steps < total_steps {
         if let Err(unstable) = sim.step() {
             let last = sim.steps.saturating_sub(1) / steps_per_frame.max(1);
@@ -437,15 +452,19 @@ pub fn run_on(
         if let Some(bar) = bar.as_ref().filter(|_| sim.steps.is_multiple_of(100)) {
             bar.set_position(sim.steps);
         }
-        // Asked by signals: a checkpoint now, a stop (any process asks, all do it).
+        // Asked by signals: a checkpoint now, a stop (any process asks, all do it; one
+        // collective a step for both).
         let asked = |flag: fn(&Requests) -> &AtomicBool| {
             options
                 .requests
                 .is_some_and(|r| flag(r).swap(false, Ordering::Relaxed))
         };
-        if sim.any(asked(|r| &r.checkpoint)) && checkpointed_at != Some(sim.steps) {
+        let [checkpoint_now, mut stop_now] =
+            sim.any_each([asked(|r| &r.checkpoint), asked(|r| &r.stop)]);
+        if checkpoint_now && checkpointed_at != Some(sim.steps) {
             let path = save_pieces(output_dir, &sim)?;
             checkpointed_at = Some(sim.steps);
+            warned = Some((sim.steps, Instant::now()));
             if writer {
                 eprintln!(
                     "SIGCONT: checkpoint of step {} written to {} (a launcher stopping the run sends SIGCONT before SIGTERM)",
@@ -453,13 +472,22 @@ pub fn run_on(
                     path.display()
                 );
             }
+            // A stop asked while it was written (mpirun's SIGTERM follows its SIGCONT)
+            // is done now, with this checkpoint.
+            stop_now |= sim.any(asked(|r| &r.stop));
         }
-        if sim.any(asked(|r| &r.stop)) {
+        if stop_now {
             if let Some(bar) = &bar {
                 bar.abandon();
             }
-            let written = checkpointed_at == Some(sim.steps);
-            return Err(stop(output_dir, &sim, out.extra, written)?.into());
+            // The checkpoint to keep: one of this step, or one SIGCONT asked for a moment
+            // ago (the launcher's warning: its SIGKILL may come before another is written).
+            let recent = warned.filter(|w: &(u64, Instant)| w.1.elapsed() < SIGCONT_KEEPS);
+            let keep = match checkpointed_at == Some(sim.steps) {
+                true => Some(sim.steps),
+                false => sim.any(recent.is_some()).then(|| warned.expect("recent").0),
+            };
+            return Err(stop(output_dir, &sim, out.extra, keep)?.into());
         }
     }
     if let Some(bar) = bar {
@@ -608,20 +636,23 @@ pub fn open(
     }
 }
 
-/// Stops a run on request (collective): the checkpoint first (unless one of this step is
-/// `written`), said as soon as it is complete (a launcher may send SIGKILL a second after
+/// How long after a checkpoint asked by SIGCONT a stop keeps it instead of writing another.
+const SIGCONT_KEEPS: std::time::Duration = std::time::Duration::from_secs(10);
+
+/// Stops a run on request (collective): the checkpoint first (unless one of step `keep`
+/// is to be kept), said as soon as it is complete (a launcher may send SIGKILL a second after
 /// SIGTERM), then the state as a CSV frame. In a split run the first process joins the
 /// parts of the checkpoint into the one file after saying it.
-fn stop(dir: &Path, sim: &Simulation, extra: Extra, written: bool) -> Result<Interrupted> {
-    let path = if written {
-        dir.join(CHECKPOINT)
-    } else {
-        save_pieces(dir, sim)?
+fn stop(dir: &Path, sim: &Simulation, extra: Extra, keep: Option<u64>) -> Result<Interrupted> {
+    let path = match keep {
+        Some(_) => dir.join(CHECKPOINT),
+        None => save_pieces(dir, sim)?,
     };
     let stop = Interrupted {
         step: sim.steps,
         time: sim.time,
         checkpoint: path.clone(),
+        checkpoint_step: keep.unwrap_or(sim.steps),
     };
     let writer = sim.is_writer();
     if writer {

@@ -327,8 +327,9 @@ fn wait_for_frames(dir: &Path, lines: usize) {
 fn sigterm_to_mpirun_keeps_a_checkpoint_that_takes_seconds_to_gather() {
     // mpirun answers SIGTERM with SIGCONT to the processes, SIGTERM a second later and
     // SIGKILL a second after that: far less than the gathered checkpoint of 10^6 grains
-    // takes. The processes write their parts of it at once on SIGCONT, stop at SIGTERM in
-    // the same step, and the parts resume exactly (here in one process).
+    // takes. The processes write their parts of it at once on SIGCONT and keep them when
+    // SIGTERM comes (in the same step, or a few steps later: a new checkpoint might not be
+    // complete before SIGKILL), and the parts resume exactly (here in one process).
     let dir = tempfile::tempdir().unwrap();
     let scenario = million(dir.path(), 2, 20);
     let name = scenario.to_str().unwrap();
