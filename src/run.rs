@@ -405,7 +405,7 @@ pub fn run_on(
     // The step of the last checkpoint this run wrote.
     let mut checkpointed_at = None;
     // The step and time of the last checkpoint asked by SIGCONT.
-    let mut warned = None;
+    let mut sigcont_checkpoint = None;
     while sim.steps < total_steps {
         if let Err(unstable) = sim.step() {
             let last = sim.steps.saturating_sub(1) / steps_per_frame.max(1);
@@ -464,7 +464,7 @@ pub fn run_on(
         if checkpoint_now && checkpointed_at != Some(sim.steps) {
             let path = save_pieces(output_dir, &sim)?;
             checkpointed_at = Some(sim.steps);
-            warned = Some((sim.steps, Instant::now()));
+            sigcont_checkpoint = Some((sim.steps, Instant::now()));
             if writer {
                 eprintln!(
                     "SIGCONT: checkpoint of step {} written to {} (a launcher stopping the run sends SIGCONT before SIGTERM)",
@@ -482,10 +482,13 @@ pub fn run_on(
             }
             // The checkpoint to keep: one of this step, or one SIGCONT asked for a moment
             // ago (the launcher's warning: its SIGKILL may come before another is written).
-            let recent = warned.filter(|w: &(u64, Instant)| w.1.elapsed() < SIGCONT_KEEPS);
+            let recent =
+                sigcont_checkpoint.filter(|w: &(u64, Instant)| w.1.elapsed() < SIGCONT_KEEPS);
             let keep = match checkpointed_at == Some(sim.steps) {
                 true => Some(sim.steps),
-                false => sim.any(recent.is_some()).then(|| warned.expect("recent").0),
+                false => sim
+                    .any(recent.is_some())
+                    .then(|| sigcont_checkpoint.expect("recent").0),
             };
             return Err(stop(output_dir, &sim, out.extra, keep)?.into());
         }
