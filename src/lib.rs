@@ -2,34 +2,43 @@
 //! (R. Vetter, Comput. Phys. Commun. 2025): soft frictional spheres with Hertz-Mindlin
 //! contact, sliding, rolling and twisting friction, quaternion orientations and static
 //! meshes. See `ARCHITECTURE.md` for a map of the code.
+//!
+//! The folders are layers, listed here from the bottom up; a module imports only from
+//! its own layer and those below it (`bench/modgraph.py` checks it).
 
-pub mod analyze;
-pub mod bench;
-pub mod check;
-pub mod checkpoint;
-pub mod comm;
-pub mod contact;
-pub mod csv;
-pub mod domain;
-pub mod exact;
-pub mod files;
+/// Layer 1: lanes, exact sums, particles, springs, the contact law, integration, motion.
+pub mod model;
+
+/// Layer 2: closest points, meshes, analytic surfaces.
 pub mod geometry;
-pub mod integrate;
-pub mod lanes;
-pub mod lock;
-pub mod mesh;
-pub mod motion;
+
+/// Layer 3: the cell grid, contact lists and their history.
 pub mod neighbours;
-pub mod output;
-pub mod particles;
-pub mod plot;
-pub mod records;
-pub mod render;
-pub mod run;
+
+/// Layer 4: the communicator and the decomposition of space.
+pub mod parallel;
+
+/// Layer 5: the one parser of scenario files.
 pub mod scenario;
-pub mod simulation;
-pub mod spawn;
-pub mod springs;
-pub mod surface;
-pub mod text;
-pub mod vtk;
+
+/// Layer 6: the simulation and one file per stage of the step.
+pub mod engine;
+
+/// Layer 7: every file read or written.
+pub mod io;
+
+/// Layer 8: the run loop and the checks before a run.
+pub mod driver;
+
+/// Layer 9: render, plot, text, analyze, bench.
+pub mod tools;
+
+// The public paths of the front ends (main.rs, python/) and the tests.
+pub use driver::{check, run};
+pub use engine as simulation;
+pub use engine::{records, spawn};
+pub use geometry::{mesh, surface};
+pub use io::{checkpoint, csv, files, lock, output, vtk};
+pub use model::{contact, exact, integrate, lanes, motion, particles, springs};
+pub use parallel::{comm, domain};
+pub use tools::{analyze, bench, plot, render, text};

@@ -1,0 +1,156 @@
+//! Stage 6 of the step: the stability verdict (deep overlaps, states out of range), the
+//! warnings of overlaps past the smaller radius and the advice they give.
+
+use super::*;
+
+/// The reports of every process of a split run, in the order they are told.
+pub(super) fn gather_told(
+    comm: &dyn crate::parallel::comm::Comm,
+    told: Vec<(u8, u64, u64, String)>,
+) -> Vec<(u8, u64, u64, String)> {
+    use crate::parallel::comm::{Reader, Writer};
+    let mut w = Writer::default();
+    for (kind, a, b, text) in &told {
+        w.u8(*kind);
+        w.u64(*a);
+        w.u64(*b);
+        w.bytes(text.as_bytes());
+    }
+    let mut all = Vec::new();
+    for m in comm.all_gather(w.0) {
+        let mut r = Reader::new(&m);
+        while !r.done() {
+            let (kind, a, b) = (r.u8(), r.u64(), r.u64());
+            all.push((kind, a, b, String::from_utf8_lossy(r.bytes()).into_owned()));
+        }
+    }
+    all.sort_by_key(|x| (x.0, x.1, x.2));
+    all
+}
+
+impl Simulation {
+    /// Stage 6: stop loudly rather than continue a run that has blown up: a non-finite
+    /// state (`bad`, from the integration) or an overlap past the smaller diameter. `deep`
+    /// lists the overlaps deeper than the smaller radius found in this step's contact
+    /// stages; those within the diameter are a legitimate transient of a crowded packing
+    /// (a small grain squeezed by a large one) and only warned of, once per pair.
+    #[inline(never)] // a stage of its own in profiles
+    pub(super) fn check_stability(
+        &mut self,
+        mut deep: Vec<Deep>,
+        bad: bool,
+    ) -> Result<(), Unstable> {
+        let p = &self.particles;
+        let non_finite =
+            |k: usize| !(p.x[k].is_finite() && p.v[k].is_finite() && p.w[k].is_finite());
+        // Split over processes: each reports on its own particles (a pair: the one of the
+        // lower id), and all stop if one must.
+        let bad = match &self.domain {
+            Some(d) => {
+                deep.retain(|x| d.owned[x.i]);
+                let own_bad = (0..p.len()).any(|k| d.owned[k] && non_finite(k));
+                let bad = self.beyond_range || own_bad || deep.iter().any(Deep::through);
+                d.comm.any(bad)
+            }
+            None => bad || deep.iter().any(Deep::through),
+        };
+        if !bad {
+            for d in deep {
+                if self.warnings.seen.insert(d.key(&p.id)) {
+                    self.warnings
+                        .fresh
+                        .push(format!("step {}: {}", self.steps, d.describe(&p.id)));
+                }
+            }
+            return Ok(());
+        }
+        // What went wrong, each with the order it is told in: the range of the sums, then
+        // up to five particles in id order, then the deepest overlaps by pair.
+        let mut told: Vec<(u8, u64, u64, String)> = Vec::new();
+        if self.beyond_range {
+            told.push((0, 0, 0, format!(
+                "a contact force or torque was not finite or beyond the range of the sums ({:.3e} N, {:.3e} N m: 4096 times the largest a contact of these materials and radii should give)",
+                self.scales.force.largest(),
+                self.scales.torque.largest()
+            )));
+        }
+        for k in p
+            .id_order()
+            .into_iter()
+            .filter(|&k| self.own(k) && non_finite(k))
+            .take(5)
+        {
+            told.push((
+                1,
+                p.id[k] as u64,
+                0,
+                format!(
+                    "particle {} has a non-finite state (x = {}, v = {}, w = {})",
+                    p.id[k], p.x[k], p.v[k], p.w[k]
+                ),
+            ));
+        }
+        deep.retain(Deep::through);
+        deep.sort_by_key(|d| d.key(&p.id));
+        for d in deep.iter().take(5) {
+            let (a, other) = d.key(&p.id);
+            let b = match other {
+                Partner::Particle(j) => j as u64,
+                Partner::Face(f) => (1 << 40) | f as u64,
+            };
+            told.push((2, a as u64, b, d.describe(&p.id)));
+        }
+        if let Some(d) = &self.domain {
+            told = gather_told(&*d.comm, told);
+        }
+        let mut what: Vec<String> = Vec::new();
+        let kind = |k: u8| told.iter().filter(move |t| t.0 == k).map(|t| t.3.clone());
+        what.extend(kind(0).take(1));
+        what.extend(kind(1).take(5));
+        let room = 5 - what.len().min(5);
+        what.extend(kind(2).take(room));
+        Err(Unstable {
+            step: self.steps,
+            time: self.time,
+            what,
+            advice: self.advice(),
+        })
+    }
+
+    /// Overlaps past the smaller radius so far (each pair once).
+    pub fn warnings(&self) -> &Warnings {
+        &self.warnings
+    }
+
+    /// Descriptions of the pairs that overlapped past the smaller radius for the first time
+    /// since the last call.
+    pub fn take_new_warnings(&mut self) -> Vec<String> {
+        let fresh = std::mem::take(&mut self.warnings.fresh);
+        match &self.domain {
+            // Every process's (collective).
+            Some(d) => crate::parallel::domain::gather_lines(&*d.comm, fresh),
+            None => fresh,
+        }
+    }
+
+    /// The likely cause of an instability, from the time step and the material.
+    pub fn advice(&self) -> String {
+        let s = &self.scenario;
+        let dt = s.simulation.timestep;
+        let eq50 = s.eq50_timestep();
+        if dt > eq50 {
+            format!(
+                "timestep {dt:.3e} s exceeds Eq. 50's {eq50:.3e} s for this stiffness and density \
+                 ({:.1} x): try timestep <= {eq50:.3e} s (or leave it unset)",
+                dt / eq50
+            )
+        } else {
+            format!(
+                "timestep {dt:.3e} s is within Eq. 50's {eq50:.3e} s: check for particles \
+                 created overlapping each other or the mesh, radii below radius_min, very \
+                 high impact speeds or strong friction (try a smaller timestep, e.g. {:.3e} s)",
+                dt / 5.0
+            )
+        }
+    }
+}

@@ -1,0 +1,851 @@
+//! The simulation: state and the time step as named stages.
+//!
+//! ```text
+//! step:  move meshes -> spawn -> update neighbours -> particle contacts -> mesh contacts
+//!        -> integrate -> tag -> exchange (split runs) -> check stability -> remove
+//! ```
+
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use anyhow::{Result, bail};
+use glam::DVec3;
+use rayon::prelude::*;
+
+pub use crate::engine::records::{ContactRecord, Outflow, Partner, Removed, Snapshot, Wrench};
+use crate::geometry::mesh::{Contacts, Face, Mesh};
+use crate::model::contact::{Body, Coefficients, ContactLaw, Kinematics, Other};
+use crate::model::exact::{Scale, Scales8, Sum6, pack};
+use crate::model::integrate::{Density, Inertia, Response, State, advance};
+use crate::model::lanes::{Gather, Lanes};
+use crate::model::motion::{Motion, Pose, RigidVelocity};
+use crate::model::particles::Particles;
+use crate::neighbours::{
+    CellGrid, ContactList, FACE_PIECE, Histories, History, MIN_PARALLEL_LEN, NONE, Neighbours,
+    Store, cut, face_grid,
+};
+use crate::parallel::domain::Domain;
+
+mod advance;
+mod checks;
+mod faces;
+mod pairs;
+pub mod records;
+mod report;
+mod setup;
+pub mod spawn;
+mod split;
+use crate::engine::spawn::{Spawner, SpawnerState};
+use crate::geometry::surface::{self, Candidate, Fate};
+use crate::model::springs::Springs;
+use crate::scenario::{MeshSource, Scenario};
+
+/// Contacts per group evaluated together: 8 doubles fill an AVX-512 register, two AVX ones.
+const WIDTH: usize = 8;
+type Group = wide::f64x8;
+
+/// Force (components 0-2) and torque (3-5) on one particle, summed over its contacts during
+/// a step (Eqs. 1-2), exactly (`exact.rs`): the same bits in whatever order the contacts add
+/// to it.
+type Load = Sum6;
+
+/// The resolutions of the force and torque sums, from the largest force and torque the
+/// scenario's materials and radii can produce (see [`LoadScales::of`]).
+#[derive(Clone, Copy, Debug)]
+pub struct LoadScales {
+    pub force: Scale,
+    pub torque: Scale,
+    /// Of a load's components.
+    lanes: Scales8,
+}
+
+impl LoadScales {
+    /// The largest radius the scenario's particles can have.
+    fn largest_radius(s: &Scenario) -> f64 {
+        let mut r_max = s.geometry.radius_max;
+        for region in &s.spawn {
+            r_max = r_max.max(region.radius.largest());
+        }
+        r_max
+    }
+
+    /// Room above the largest total load of one step on a wall: 2^20 contacts of the
+    /// largest force (far more than the grains' weight); torques with the lever `lever`.
+    const WALL_ROOM: f64 = 1048576.0;
+
+    /// The scales of a step's loads on the walls, for torques about points at most `lever`
+    /// from the particles.
+    fn walls(&self, lever: f64) -> Scales8 {
+        let largest = LoadScales::WALL_ROOM * self.force.largest();
+        let (force, torque) = (
+            Scale::for_largest(largest),
+            Scale::for_largest((largest * lever).max(f64::MIN_POSITIVE)),
+        );
+        Scales8::new([force, force, force, torque, torque, torque, force, force])
+    }
+
+    /// Room above the largest force of a contact, E* R_max^2 (Hertz at an overlap of R_max,
+    /// or the cohesion k_c pi R_max^2): 2^12, which also holds particles up to 64 R_max.
+    const ROOM: f64 = 4096.0;
+
+    /// The scales of a scenario: from its parameters only (not from the particles of the
+    /// moment), so that a resumed run and every process of a run use the same ones.
+    pub fn of(s: &Scenario) -> LoadScales {
+        let r_max = LoadScales::largest_radius(s);
+        let mut stiffest: f64 = 0.0;
+        for m in &s.materials {
+            let m = &m.properties;
+            let e_star = m.youngs_modulus / (1.0 - m.poisson_ratio * m.poisson_ratio);
+            stiffest = stiffest.max(e_star).max(std::f64::consts::PI * m.cohesion);
+        }
+        for i in &s.interactions {
+            stiffest = stiffest.max(std::f64::consts::PI * i.cohesion.unwrap_or(0.0));
+        }
+        let largest = (LoadScales::ROOM * stiffest * r_max * r_max).max(f64::MIN_POSITIVE);
+        let (force, torque) = (
+            Scale::for_largest(largest),
+            Scale::for_largest((largest * r_max).max(f64::MIN_POSITIVE)),
+        );
+        LoadScales {
+            force,
+            torque,
+            lanes: Scales8::new([force, force, force, torque, torque, torque, force, force]),
+        }
+    }
+}
+
+/// A piece of owners `owners` of a contact list: their loads, and the contacts of their
+/// slots (which start at slot `first`) with the piece's store.
+struct Piece<'a> {
+    owners: std::ops::Range<usize>,
+    first: usize,
+    loads: &'a mut [Load],
+    contact: &'a mut [u32],
+    store: &'a mut Store,
+}
+
+/// The pieces of a contact list (its run starts `start`, owner bounds `bounds` of its pieces,
+/// its slots' `contact` and its `stores`), each with the `loads` of its owners.
+fn pieces<'a>(
+    bounds: &[u32],
+    loads: &'a mut [Load],
+    start: &[u32],
+    contact: &'a mut [u32],
+    stores: &'a mut [Store],
+) -> Vec<Piece<'a>> {
+    let owners: Vec<usize> = bounds.iter().map(|&o| o as usize).collect();
+    let slots: Vec<usize> = owners.iter().map(|&o| start[o] as usize).collect();
+    cut(loads, &owners)
+        .into_iter()
+        .zip(cut(contact, &slots))
+        .zip(stores.iter_mut())
+        .enumerate()
+        .map(|(k, ((loads, contact), store))| Piece {
+            owners: owners[k]..owners[k + 1],
+            first: slots[k],
+            loads,
+            contact,
+            store,
+        })
+        .collect()
+}
+
+/// The springs of store entries `c` in the lanes of a group.
+#[inline(always)]
+fn gather_springs(store: &Store, c: [u32; WIDTH]) -> Springs<Group> {
+    let (mut u_s, mut u_r, mut u_t) = ([DVec3::ZERO; WIDTH], [DVec3::ZERO; WIDTH], [0.0; WIDTH]);
+    for l in 0..WIDTH {
+        let s = &store.springs[c[l] as usize];
+        (u_s[l], u_r[l], u_t[l]) = (s.u_s, s.u_r, s.u_t);
+    }
+    Springs {
+        u_s: Group::gather_vec(u_s),
+        u_r: Group::gather_vec(u_r),
+        u_t: Group::gather(u_t),
+    }
+}
+
+/// Puts the springs of a group's lanes back into store entries `c` (the first `c.len()`
+/// lanes).
+#[inline(always)]
+fn scatter_springs(lanes: Springs<Group>, store: &mut Store, c: &[u32]) {
+    let (u_s, u_r, u_t) = (
+        Group::scatter_vec(lanes.u_s),
+        Group::scatter_vec(lanes.u_r),
+        lanes.u_t.scatter(),
+    );
+    for (l, &c) in c.iter().enumerate() {
+        store.springs[c as usize] = Springs {
+            u_s: u_s[l],
+            u_r: u_r[l],
+            u_t: u_t[l],
+        };
+    }
+}
+
+/// The stages of a step, for the timing breakdown.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stage {
+    MoveMeshes,
+    Spawn,
+    Neighbours,
+    ParticleContacts,
+    MeshContacts,
+    Integrate,
+    Tag,
+    Exchange,
+    Stability,
+    Remove,
+}
+
+impl Stage {
+    pub const ALL: [Stage; 10] = [
+        Stage::MoveMeshes,
+        Stage::Spawn,
+        Stage::Neighbours,
+        Stage::ParticleContacts,
+        Stage::MeshContacts,
+        Stage::Integrate,
+        Stage::Tag,
+        Stage::Exchange,
+        Stage::Stability,
+        Stage::Remove,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Stage::MoveMeshes => "move meshes",
+            Stage::Spawn => "spawn",
+            Stage::Neighbours => "neighbour lists",
+            Stage::ParticleContacts => "particle contacts",
+            Stage::MeshContacts => "mesh contacts",
+            Stage::Integrate => "integrate",
+            Stage::Tag => "tag",
+            Stage::Exchange => "exchange",
+            Stage::Stability => "stability check",
+            Stage::Remove => "remove",
+        }
+    }
+}
+
+/// Wall time spent in each stage of the step so far \[s\].
+#[derive(Clone, Debug, Default)]
+pub struct StageTimes {
+    seconds: [f64; Stage::ALL.len()],
+}
+
+impl StageTimes {
+    fn add(&mut self, stage: Stage, since: Instant) -> Instant {
+        let now = Instant::now();
+        self.seconds[stage as usize] += (now - since).as_secs_f64();
+        now
+    }
+
+    /// Seconds spent in `stage`.
+    pub fn of(&self, stage: Stage) -> f64 {
+        self.seconds[stage as usize]
+    }
+
+    /// Seconds spent in all stages.
+    pub fn total(&self) -> f64 {
+        self.seconds.iter().sum()
+    }
+}
+
+/// An overlap deeper than `limit`, the smaller radius (the particle's, against a face):
+/// a warning; deeper than twice that, a sign of instability.
+#[derive(Clone, Copy, Debug)]
+pub struct Deep {
+    i: usize,
+    other: Partner,
+    delta: f64,
+    limit: f64,
+}
+
+impl Deep {
+    /// Whether the overlap passes the smaller diameter: the smaller body is wholly inside
+    /// the other, which no transient of a stable run does.
+    fn through(&self) -> bool {
+        self.delta > 2.0 * self.limit
+    }
+
+    /// "particles 1 and 2 overlap by ..., more than the smaller radius ..." (or diameter),
+    /// naming the particles by their `ids`.
+    fn describe(&self, ids: &[u32]) -> String {
+        let (bound, size) = if self.through() {
+            ("diameter", 2.0 * self.limit)
+        } else {
+            ("radius", self.limit)
+        };
+        let i = ids[self.i];
+        match self.other {
+            Partner::Particle(j) => {
+                let (a, b) = (i.min(ids[j]), i.max(ids[j]));
+                format!(
+                    "particles {a} and {b} overlap by {:.3e} m, more than the smaller {bound} {size:.3e} m",
+                    self.delta
+                )
+            }
+            Partner::Face(f) => format!(
+                "particle {i} overlaps mesh face {f} by {:.3e} m, more than its {bound} {size:.3e} m",
+                self.delta
+            ),
+        }
+    }
+
+    /// The pair in ids, the same whatever the storage order.
+    fn key(&self, ids: &[u32]) -> (u32, Partner) {
+        let i = ids[self.i];
+        match self.other {
+            Partner::Particle(j) => (i.min(ids[j]), Partner::Particle(i.max(ids[j]) as usize)),
+            face => (i, face),
+        }
+    }
+}
+
+/// Overlaps deeper than the smaller radius that did not stop the run, each pair counted
+/// once.
+#[derive(Clone, Debug, Default)]
+pub struct Warnings {
+    /// Pairs by id: the particle (the lower id of a particle pair) and its partner.
+    seen: rustc_hash::FxHashSet<(u32, Partner)>,
+    /// Descriptions of the pairs seen for the first time since the last
+    /// [`Simulation::take_new_warnings`], with their step.
+    fresh: Vec<String>,
+}
+
+impl Warnings {
+    /// Number of pairs that have overlapped by more than the smaller radius.
+    pub fn count(&self) -> usize {
+        self.seen.len()
+    }
+}
+
+/// A run that has become numerically unstable.
+#[derive(Clone, Debug)]
+pub struct Unstable {
+    pub step: u64,
+    pub time: f64,
+    /// The offending particles and contacts (at most five).
+    pub what: Vec<String>,
+    /// The likely cause and what to try.
+    pub advice: String,
+}
+
+impl std::fmt::Display for Unstable {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "the run became unstable at step {} (t = {:.6e} s): ",
+            self.step, self.time
+        )?;
+        write!(f, "{}", self.what.join("; "))?;
+        write!(f, ". Likely cause: {}", self.advice)
+    }
+}
+
+impl std::error::Error for Unstable {}
+
+/// Fails unless every particle's material is one of the scenario's.
+fn check_materials(p: &Particles, s: &Scenario) -> Result<()> {
+    let n = s.materials.len();
+    if let Some(k) = (0..p.len()).find(|&k| p.material[k] as usize >= n) {
+        bail!(
+            "particle {} has material {}, but the scenario has {n} material{} (0 to {})",
+            p.id[k],
+            p.material[k],
+            if n == 1 { "" } else { "s" },
+            n - 1
+        );
+    }
+    Ok(())
+}
+
+/// The state in numbers (`Simulation::thermo`), for the status line and `log.csv`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Thermo {
+    pub particles: usize,
+    /// Kinetic energy, translational and rotational \[J\], and its rotational part.
+    pub kinetic_energy: f64,
+    pub rotational_energy: f64,
+    /// Touching particle pairs and particle-face contacts in the last step.
+    pub pair_contacts: usize,
+    pub wall_contacts: usize,
+    /// The deepest overlap relative to the smaller radius (the particle's, against a face).
+    pub max_overlap: f64,
+    /// Particles removed so far by the outlets and the domain bounds.
+    pub removed: u64,
+}
+
+impl Thermo {
+    /// Contacts per particle: each pair counts for both, each face contact for its particle.
+    pub fn contacts_per_particle(&self) -> f64 {
+        match self.particles {
+            0 => 0.0,
+            n => (2 * self.pair_contacts + self.wall_contacts) as f64 / n as f64,
+        }
+    }
+}
+
+/// `face_part` of a face that does not move.
+const STATIC: u32 = u32::MAX;
+
+/// A mesh file whose faces follow a prescribed motion.
+#[derive(Clone, Debug)]
+struct MovingPart {
+    faces: std::ops::Range<usize>,
+    motion: Motion,
+    /// Velocity field at the current time.
+    velocity: RigidVelocity,
+    /// Corners of its faces at rest, to measure how far they moved.
+    corners: Vec<DVec3>,
+    /// Pose at the last neighbour-list rebuild.
+    pose_at_build: Pose,
+}
+
+/// Where a mesh file's faces are in [`Simulation::mesh`]: `[geometry] mesh` first, then the
+/// `[[meshes]]` in order.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshFile {
+    pub name: String,
+    pub faces: std::ops::Range<usize>,
+    pub contacts: Contacts,
+    /// The point torques on it are taken about: the origin, or the centre of its rotation.
+    pub torque_about: DVec3,
+    /// The material of its faces.
+    pub material: u16,
+}
+
+/// A running simulation.
+pub struct Simulation {
+    pub scenario: Scenario,
+    pub particles: Particles,
+    pub mesh: Mesh,
+    /// The mesh files `mesh` was put together from.
+    pub mesh_files: Vec<MeshFile>,
+    law: ContactLaw,
+    pub(crate) neighbours: Neighbours,
+    pub(crate) face_grid: CellGrid,
+    pub(crate) spawner: Spawner,
+    /// Force and torque on each particle (storage order), summed by stages 3 and 4 and used
+    /// up by stage 5.
+    loads: Vec<Load>,
+    /// The resolutions of the loads' sums.
+    scales: LoadScales,
+    /// Some force or torque of the last step was beyond the range of the sums, or not
+    /// finite (the run is unstable).
+    beyond_range: bool,
+    /// The mesh as read (at t = 0).
+    rest_faces: Vec<Face>,
+    /// Parts of the mesh that follow a prescribed motion.
+    moving: Vec<MovingPart>,
+    /// For each face, its moving part, or `STATIC`.
+    face_part: Vec<u32>,
+    /// Largest displacement of a moving face since the last neighbour-list rebuild.
+    mesh_drift: f64,
+    /// Step of the last neighbour-list rebuild.
+    pub(crate) built_at: u64,
+    /// Simulated time \[T\] and number of steps taken.
+    pub time: f64,
+    pub steps: u64,
+    /// Wall time per stage.
+    pub stage_times: StageTimes,
+    /// Overlaps past the smaller radius that did not stop the run.
+    warnings: Warnings,
+    /// Particles removed so far by the outlets and the domain bounds.
+    pub removed: Removed,
+    /// For each face, its mesh file (an index of `mesh_files`), if wall loads are summed.
+    face_file: Vec<u32>,
+    /// For each face, its material.
+    face_material: Vec<u16>,
+    /// For each material, the quotients of its density.
+    pub(crate) densities: Vec<Density>,
+    /// The loads on each mesh file summed over the steps since the last call of
+    /// [`Simulation::take_wall_loads`] (`[output] wall_forces`): each step's exactly (over
+    /// all contacts, and all processes), then the steps in order.
+    pub(crate) wall_sums: Vec<Wrench>,
+    /// The resolutions of the wall loads' sums of a step.
+    wall_scales: Scales8,
+    /// The largest radius the faces are binned for.
+    pub(crate) face_grid_radius: f64,
+    /// This process's share of a run split over several (`domain.rs`).
+    pub(crate) domain: Option<Domain>,
+}
+
+impl Simulation {
+    /// The complete state of the run (collective in a split run, where it fails if the
+    /// state of some process is not one a checkpoint may hold).
+    pub fn snapshot(&self) -> Result<Snapshot> {
+        if self.domain.is_some() {
+            return self.snapshot_split();
+        }
+        let p = &self.particles;
+        let history = self.neighbours.history(&p.id, p.next_id as usize);
+        let (anchors, lonely) = self.neighbours.anchors();
+        Ok(Snapshot {
+            steps: self.steps,
+            built_at: self.built_at,
+            particles: p.clone(),
+            spawner: self.spawner.state(),
+            anchors: anchors.to_vec(),
+            lonely: lonely.to_vec(),
+            pair_history: history.pairs.entries(),
+            face_history: history.faces.entries(),
+            removed: self.removed.clone(),
+            wall_sums: self.wall_sums.clone(),
+            scenario: self.scenario.to_toml(),
+            mesh_files: self.mesh_signatures(),
+        })
+    }
+
+    /// Face count and a hash of the rest geometry of each mesh file (shape, radius and
+    /// contact mode of its faces, in order).
+    pub fn mesh_signatures(&self) -> Vec<(u64, u64)> {
+        self.mesh_files
+            .iter()
+            .map(|file| {
+                let faces = &self.rest_faces[file.faces.clone()];
+                let text: String = faces
+                    .iter()
+                    .map(|f| format!("{:?}{:?}{:?};", f.shape, f.radius, f.contacts))
+                    .collect();
+                (faces.len() as u64, crate::engine::records::hash(&text))
+            })
+            .collect()
+    }
+
+    /// Number of neighbour-list rebuilds so far.
+    pub fn rebuilds(&self) -> u64 {
+        self.neighbours.rebuilds
+    }
+
+    /// Number of listed particle pairs and particle-face pairs (Verlet list slots).
+    pub fn list_slots(&self) -> (usize, usize) {
+        (self.neighbours.pairs.slots(), self.neighbours.faces.slots())
+    }
+
+    /// Number of particle-particle and particle-face contacts in the last step.
+    pub fn contact_count(&self) -> usize {
+        let nb = &self.neighbours;
+        nb.pairs.contacts() + nb.wrapped.contacts() + nb.faces.contacts()
+    }
+
+    /// The particles with their positions put back into the domain along its periodic
+    /// axes (between neighbour-list rebuilds they may be up to half the skin beyond a side),
+    /// for output; the particles themselves if it has none.
+    pub fn particles_in_domain(&self) -> std::borrow::Cow<'_, Particles> {
+        // Of a split run, all processes' (collective), in id order.
+        let mut p = match (&self.domain, self.neighbours.periodic) {
+            (None, None) => return std::borrow::Cow::Borrowed(&self.particles),
+            (None, Some(_)) => self.particles.clone(),
+            (Some(_), _) => self.gather_particles(),
+        };
+        if let Some(periodic) = self.neighbours.periodic {
+            for (x, v) in p.x.iter_mut().zip(p.v.iter_mut()) {
+                (*x, *v) = periodic.wrap_state(*x, *v);
+            }
+        }
+        std::borrow::Cow::Owned(p)
+    }
+
+    /// Advances the simulation by one time step Δt.
+    ///
+    /// Fails, leaving the state as computed, when the run has become unstable: an overlap
+    /// deeper than the smaller radius, or a non-finite position or velocity.
+    pub fn step(&mut self) -> Result<(), Unstable> {
+        let t = Instant::now();
+        self.slide_images();
+        self.move_meshes();
+        let t = self.stage_times.add(Stage::MoveMeshes, t);
+        self.spawn();
+        let t = self.stage_times.add(Stage::Spawn, t);
+        self.update_neighbours();
+        let t = self.stage_times.add(Stage::Neighbours, t);
+        let mut deep = self.particle_contacts();
+        let t = self.stage_times.add(Stage::ParticleContacts, t);
+        deep.extend(self.mesh_contacts());
+        let t = self.stage_times.add(Stage::MeshContacts, t);
+        let non_finite = self.integrate();
+        let t = self.stage_times.add(Stage::Integrate, t);
+        self.tag();
+        let t = self.stage_times.add(Stage::Tag, t);
+        self.refresh_ghosts();
+        let t = self.stage_times.add(Stage::Exchange, t);
+        self.steps += 1;
+        self.time = self.steps as f64 * self.scenario.simulation.timestep;
+        self.check_stability(deep, non_finite || self.beyond_range)?;
+        let t = self.stage_times.add(Stage::Stability, t);
+        self.remove();
+        self.stage_times.add(Stage::Remove, t);
+        Ok(())
+    }
+
+    /// Stage 7: particles whose centre has entered an outlet or left the domain are
+    /// removed (counted, with their mass, by the outlet or the domain: the first outlet
+    /// that holds a particle takes it). The lists are rebuilt without them; the ids of the
+    /// others stay.
+    #[inline(never)] // a stage of its own in profiles
+    fn remove(&mut self) {
+        let s = &self.scenario;
+        if !s.removes() {
+            return;
+        }
+        let (domain, outlets, periodic) = (s.domain, s.outlets.clone(), s.periodic);
+        // Outside the domain through a side that is not periodic.
+        let outside = move |x: DVec3| {
+            domain.is_some_and(|d| {
+                (0..3).any(|a| !periodic[a] && (x[a] < d.min[a] || x[a] > d.max[a]))
+            })
+        };
+        // Where each removed particle goes: an outlet, or `outlets.len()` for the domain.
+        let fate = move |x: DVec3| -> Option<u32> {
+            if let Some(k) = outlets.iter().position(|o| o.contains(x)) {
+                return Some(k as u32);
+            }
+            outside(x).then_some(outlets.len() as u32)
+        };
+        if self.domain.is_some() {
+            return self.remove_split(fate);
+        }
+        let p = &self.particles;
+        let gone: Vec<(u32, u32)> =
+            p.x.par_iter()
+                .enumerate()
+                .with_min_len(4 * MIN_PARALLEL_LEN)
+                .filter_map(|(i, x)| fate(*x).map(|f| (i as u32, f)))
+                .collect();
+        if gone.is_empty() {
+            return;
+        }
+        // Counted in id order, so the masses sum in an order of their own.
+        let mut by_id: Vec<(u32, u32, u32)> = gone
+            .iter()
+            .map(|&(i, f)| (p.id[i as usize], i, f))
+            .collect();
+        by_id.sort_unstable();
+        let densities = &self.densities;
+        for &(_, i, f) in &by_id {
+            let out = match self.removed.outlets.get_mut(f as usize) {
+                Some(o) => o,
+                None => &mut self.removed.domain,
+            };
+            out.count += 1;
+            let material = densities[p.material[i as usize] as usize];
+            out.mass += Inertia::mass_with(p.radius[i as usize], material.mass_per_r3);
+        }
+        let gone: Vec<u32> = gone.into_iter().map(|(i, _)| i).collect();
+        self.neighbours.rebuild_without(
+            &mut self.particles,
+            &gone,
+            &self.mesh.faces,
+            &self.face_grid,
+        );
+        self.built();
+    }
+
+    /// Whether frames name each particle's id and material: particles can be removed (or
+    /// were, in an earlier stage), so the line of a particle is not its id, or there are
+    /// several materials.
+    pub fn frames_carry_ids(&self) -> bool {
+        let p = &self.particles;
+        self.scenario.removes()
+            || self.scenario.materials.len() > 1
+            || p.next_id as usize != self.particle_count()
+    }
+
+    /// Starts summing the loads on each mesh file (`take_wall_loads`).
+    fn sum_wall_loads(&mut self) {
+        if !self.scenario.wall_forces {
+            return;
+        }
+        self.face_file = vec![0; self.mesh.faces.len()];
+        for (k, file) in self.mesh_files.iter().enumerate() {
+            self.face_file[file.faces.clone()].fill(k as u32);
+        }
+        self.wall_sums = vec![Wrench::default(); self.mesh_files.len()];
+        // The lever of a torque about a file's point: to its farthest corner, or across the
+        // domain, and a particle's radius; 16 times that, for meshes that move.
+        let mut lever: f64 = 0.0;
+        for file in &self.mesh_files {
+            for face in &self.rest_faces[file.faces.clone()] {
+                for c in face.corners() {
+                    lever = lever.max(c.distance(file.torque_about) + face.radius);
+                }
+            }
+        }
+        if let Some(d) = self.scenario.domain {
+            lever = lever.max((d.max - d.min).length());
+        }
+        lever = 16.0 * (lever + LoadScales::largest_radius(&self.scenario));
+        self.wall_scales = self.scales.walls(lever);
+    }
+
+    /// The loads on each mesh file summed over the steps since the last call, and the
+    /// sums set back to zero (empty unless `[output] wall_forces`).
+    pub fn take_wall_loads(&mut self) -> Vec<Wrench> {
+        let zero = vec![Wrench::default(); self.wall_sums.len()];
+        std::mem::replace(&mut self.wall_sums, zero)
+    }
+
+    /// Stage 5b: particles whose centre is inside a `[[tags]]` box take its tag.
+    #[inline(never)] // a stage of its own in profiles
+    fn tag(&mut self) {
+        let regions = &self.scenario.tags;
+        if regions.is_empty() {
+            return;
+        }
+        let p = &mut self.particles;
+        p.tag
+            .par_iter_mut()
+            .zip(p.x.par_iter())
+            .with_min_len(4 * MIN_PARALLEL_LEN)
+            .for_each(|(tag, x)| {
+                for r in regions {
+                    if x.cmpge(r.min).all() && x.cmple(r.max).all() {
+                        *tag = r.tag;
+                    }
+                }
+            });
+    }
+
+    /// Whether frames carry a tag column: the scenario tags particles, or they came tagged.
+    pub fn has_tags(&self) -> bool {
+        let tagged = self.particles.tagged();
+        let tagged = self.domain.as_ref().map_or(tagged, |d| d.comm.any(tagged));
+        !self.scenario.tags.is_empty() || tagged
+    }
+
+    /// Stage 0: moving mesh parts to their pose at the current time, with their velocity.
+    pub(crate) fn move_meshes(&mut self) {
+        let t = self.time;
+        let mut drift: f64 = 0.0;
+        for part in &mut self.moving {
+            let pose = part.motion.pose(t);
+            for f in part.faces.clone() {
+                self.mesh.faces[f] = self.rest_faces[f].moved(&pose);
+            }
+            part.velocity = part.motion.velocity(t);
+            for &c in &part.corners {
+                drift = drift.max(pose.point(c).distance(part.pose_at_build.point(c)));
+            }
+        }
+        self.mesh_drift = drift;
+    }
+
+    /// Records the mesh pose at a neighbour-list rebuild, and re-bins moved faces.
+    fn mark_mesh_built(&mut self) {
+        let t = self.time;
+        for part in &mut self.moving {
+            part.pose_at_build = part.motion.pose(t);
+        }
+        self.mesh_drift = 0.0;
+    }
+
+    /// The rest geometry of the mesh (for checkpoint fingerprints).
+    pub fn rest_mesh(&self) -> Mesh {
+        Mesh {
+            faces: self.rest_faces.clone(),
+            vertices: self.mesh.vertices.clone(),
+        }
+    }
+
+    /// The mesh as it is at time `t` (for pictures of frames).
+    pub fn mesh_at(&mut self, t: f64) -> &Mesh {
+        let now = self.time;
+        self.time = t;
+        self.move_meshes();
+        self.time = now;
+        &self.mesh
+    }
+
+    /// Whether some part of the mesh moves.
+    pub fn mesh_moves(&self) -> bool {
+        !self.moving.is_empty()
+    }
+
+    /// Particles inserted by each `[[spawn]]` region so far.
+    pub fn spawned(&self) -> Vec<u64> {
+        let mut n = self.spawner.inserted();
+        n.resize(self.scenario.spawn.len(), 0);
+        n
+    }
+
+    /// Stage 1 (Section 3.1): new particles in the spawn box or the `[[spawn]]` regions.
+    #[inline(never)] // a stage of its own in profiles
+    fn spawn(&mut self) {
+        if self.domain.is_some() {
+            return self.spawn_split();
+        }
+        let s = &self.scenario;
+        if (self.particles.next_id as u64) < s.simulation.max_particles {
+            self.spawner.spawn(
+                s,
+                &mut self.particles,
+                &self.mesh.faces,
+                &self.face_grid,
+                self.time,
+                0.0,
+            );
+        }
+    }
+
+    /// Lees-Edwards: the images across the gradient sides of a sheared domain to their
+    /// offset V t now (for the lists and the spawner).
+    pub(crate) fn slide_images(&mut self) {
+        let time = self.time;
+        if let Some(periodic) = &mut self.neighbours.periodic
+            && let Some(shear) = &mut periodic.shear
+        {
+            shear.offset = shear.velocity * time;
+        }
+        self.spawner.periodic = self.neighbours.periodic;
+    }
+
+    /// Stage 2 (Section 3.3): rebuild the Verlet lists when they may miss a contact.
+    #[inline(never)] // a stage of its own in profiles
+    fn update_neighbours(&mut self) {
+        let p = &self.particles;
+        let stale = self.neighbours.stale(
+            &p.x,
+            &p.radius,
+            &self.mesh.faces,
+            self.mesh_drift.max(self.neighbours.shear_drift()),
+        );
+        match &self.domain {
+            // Split over processes: all rebuild when one must.
+            Some(d) if d.comm.any(stale) => {
+                self.redistribute(&Default::default(), crate::parallel::domain::Placement::Now)
+            }
+            Some(_) => {}
+            None if stale => self.rebuild_lists(!self.moving.is_empty()),
+            None => {}
+        }
+    }
+
+    /// Rebuilds the Verlet lists (re-sorting the particles into spatial order), re-binning
+    /// the faces first if `regrid_faces` (they moved, or larger particles appeared).
+    fn rebuild_lists(&mut self, regrid_faces: bool) {
+        if regrid_faces || self.particles.max_radius() > self.face_grid_radius {
+            self.regrid_faces();
+        }
+        self.neighbours
+            .rebuild(&mut self.particles, &self.mesh.faces, &self.face_grid);
+        self.built();
+    }
+
+    /// Bins the faces as they are now for particles up to the largest radius.
+    fn regrid_faces(&mut self) {
+        let g = &self.scenario.geometry;
+        self.regrid_faces_for(g.radius_max.max(self.particles.max_radius()));
+    }
+
+    /// After a rebuild: loads for the particles, pieces of the face list, and the mesh pose
+    /// the lists were built with.
+    pub(crate) fn built(&mut self) {
+        self.loads.clear();
+        self.loads.resize(self.particles.len(), Load::default());
+        self.built_at = self.steps;
+        self.mark_mesh_built();
+    }
+}

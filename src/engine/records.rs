@@ -1,0 +1,106 @@
+//! The records of a run that the engine makes and the output writes: the snapshot a
+//! checkpoint holds, the contacts of a contact network, the particles removed and the loads
+//! on the walls. They live below both, so that neither imports the other.
+
+use glam::DVec3;
+
+use crate::engine::spawn::SpawnerState;
+use crate::model::particles::Particles;
+use crate::model::springs::Springs;
+
+/// Everything needed to continue a run bit for bit: particles (in storage order, with their
+/// ids), step count, the spawner's place in its random stream, the contact history (the
+/// friction springs of every touching pair, Table 3, by particle id), and what rebuilds the
+/// neighbour lists of the last rebuild exactly: its step, the positions it anchored the
+/// particles at and its lonely particles.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Snapshot {
+    pub steps: u64,
+    pub built_at: u64,
+    pub particles: Particles,
+    pub spawner: SpawnerState,
+    pub anchors: Vec<DVec3>,
+    pub lonely: Vec<(u32, f64)>,
+    /// Particle pairs by (lower id, higher id) and particle-face contacts by (id, face).
+    pub pair_history: Vec<(u32, u32, Springs)>,
+    pub face_history: Vec<(u32, u32, Springs)>,
+    /// The particles removed so far.
+    pub removed: Removed,
+    /// The loads on the mesh files summed since the last frame (`[output] wall_forces`).
+    pub wall_sums: Vec<Wrench>,
+    /// The resolved scenario of the run (`Scenario::to_toml`), to tell what a staged run
+    /// changes.
+    pub scenario: String,
+    /// Face count and a hash of the faces of each mesh file, to find them in the mesh of a
+    /// staged run.
+    pub mesh_files: Vec<(u64, u64)>,
+}
+
+/// The partner of a particle in a contact.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Partner {
+    Particle(usize),
+    Face(usize),
+}
+
+/// Particles removed, and their mass.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Outflow {
+    pub count: u64,
+    /// \[M\]
+    pub mass: f64,
+}
+
+/// The particles removed so far: by each `[[outlets]]` box, and for leaving the `[domain]`.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Removed {
+    pub outlets: Vec<Outflow>,
+    pub domain: Outflow,
+}
+
+impl Removed {
+    /// All particles removed so far.
+    pub fn count(&self) -> u64 {
+        self.domain.count + self.outlets.iter().map(|o| o.count).sum::<u64>()
+    }
+}
+
+/// The force and torque that particles exert on a body (a mesh file).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Wrench {
+    /// [ML/T²]
+    pub f: DVec3,
+    /// [ML²/T²], about the body's reference point.
+    pub tau: DVec3,
+}
+
+impl std::ops::AddAssign for Wrench {
+    fn add_assign(&mut self, o: Wrench) {
+        self.f += o.f;
+        self.tau += o.tau;
+    }
+}
+
+/// A contact of the network (`Simulation::contact_network`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactRecord {
+    /// The particle (its id; the lower one of a pair).
+    pub id: u32,
+    /// The other particle (its id) or the face (its index in the mesh).
+    pub with: Partner,
+    /// Where the two touch: x_i - r_i n (Eq. 29).
+    pub point: DVec3,
+    /// The force on particle `id`: its normal and tangential parts \[N\].
+    pub f_n: DVec3,
+    pub f_t: DVec3,
+    /// δ \[L\]
+    pub overlap: f64,
+}
+
+/// FNV-1a, 64 bit, of `text`: how records name what they were made from (the mesh files'
+/// faces, a checkpoint's scenario).
+pub fn hash(text: &str) -> u64 {
+    text.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
+        (h ^ b as u64).wrapping_mul(0x100_0000_01b3)
+    })
+}

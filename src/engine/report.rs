@@ -1,0 +1,216 @@
+//! What the run reports of its state: the contact network and the numbers of `log.csv`
+//! (`Thermo`), over all processes of a split run.
+
+use super::*;
+
+impl Simulation {
+    /// The contact network at the current state: every touching particle pair and
+    /// particle-face contact (as the last step resolved them) with the force the law gives
+    /// it now, from its current springs (left unchanged): the forces the next step applies.
+    /// Pairs by (lower id, higher id), then contacts with faces by (id, face).
+    pub fn contact_network(&self) -> Vec<ContactRecord> {
+        let mut network = self.held_contact_network();
+        if let Some(d) = &self.domain {
+            // Each contact from the process that owns its particle (of a pair, the lower id).
+            let p = &self.particles;
+            let own: rustc_hash::FxHashSet<u32> = (0..p.len())
+                .filter(|&k| d.owned[k])
+                .map(|k| p.id[k])
+                .collect();
+            network.retain(|c| own.contains(&c.id));
+            network = super::split::gather_contacts(&*d.comm, network);
+        }
+        network
+    }
+
+    /// The contact network of the particles this process holds (own and ghosts).
+    pub(super) fn held_contact_network(&self) -> Vec<ContactRecord> {
+        let p = &self.particles;
+        let law = &self.law;
+        let mass = |k: usize| {
+            Inertia::mass_with(
+                p.radius[k],
+                self.densities[p.material[k] as usize].mass_per_r3,
+            )
+        };
+        let body = |k: usize| Body {
+            x: p.x[k],
+            radius: p.radius[k],
+            v: p.v[k],
+            w: p.w[k],
+        };
+        let record = |i: usize, other: Other, kin: &Kinematics, coef, springs: Springs, with| {
+            let mut springs = springs;
+            let force = law.evaluate(coef, p.radius[i], mass(i), other, kin, &mut springs);
+            let f_n = kin.n * kin.n.dot(force.f);
+            ContactRecord {
+                id: p.id[i],
+                with,
+                point: p.x[i] - kin.n * kin.r_i,
+                f_n,
+                f_t: force.f - f_n,
+                overlap: kin.delta,
+            }
+        };
+        let mut out = Vec::new();
+        // Each open contact of `list`: owner, partner, springs and slot.
+        let open = |list: &ContactList| {
+            let mut v = Vec::new();
+            for piece in 0..list.pieces.len().saturating_sub(1) {
+                let store = &list.stores[piece];
+                for i in list.pieces[piece] as usize..list.pieces[piece + 1] as usize {
+                    for k in list.run(i) {
+                        if list.contact[k] != NONE {
+                            let springs = store.springs[list.contact[k] as usize];
+                            v.push((i, list.partner[k] as usize, springs, k));
+                        }
+                    }
+                }
+            }
+            v
+        };
+        // Pairs within the box, and across periodic sides with the partner at its image.
+        let nb = &self.neighbours;
+        let within = open(&nb.pairs).into_iter().map(|(a, b, s, _)| {
+            let (i, j) = if p.id[a] < p.id[b] { (a, b) } else { (b, a) };
+            (i, j, s, DVec3::ZERO, DVec3::ZERO)
+        });
+        let across = open(&nb.wrapped).into_iter().map(|(a, b, s, k)| {
+            let (i, j, shift, dv) = nb.across(&p.id, a, b, k);
+            (i, j, s, shift, dv)
+        });
+        for (i, j, springs, shift, dv) in within.chain(across) {
+            let bj = Body {
+                x: p.x[j] + shift,
+                v: p.v[j] + dv,
+                ..body(j)
+            };
+            let Some(kin) = Kinematics::between_particles(&body(i), &bj) else {
+                continue;
+            };
+            let other = Other::Particle {
+                r: p.radius[j],
+                m: mass(j),
+            };
+            let coef = law.pair(p.material[i], p.material[j]);
+            out.push(record(
+                i,
+                other,
+                &kin,
+                coef,
+                springs,
+                Partner::Particle(p.id[j] as usize),
+            ));
+        }
+        for (i, f, springs, _) in open(&self.neighbours.faces) {
+            let face = &self.mesh.faces[f];
+            let wall = match self.face_part[f] {
+                STATIC => RigidVelocity::default(),
+                part => self.moving[part as usize].velocity,
+            };
+            let b = body(i);
+            let (d, feature) = face.separation_and_feature(b.x);
+            let (d, _) = surface::snap(face, b.x, b.radius, d, feature);
+            let Some(kin) = Kinematics::with_wall(&b, d, face.radius, &wall) else {
+                continue;
+            };
+            let coef = law.with_wall(p.material[i], self.face_material[f]);
+            out.push(record(
+                i,
+                Other::Wall,
+                &kin,
+                coef,
+                springs,
+                Partner::Face(f),
+            ));
+        }
+        out.sort_by_key(|r| match r.with {
+            Partner::Particle(j) => (0, r.id, j),
+            Partner::Face(f) => (1, r.id, f),
+        });
+        out
+    }
+
+    /// What the status line and `log.csv` report of the current state, as LAMMPS's thermo
+    /// output does: the energies (summed in id order, so the same for any storage order),
+    /// the contacts of the last step and the deepest of them relative to the smaller radius.
+    pub fn thermo(&self) -> Thermo {
+        let p = &self.particles;
+        let mut energies: Vec<(u32, f64, f64)> = (0..p.len())
+            .filter(|&k| self.own(k))
+            .map(|k| {
+                let m = Inertia::mass_with(
+                    p.radius[k],
+                    self.densities[p.material[k] as usize].mass_per_r3,
+                );
+                let i = 0.4 * m * p.radius[k] * p.radius[k];
+                (
+                    p.id[k],
+                    0.5 * m * p.v[k].length_squared(),
+                    0.5 * i * p.w[k].length_squared(),
+                )
+            })
+            .collect();
+        if let Some(d) = &self.domain {
+            // Over all processes, still in id order.
+            use crate::parallel::comm::{Reader, Writer};
+            let mut w = Writer::default();
+            for &(id, t, r) in &energies {
+                w.u32(id);
+                w.f64(t);
+                w.f64(r);
+            }
+            energies.clear();
+            for m in d.comm.all_gather(w.0) {
+                let mut r = Reader::new(&m);
+                while !r.done() {
+                    energies.push((r.u32(), r.f64(), r.f64()));
+                }
+            }
+        }
+        energies.sort_unstable_by_key(|e| e.0);
+        let (translational, rotational) = energies
+            .iter()
+            .fold((0.0, 0.0), |(t, r), e| (t + e.1, r + e.2));
+        let radius_of: rustc_hash::FxHashMap<u32, f64> =
+            p.id.iter().copied().zip(p.radius.iter().copied()).collect();
+        let own: Option<rustc_hash::FxHashSet<u32>> = self.domain.as_ref().map(|d| {
+            (0..p.len())
+                .filter(|&k| d.owned[k])
+                .map(|k| p.id[k])
+                .collect()
+        });
+        let mut thermo = Thermo {
+            particles: energies.len(),
+            kinetic_energy: translational + rotational,
+            rotational_energy: rotational,
+            removed: self.removed.count(),
+            ..Thermo::default()
+        };
+        for c in self.held_contact_network() {
+            if own.as_ref().is_some_and(|own| !own.contains(&c.id)) {
+                continue; // told by the process that owns it
+            }
+            let r = radius_of[&c.id];
+            let smaller = match c.with {
+                Partner::Particle(j) => {
+                    thermo.pair_contacts += 1;
+                    r.min(radius_of[&(j as u32)])
+                }
+                Partner::Face(_) => {
+                    thermo.wall_contacts += 1;
+                    r
+                }
+            };
+            thermo.max_overlap = thermo.max_overlap.max(c.overlap / smaller);
+        }
+        if let Some(d) = &self.domain {
+            let counts = d
+                .comm
+                .sum_i64(&[thermo.pair_contacts as i64, thermo.wall_contacts as i64]);
+            (thermo.pair_contacts, thermo.wall_contacts) = (counts[0] as usize, counts[1] as usize);
+            thermo.max_overlap = d.comm.max(thermo.max_overlap);
+        }
+        thermo
+    }
+}

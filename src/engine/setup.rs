@@ -1,0 +1,354 @@
+//! Making a simulation: from a scenario (`new`, `from_parts`), from a checkpoint of the same
+//! run (`restore`: bit for bit) or as a new stage after another run (`stage`).
+
+use super::*;
+
+impl Simulation {
+    /// Sets up a simulation: reads the mesh and the initial particles.
+    pub fn new(scenario: Scenario) -> Result<Simulation> {
+        let g = &scenario.geometry;
+        let (mut mesh, name) = match &g.mesh {
+            MeshSource::None => (Mesh::default(), String::new()),
+            MeshSource::File(path) => {
+                (Mesh::load(path, &g.mesh_radii)?, path.display().to_string())
+            }
+            MeshSource::Embedded { name, text } => (
+                Mesh::parse_off(text, name, &g.mesh_radii)?,
+                name.to_string(),
+            ),
+        };
+        mesh = mesh.with_contacts(g.mesh_contacts);
+        let mut files = vec![MeshFile {
+            name,
+            faces: 0..mesh.faces.len(),
+            contacts: g.mesh_contacts,
+            torque_about: DVec3::ZERO,
+            material: g.mesh_material,
+        }];
+        let mut moving = Vec::new();
+        for spec in &scenario.meshes {
+            let part = Mesh::load(&spec.file, &spec.radii)?.with_contacts(spec.contacts);
+            let faces = mesh.faces.len()..mesh.faces.len() + part.faces.len();
+            if let Some(motion) = spec.motion {
+                moving.push((faces.clone(), motion));
+            }
+            files.push(MeshFile {
+                name: spec.file.display().to_string(),
+                faces,
+                contacts: spec.contacts,
+                torque_about: match spec.motion {
+                    Some(Motion::Rotation { center, .. }) => center,
+                    _ => DVec3::ZERO,
+                },
+                material: spec.material,
+            });
+            mesh.append(part);
+        }
+        let particles = match &scenario.particles {
+            Some(path) => crate::io::csv::load_particles(path)?,
+            None => Particles::default(),
+        };
+        let mut sim = Simulation::from_parts(scenario, mesh, particles)?;
+        sim.mesh_files = files;
+        for file in &sim.mesh_files {
+            sim.face_material[file.faces.clone()].fill(file.material);
+        }
+        sim.sum_wall_loads();
+        for (faces, motion) in moving {
+            for f in faces.clone() {
+                sim.face_part[f] = sim.moving.len() as u32;
+            }
+            let corners = sim.rest_faces[faces.clone()]
+                .iter()
+                .flat_map(Face::corners)
+                .collect();
+            sim.moving.push(MovingPart {
+                faces,
+                motion,
+                velocity: RigidVelocity::default(),
+                corners,
+                pose_at_build: Pose::REST,
+            });
+        }
+        sim.move_meshes();
+        Ok(sim)
+    }
+
+    /// Continues a run from a snapshot taken by [`Simulation::snapshot`] with the same
+    /// scenario: the result is bitwise the same as if the run had not stopped.
+    pub fn restore(scenario: Scenario, snapshot: Snapshot) -> Result<Simulation> {
+        let input = scenario.particles.clone();
+        let mut sim = Simulation::new(Scenario {
+            particles: None,
+            ..scenario
+        })?;
+        // The particles come from the snapshot; the scenario keeps its input file, so that
+        // its `run.toml` reruns the run.
+        sim.scenario.particles = input;
+        let misfit = |what: String| anyhow::anyhow!("the checkpoint does not fit: {what}");
+        let built = !snapshot.anchors.is_empty();
+        if built && snapshot.anchors.len() != snapshot.particles.len() {
+            return Err(misfit("one anchor per particle".into()));
+        }
+        check_materials(&snapshot.particles, &sim.scenario)
+            .map_err(|e| misfit(format!("{e:#}")))?;
+        sim.particles = snapshot.particles;
+        let (regions, spawn) = (snapshot.spawner.regions.len(), sim.scenario.spawn.len());
+        if regions > spawn {
+            return Err(misfit(format!(
+                "it counts the insertions of {regions} [[spawn]] regions, the scenario has {spawn}"
+            )));
+        }
+        let (sums, files) = (snapshot.wall_sums.len(), sim.mesh_files.len());
+        if sums != 0 && sums != files {
+            return Err(misfit(format!(
+                "it sums the loads on {sums} mesh files, the scenario has {files}"
+            )));
+        }
+        sim.spawner = Spawner::resume(sim.scenario.simulation.seed, snapshot.spawner);
+        if snapshot.removed.outlets.len() > sim.removed.outlets.len() {
+            return Err(misfit(format!(
+                "it counts {} outlets, the scenario has {}",
+                snapshot.removed.outlets.len(),
+                sim.removed.outlets.len()
+            )));
+        }
+        sim.removed.domain = snapshot.removed.domain;
+        sim.removed.outlets[..snapshot.removed.outlets.len()]
+            .copy_from_slice(&snapshot.removed.outlets);
+        if !sim.wall_sums.is_empty() && snapshot.wall_sums.len() == sim.wall_sums.len() {
+            sim.wall_sums = snapshot.wall_sums;
+        }
+        let history = Histories {
+            pairs: History::in_storage(&sim.particles, &snapshot.pair_history, true)
+                .map_err(misfit)?,
+            faces: History::in_storage(&sim.particles, &snapshot.face_history, false)
+                .map_err(misfit)?,
+        };
+        if let Some(&(_, f, _)) = snapshot
+            .face_history
+            .iter()
+            .find(|e| e.1 as usize >= sim.mesh.faces.len())
+        {
+            return Err(misfit(format!(
+                "contact with face {f}, which the mesh lacks"
+            )));
+        }
+        let dt = sim.scenario.simulation.timestep;
+        if !built {
+            // Taken before the first step: the lists are made as that step would make them.
+            sim.steps = snapshot.steps;
+            sim.time = sim.steps as f64 * dt;
+            sim.move_meshes();
+            sim.neighbours =
+                Neighbours::with_periodic(sim.neighbours.skin, sim.neighbours.periodic);
+            return Ok(sim);
+        }
+        // The lists of the last rebuild, built again with the mesh (and sheared images)
+        // where they were then.
+        sim.steps = snapshot.built_at;
+        sim.time = sim.steps as f64 * dt;
+        sim.slide_images();
+        sim.move_meshes();
+        sim.regrid_faces();
+        sim.neighbours.restore(
+            &sim.particles,
+            snapshot.anchors,
+            snapshot.lonely,
+            &sim.mesh.faces,
+            &sim.face_grid,
+            &history,
+        );
+        sim.built();
+        sim.steps = snapshot.steps;
+        sim.time = sim.steps as f64 * dt;
+        sim.move_meshes();
+        Ok(sim)
+    }
+
+    /// Starts a new stage of a study from the snapshot of another run (`tinydem run NEXT
+    /// --from CHECKPOINT`): the particles (ids, materials, tags) and all their contact
+    /// history are the snapshot's, everything else is `scenario`'s, whose clock starts at 0
+    /// (its meshes start their motions at rest, its frames count from 0). Contacts with a
+    /// mesh file are carried when `scenario` has the same file (the same faces), wherever
+    /// it stands in the list; the spawner continues its random stream if the seed is the
+    /// same. When the mesh is the same too, the lists are rebuilt as the run had them, so a
+    /// stage that only adds frames gives the bits of one uninterrupted run. Returns what was
+    /// carried and dropped, for the user.
+    pub fn stage(scenario: Scenario, snapshot: Snapshot) -> Result<(Simulation, Vec<String>)> {
+        if scenario.particles.is_some() {
+            bail!(
+                "[input] particles cannot be combined with --from: the particles are those of the checkpoint"
+            );
+        }
+        let mut sim = Simulation::new(scenario)?;
+        let misfit = |what: String| anyhow::anyhow!("the checkpoint does not fit: {what}");
+        let mut notes = Vec::new();
+        let p = snapshot.particles;
+        check_materials(&p, &sim.scenario).map_err(|e| misfit(format!("{e:#}")))?;
+        let old_seed = if snapshot.scenario.is_empty() {
+            None
+        } else {
+            let old = Scenario::parse(&snapshot.scenario, std::path::Path::new("checkpoint"))
+                .map_err(|e| misfit(format!("its scenario does not parse: {e:#}")))?;
+            if old.lees_edwards.is_some() {
+                bail!(
+                    "a run with Lees-Edwards boundaries cannot start a stage yet (its images would jump back to offset 0): continue it with --resume"
+                );
+            }
+            Some(old.simulation.seed)
+        };
+        if old_seed == Some(sim.scenario.simulation.seed) {
+            // The stage's [[spawn]] regions are its own: their counts start at 0 with its
+            // clock.
+            let state = SpawnerState {
+                regions: Vec::new(),
+                ..snapshot.spawner
+            };
+            sim.spawner = Spawner::resume(sim.scenario.simulation.seed, state);
+            notes.push("spawning continues the random stream of the checkpoint".into());
+        } else {
+            notes.push(format!(
+                "spawning draws from a new random stream (seed {})",
+                sim.scenario.simulation.seed
+            ));
+        }
+        // Each mesh file of the checkpoint's run, found among this scenario's by its faces.
+        let new_files = sim.mesh_signatures();
+        let mut taken = vec![false; new_files.len()];
+        let mut face_map: Vec<Option<u32>> = Vec::new();
+        for old in &snapshot.mesh_files {
+            let found = (0..new_files.len()).find(|&j| !taken[j] && new_files[j] == *old);
+            if let Some(j) = found {
+                taken[j] = true;
+            }
+            let start = found.map(|j| sim.mesh_files[j].faces.start as u32);
+            face_map.extend((0..old.0 as u32).map(|f| start.map(|s| s + f)));
+        }
+        let face_history: Vec<_> = snapshot
+            .face_history
+            .iter()
+            .filter_map(|&(id, f, springs)| {
+                face_map
+                    .get(f as usize)
+                    .copied()
+                    .flatten()
+                    .map(|f| (id, f, springs))
+            })
+            .collect();
+        let dropped = snapshot.face_history.len() - face_history.len();
+        let same_mesh = snapshot.mesh_files == new_files;
+        notes.push(format!(
+            "carried {} particles, {} particle contacts and {} contacts with meshes{}",
+            p.len(),
+            snapshot.pair_history.len(),
+            face_history.len(),
+            if dropped > 0 {
+                format!(" ({dropped} with mesh files this scenario lacks were dropped)")
+            } else {
+                String::new()
+            }
+        ));
+        let history = Histories {
+            pairs: History::in_storage(&p, &snapshot.pair_history, true).map_err(misfit)?,
+            faces: History::in_storage(&p, &face_history, false).map_err(misfit)?,
+        };
+        let built = !snapshot.anchors.is_empty();
+        if built && snapshot.anchors.len() != p.len() {
+            return Err(misfit("one anchor per particle".into()));
+        }
+        sim.particles = p;
+        if built {
+            // The lists at the positions of the run's last rebuild; the allowances of its
+            // lonely particles hold only for the same mesh.
+            let lonely = if same_mesh {
+                snapshot.lonely
+            } else {
+                Vec::new()
+            };
+            sim.regrid_faces();
+            sim.neighbours.restore(
+                &sim.particles,
+                snapshot.anchors,
+                lonely,
+                &sim.mesh.faces,
+                &sim.face_grid,
+                &history,
+            );
+            sim.built();
+        }
+        Ok((sim, notes))
+    }
+
+    /// Sets up a simulation from a mesh and particles already in memory.
+    pub fn from_parts(scenario: Scenario, mesh: Mesh, particles: Particles) -> Result<Simulation> {
+        let g = &scenario.geometry;
+        let max_radius = g.radius_max.max(particles.max_radius());
+        if particles.len() as u64 > u32::MAX as u64 / 2 {
+            bail!("too many particles: {}", particles.len());
+        }
+        check_materials(&particles, &scenario)?;
+        if let Some(periodic) = scenario.periodicity() {
+            let periods = scenario.simulation.shortest_period();
+            let shortest = periods * max_radius;
+            for a in 0..3 {
+                if periodic.axes[a] && periodic.length[a] < shortest {
+                    bail!(
+                        "the period {} of the domain along axis {a} is shorter than {periods} times the largest radius ({shortest})",
+                        periodic.length[a]
+                    );
+                }
+            }
+        }
+        let skin = scenario.simulation.skin * g.radius_max;
+        let face_grid = face_grid(&mesh.faces, max_radius, skin);
+        let mut sim = Simulation {
+            law: ContactLaw::of(&scenario),
+            neighbours: Neighbours::with_periodic(skin, scenario.periodicity()),
+            face_grid,
+            spawner: Spawner::new(scenario.simulation.seed),
+            loads: Vec::new(),
+            scales: LoadScales::of(&scenario),
+            beyond_range: false,
+            rest_faces: mesh.faces.clone(),
+            moving: Vec::new(),
+            face_part: vec![STATIC; mesh.faces.len()],
+            mesh_drift: 0.0,
+            built_at: 0,
+            time: 0.0,
+            steps: 0,
+            stage_times: StageTimes::default(),
+            warnings: Warnings::default(),
+            mesh_files: vec![MeshFile {
+                name: "mesh".into(),
+                faces: 0..mesh.faces.len(),
+                contacts: mesh
+                    .faces
+                    .first()
+                    .map_or_else(Contacts::default, |f| f.contacts),
+                torque_about: DVec3::ZERO,
+                material: scenario.geometry.mesh_material,
+            }],
+            face_material: vec![scenario.geometry.mesh_material; mesh.faces.len()],
+            densities: scenario
+                .materials
+                .iter()
+                .map(|m| Density::new(m.properties.density, m.properties.viscosity))
+                .collect(),
+            removed: Removed {
+                outlets: vec![Outflow::default(); scenario.outlets.len()],
+                domain: Outflow::default(),
+            },
+            face_file: Vec::new(),
+            wall_sums: Vec::new(),
+            wall_scales: Scales8::new([Scale::for_largest(1.0); 8]),
+            face_grid_radius: max_radius,
+            domain: None,
+            scenario,
+            particles,
+            mesh,
+        };
+        sim.sum_wall_loads();
+        Ok(sim)
+    }
+}

@@ -1,0 +1,388 @@
+//! Particle spawning (paper Section 3.1): in the `[geometry]` spawn box, or in `[[spawn]]`
+//! regions with a count, a rate, a time window, a material, a velocity and a distribution of
+//! radii.
+
+use glam::{DQuat, DVec3};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rustc_hash::FxHashMap;
+
+use crate::geometry::mesh::Face;
+use crate::model::particles::{Particle, Particles};
+use crate::neighbours::{CellGrid, cell_of, key};
+use crate::scenario::{RadiusDistribution, Region, Scenario, SpawnRegion};
+
+/// Draws spawn attempts from a seeded random stream, so the same seed gives the same run.
+#[derive(Clone, Debug)]
+pub struct Spawner {
+    rng: ChaCha8Rng,
+    /// A radius whose attempt failed, carried over to the next attempt so that the size
+    /// distribution is not biased toward small particles (the spawn box's).
+    pending_radius: Option<f64>,
+    /// What each `[[spawn]]` region has done so far.
+    regions: Vec<RegionState>,
+    /// The periodic axes of the domain, as they are now (its shear offset), to test
+    /// candidates against the images of particles across the sides.
+    pub periodic: Option<crate::neighbours::Periodic>,
+}
+
+/// How far a `[[spawn]]` region has got: particles inserted, and its pending radius.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RegionState {
+    pub inserted: u64,
+    pub pending_radius: Option<f64>,
+}
+
+/// Uniform in [lo, hi]; exactly `lo` for a degenerate interval (2D and 1D spawn regions).
+fn uniform(rng: &mut ChaCha8Rng, lo: f64, hi: f64) -> f64 {
+    if hi > lo {
+        rng.random_range(lo..=hi)
+    } else {
+        lo
+    }
+}
+
+/// A standard normal number (Box-Muller, from two uniform draws).
+fn standard_normal(rng: &mut ChaCha8Rng) -> f64 {
+    let u1: f64 = 1.0 - rng.random_range(0.0..1.0); // in (0, 1]
+    let u2: f64 = rng.random_range(0.0..1.0);
+    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+}
+
+/// A radius drawn from `d`. Truncated distributions draw again outside their bounds (at
+/// most a thousand times, then the nearest bound: only for a range far in a tail).
+fn draw(rng: &mut ChaCha8Rng, d: &RadiusDistribution) -> f64 {
+    let truncated = |rng: &mut ChaCha8Rng, min: f64, max: f64, f: &dyn Fn(f64) -> f64| {
+        let mut r = f(standard_normal(rng));
+        for _ in 0..1000 {
+            if (min..=max).contains(&r) {
+                return r;
+            }
+            r = f(standard_normal(rng));
+        }
+        r.clamp(min, max)
+    };
+    match *d {
+        RadiusDistribution::Uniform { min, max } => uniform(rng, min, max),
+        RadiusDistribution::Normal {
+            mean,
+            std,
+            min,
+            max,
+        } => truncated(rng, min, max, &|z| mean + std * z),
+        RadiusDistribution::LogNormal {
+            mean,
+            std,
+            min,
+            max,
+        } => {
+            // ln R ~ N(mu, sigma²) with the mean and deviation of R itself.
+            let sigma2 = (1.0 + (std / mean).powi(2)).ln();
+            let mu = mean.ln() - 0.5 * sigma2;
+            truncated(rng, min, max, &|z| (mu + sigma2.sqrt() * z).exp())
+        }
+        RadiusDistribution::Table {
+            ref radii,
+            ref weights,
+        } => {
+            let total: f64 = weights.iter().sum();
+            let u = rng.random_range(0.0..1.0) * total;
+            let mut sum = 0.0;
+            for (r, w) in radii.iter().zip(weights) {
+                sum += w;
+                if u < sum {
+                    return *r;
+                }
+            }
+            *radii.last().expect("at least one radius")
+        }
+    }
+}
+
+/// How many particles region `r` should have inserted by the end of the step at `t`:
+/// floor(rate (t + dt - start)), or its count.
+fn due(r: &SpawnRegion, dt: f64, t: f64) -> u64 {
+    match r.rate {
+        Some(rate) => (rate * (t + dt - r.start)).floor() as u64,
+        None => u64::MAX,
+    }
+    .min(r.count.unwrap_or(u64::MAX))
+}
+
+/// The position of a spawner in its random stream, for checkpoints.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SpawnerState {
+    pub word_pos: u128,
+    pub pending_radius: Option<f64>,
+    pub regions: Vec<RegionState>,
+}
+
+/// What one insertion draws from and where it puts its particles.
+struct Source<'a> {
+    region: Region,
+    radius: &'a RadiusDistribution,
+    velocity: DVec3,
+    material: u16,
+}
+
+impl Spawner {
+    pub fn state(&self) -> SpawnerState {
+        SpawnerState {
+            word_pos: self.rng.get_word_pos(),
+            pending_radius: self.pending_radius,
+            regions: self.regions.clone(),
+        }
+    }
+
+    /// A spawner for `seed` continued at `state`.
+    pub fn resume(seed: u64, state: SpawnerState) -> Self {
+        let mut s = Spawner::new(seed);
+        s.rng.set_word_pos(state.word_pos);
+        s.pending_radius = state.pending_radius;
+        s.regions = state.regions;
+        s
+    }
+
+    pub fn new(seed: u64) -> Self {
+        Spawner {
+            rng: ChaCha8Rng::seed_from_u64(seed),
+            pending_radius: None,
+            regions: Vec::new(),
+            periodic: None,
+        }
+    }
+
+    /// Particles inserted by each `[[spawn]]` region so far.
+    pub fn inserted(&self) -> Vec<u64> {
+        self.regions.iter().map(|r| r.inserted).collect()
+    }
+
+    /// Whether a step at time `t` would try to spawn, `next_id` particles having been made.
+    pub fn active(&self, s: &Scenario, next_id: u32, t: f64) -> bool {
+        if s.simulation.spawn_attempts == 0 || next_id as u64 >= s.simulation.max_particles {
+            return false;
+        }
+        if s.spawn.is_empty() {
+            return true;
+        }
+        s.spawn.iter().enumerate().any(|(k, r)| {
+            let inserted = self.regions.get(k).map_or(0, |st| st.inserted);
+            t >= r.start && t < r.stop && inserted < due(r, s.simulation.timestep, t)
+        })
+    }
+
+    /// The boxes spawned into: the `[[spawn]]` regions, or the spawn box.
+    pub fn regions(s: &Scenario) -> Vec<Region> {
+        if s.spawn.is_empty() {
+            vec![Region {
+                min: s.geometry.spawn_min,
+                max: s.geometry.spawn_max,
+            }]
+        } else {
+            s.spawn.iter().map(|r| r.region).collect()
+        }
+    }
+
+    /// One step of spawning at time `t` (the step ends at `t + dt`), until `N_max`
+    /// particles have been created (those removed since included). Without `[[spawn]]`
+    /// regions: up to `N_spawn` attempts in the spawn box, each with a uniform centre and a
+    /// uniform radius in [R_min, R_max] (the paper's). With regions: each active one (from
+    /// `start` until `stop`) makes up to `N_spawn` attempts until it has inserted what its
+    /// rate asks for by the end of the step (floor(rate (t + dt - start))) or its count. An
+    /// attempt is rejected if the sphere would overlap a particle or a mesh face. Returns
+    /// the number of particles added. `present` is the largest radius of the particles
+    /// that exist (`particles` may hold only those near the regions: a process's share).
+    #[allow(clippy::too_many_arguments)]
+    pub fn spawn(
+        &mut self,
+        s: &Scenario,
+        particles: &mut Particles,
+        faces: &[Face],
+        face_grid: &CellGrid,
+        t: f64,
+        present: f64,
+    ) -> usize {
+        let g = &s.geometry;
+        let max = s.simulation.max_particles;
+        let attempts = s.simulation.spawn_attempts;
+        if attempts == 0 || particles.next_id as u64 >= max {
+            return 0;
+        }
+        if s.spawn.is_empty() {
+            let uniform = RadiusDistribution::Uniform {
+                min: g.radius_min,
+                max: g.radius_max,
+            };
+            let source = Source {
+                region: Region {
+                    min: g.spawn_min,
+                    max: g.spawn_max,
+                },
+                radius: &uniform,
+                velocity: s.kinetics.initial_velocity,
+                material: 0,
+            };
+            let mut pending = self.pending_radius;
+            let n = self.insert(
+                s,
+                &source,
+                attempts,
+                u64::MAX,
+                &mut pending,
+                (particles, present),
+                faces,
+                face_grid,
+            );
+            self.pending_radius = pending;
+            return n as usize;
+        }
+        self.regions.resize(s.spawn.len(), RegionState::default());
+        let dt = s.simulation.timestep;
+        let mut added = 0;
+        for (k, r) in s.spawn.iter().enumerate() {
+            if t < r.start || t >= r.stop {
+                continue;
+            }
+            let due = due(r, dt, t);
+            let state = self.regions[k];
+            if state.inserted >= due {
+                continue;
+            }
+            let source = Source {
+                region: r.region,
+                radius: &r.radius,
+                velocity: r.velocity,
+                material: r.material,
+            };
+            let mut pending = state.pending_radius;
+            let n = self.insert(
+                s,
+                &source,
+                attempts,
+                due - state.inserted,
+                &mut pending,
+                (particles, present),
+                faces,
+                face_grid,
+            );
+            self.regions[k] = RegionState {
+                inserted: state.inserted + n,
+                pending_radius: pending,
+            };
+            added += n as usize;
+        }
+        added
+    }
+
+    /// Up to `attempts` attempts to insert at most `budget` particles from `source`
+    /// (and no more than `N_max` created in all); `pending` is the radius carried over
+    /// from a failed attempt. Returns how many it inserted.
+    #[allow(clippy::too_many_arguments)]
+    fn insert(
+        &mut self,
+        s: &Scenario,
+        source: &Source,
+        attempts: u64,
+        budget: u64,
+        pending: &mut Option<f64>,
+        (particles, present): (&mut Particles, f64),
+        faces: &[Face],
+        face_grid: &CellGrid,
+    ) -> u64 {
+        let max = s.simulation.max_particles;
+        // A grid of the particles that a sphere in the region could touch, grown as
+        // particles are added.
+        let h = 2.0
+            * s.geometry
+                .radius_max
+                .max(particles.max_radius())
+                .max(present);
+        let inv_h = 1.0 / h;
+        let near = Region {
+            min: source.region.min - DVec3::splat(h),
+            max: source.region.max + DVec3::splat(h),
+        };
+        // In a periodic domain a sphere may touch the images of particles near the far side.
+        let periodic = self.periodic;
+        let wrap = |x: DVec3| periodic.map_or(x, |p| p.wrap(x));
+        let mut shifts = Vec::new();
+        let mut cells: FxHashMap<u64, Vec<u32>> = FxHashMap::default();
+        for (i, &x) in particles.x.iter().enumerate() {
+            let x = wrap(x);
+            if periodic.is_some() || near.contains(x) {
+                cells
+                    .entry(key(cell_of(x, inv_h)))
+                    .or_default()
+                    .push(i as u32);
+            }
+        }
+        let (lo, hi) = (source.region.min, source.region.max);
+        let mut inserted = 0;
+        for _ in 0..attempts {
+            if particles.next_id as u64 >= max || inserted >= budget {
+                break;
+            }
+            let radius = match *pending {
+                Some(r) => r,
+                None => draw(&mut self.rng, source.radius),
+            };
+            let x = DVec3::new(
+                uniform(&mut self.rng, lo.x, hi.x),
+                uniform(&mut self.rng, lo.y, hi.y),
+                uniform(&mut self.rng, lo.z, hi.z),
+            );
+            let overlaps = |at: DVec3| {
+                let c = cell_of(at, inv_h);
+                for dz in -1..=1 {
+                    for dy in -1..=1 {
+                        for dx in -1..=1 {
+                            let Some(list) = cells.get(&key(c + glam::IVec3::new(dx, dy, dz)))
+                            else {
+                                continue;
+                            };
+                            for &j in list {
+                                let j = j as usize;
+                                let reach = radius + particles.radius[j];
+                                if (at - wrap(particles.x[j])).length_squared() < reach * reach {
+                                    return true;
+                                }
+                            }
+                        }
+                    }
+                }
+                false
+            };
+            let mut free = !overlaps(x);
+            if free && let Some(p) = periodic {
+                p.image_shifts(wrap(x), h, &mut shifts);
+                free = shifts.iter().all(|&(s, _)| !overlaps(wrap(x) + s));
+            }
+            free = free
+                && face_grid.at(x).iter().all(|&f| {
+                    let face = &faces[f as usize];
+                    let reach = radius + face.radius;
+                    face.separation(x).length_squared() >= reach * reach
+                });
+            if !free {
+                *pending = Some(radius);
+                continue;
+            }
+            *pending = None;
+            cells
+                .entry(key(cell_of(wrap(x), inv_h)))
+                .or_default()
+                .push(particles.len() as u32);
+            particles.push(Particle {
+                x,
+                radius,
+                v: source.velocity,
+                q: DQuat::IDENTITY,
+                w: s.kinetics.initial_angular_velocity,
+                tag: 0,
+                material: source.material,
+            });
+            inserted += 1;
+        }
+        inserted
+    }
+}

@@ -1,0 +1,625 @@
+//! The split run's side of the simulation (`parallel/domain.rs` holds the decomposition
+//! itself): splitting a simulation over processes, its collectives (`any`, `agree`), the
+//! redistribution of particles and their contact history at rebuilds, ghosts, spawning and
+//! removal over all processes, and the gathers of particles, contacts and snapshots.
+
+use super::*;
+use crate::parallel::comm::{Comm, Reader, Writer};
+use crate::parallel::domain::{
+    Domain, GHOST_STATE, Placement, REBALANCE, Tree, agree, gather_by_id, get_entry, get_particle,
+    put_entry, put_particle,
+};
+use rustc_hash::{FxHashMap, FxHashSet};
+
+/// Every process's contacts (collective), in the order of `Simulation::contact_network`.
+pub(crate) fn gather_contacts(comm: &dyn Comm, mine: Vec<ContactRecord>) -> Vec<ContactRecord> {
+    let mut w = Writer::default();
+    for c in &mine {
+        w.u32(c.id);
+        match c.with {
+            Partner::Particle(j) => {
+                w.u8(0);
+                w.u64(j as u64);
+            }
+            Partner::Face(f) => {
+                w.u8(1);
+                w.u64(f as u64);
+            }
+        }
+        w.vec3(c.point);
+        w.vec3(c.f_n);
+        w.vec3(c.f_t);
+        w.f64(c.overlap);
+    }
+    let mut all = Vec::new();
+    for m in comm.all_gather(w.0) {
+        let mut r = Reader::new(&m);
+        while !r.done() {
+            let id = r.u32();
+            let with = match (r.u8(), r.u64() as usize) {
+                (0, j) => Partner::Particle(j),
+                (_, f) => Partner::Face(f),
+            };
+            all.push(ContactRecord {
+                id,
+                with,
+                point: r.vec3(),
+                f_n: r.vec3(),
+                f_t: r.vec3(),
+                overlap: r.f64(),
+            });
+        }
+    }
+    all.sort_by_key(|r| match r.with {
+        Partner::Particle(j) => (0, r.id, j),
+        Partner::Face(f) => (1, r.id, f),
+    });
+    all
+}
+
+impl Simulation {
+    /// Whether this process writes the output: the first of a split run.
+    pub fn is_writer(&self) -> bool {
+        self.domain.as_ref().is_none_or(|d| d.comm.rank() == 0)
+    }
+
+    /// Whether each of `flags` is set on any process (one collective in a split run).
+    pub fn any_each<const N: usize>(&self, flags: [bool; N]) -> [bool; N] {
+        match &self.domain {
+            Some(d) => {
+                let counts = d.comm.sum_i64(&flags.map(|f| f as i64));
+                std::array::from_fn(|k| counts[k] > 0)
+            }
+            None => flags,
+        }
+    }
+
+    /// This process's place among the processes of a split run: (rank, count).
+    pub fn process(&self) -> Option<(usize, usize)> {
+        self.domain.as_ref().map(|d| d.rank())
+    }
+
+    /// [`agree`] over the processes of a split run; `r` in one process.
+    pub fn agree<T>(&self, r: Result<T>) -> Result<T> {
+        match &self.domain {
+            Some(d) => agree(&*d.comm, r),
+            None => r,
+        }
+    }
+
+    /// Whether `flag` is set on any process (collective in a split run).
+    pub fn any(&self, flag: bool) -> bool {
+        self.domain.as_ref().map_or(flag, |d| d.comm.any(flag))
+    }
+
+    /// The number of particles (of all processes: collective in a split run).
+    pub fn particle_count(&self) -> usize {
+        match &self.domain {
+            Some(d) => d.comm.sum_i64(&[d.own_count() as i64])[0] as usize,
+            None => self.particles.len(),
+        }
+    }
+
+    /// The snapshot of a split run (collective): the pieces of all processes, joined
+    /// (`checkpoint::join`) as the parts of a stop checkpoint are, so that both give the
+    /// same checkpoint. An error if some process's state is not one a checkpoint may hold.
+    pub(crate) fn snapshot_split(&self) -> Result<Snapshot> {
+        let d = self.domain.as_ref().expect("a split run");
+        let mine = crate::io::checkpoint::encode(&self.snapshot_piece(), 0);
+        let pieces = d
+            .comm
+            .all_gather(mine)
+            .iter()
+            .map(|bytes| crate::io::checkpoint::decode(bytes, Some(0)))
+            .collect::<Result<Vec<_>>>()?;
+        crate::io::checkpoint::join(pieces)
+    }
+
+    /// This process's piece of the state of a split run: its own particles (with their
+    /// anchors of the last rebuild), the springs of every contact one of them is in, and the
+    /// state all processes share. `checkpoint::join` makes the snapshot of the pieces.
+    pub fn snapshot_piece(&self) -> Snapshot {
+        let d = self.domain.as_ref().expect("a split run");
+        let p = &self.particles;
+        let (mut pairs, mut faces) = self.neighbours.entries_by_id(&p.id);
+        let (anchors, _) = self.neighbours.anchors();
+        let own_ids: FxHashSet<u32> = (0..p.len())
+            .filter(|&k| d.owned[k])
+            .map(|k| p.id[k])
+            .collect();
+        let mut own = Particles {
+            next_id: p.next_id,
+            ..Particles::default()
+        };
+        let mut own_anchors = Vec::with_capacity(own_ids.len());
+        for k in (0..p.len()).filter(|&k| d.owned[k]) {
+            own.insert(p.id[k], p.get(k));
+            own_anchors.push(anchors.get(k).copied().unwrap_or(p.x[k]));
+        }
+        pairs.retain(|e| own_ids.contains(&e.0) || own_ids.contains(&e.1));
+        faces.retain(|e| own_ids.contains(&e.0));
+        Snapshot {
+            steps: self.steps,
+            built_at: self.built_at,
+            particles: own,
+            spawner: self.spawner.state(),
+            anchors: own_anchors,
+            lonely: Vec::new(),
+            pair_history: pairs,
+            face_history: faces,
+            removed: self.removed.clone(),
+            wall_sums: self.wall_sums.clone(),
+            scenario: self.scenario.to_toml(),
+            mesh_files: self.mesh_signatures(),
+        }
+    }
+
+    /// Splits this simulation over the processes of `comm`: each process calls it with the
+    /// same simulation (all its particles, as made or restored), keeps its share and the
+    /// ghosts it needs, and from then on steps together with the others.
+    pub fn split(mut self, comm: Box<dyn Comm>) -> Result<Simulation> {
+        let (rank, size) = (comm.rank(), comm.size());
+        let owned = self
+            .particles
+            .id
+            .iter()
+            .map(|&id| id as usize % size == rank)
+            .collect();
+        self.domain = Some(Domain {
+            comm,
+            tree: None,
+            owned,
+            send: Vec::new(),
+            recv: Vec::new(),
+            cuts: 0,
+        });
+        self.redistribute(&FxHashSet::default(), Placement::Anchors);
+        Ok(self)
+    }
+
+    /// This process's share of a split run, if it is one.
+    pub fn domain(&self) -> Option<&Domain> {
+        self.domain.as_ref()
+    }
+
+    /// Whether the particle of id `id` is this process's own (of a split run; in one
+    /// process, whether it exists).
+    pub fn owns(&self, id: u32) -> bool {
+        let p = &self.particles;
+        (0..p.len()).any(|i| p.id[i] == id && self.own(i))
+    }
+
+    /// Whether the particle stored at `i` is this process's own (always, in one process).
+    #[inline]
+    pub(crate) fn own(&self, i: usize) -> bool {
+        self.domain.as_ref().is_none_or(|d| d.owned[i])
+    }
+
+    /// Rebuilds the lists of every process of a split run (collective): the own particles
+    /// (but those of ids in `gone`) to the owners of the boxes they are in (the boxes cut
+    /// anew when out of balance) with the springs of their contacts, then the ghosts each
+    /// process needs, then the lists; all at the particles' places of `placement`.
+    pub(crate) fn redistribute(&mut self, gone: &FxHashSet<u32>, placement: Placement) {
+        // The anchors of the run in one process, if its lists were built: there the lists
+        // are built again, with the mesh and sheared images where they were then, as a
+        // checkpoint restores them.
+        let anchors = match placement {
+            Placement::Now => None,
+            Placement::Anchors => {
+                let (a, _) = self.neighbours.anchors();
+                (a.len() == self.particles.len()).then(|| a.to_vec())
+            }
+        };
+        // Carried along with the particles, if any.
+        let carry = anchors.is_some();
+        let clock = (self.steps, self.time);
+        if carry {
+            self.steps = self.built_at;
+            self.time = self.built_at as f64 * self.scenario.simulation.timestep;
+            self.slide_images();
+            self.move_meshes();
+        }
+        if let (Placement::Now, Some(periodic)) = (placement, self.neighbours.periodic) {
+            // As at a rebuild in one process: the particles put back into the box (the
+            // ghosts too, as their owners do, so that every process places them alike).
+            let p = &mut self.particles;
+            for (x, v) in p.x.iter_mut().zip(p.v.iter_mut()) {
+                (*x, *v) = periodic.wrap_state(*x, *v);
+            }
+        }
+        let mut d = self.domain.take().expect("a split run");
+        let (me, k) = (d.comm.rank(), d.comm.size());
+        // The old lists and particles go as soon as what they hold is out.
+        let (pairs, faces) = self.neighbours.entries_by_id(&self.particles.id);
+        self.neighbours.clear_lists();
+        let old = std::mem::take(&mut self.particles);
+        let p = &old;
+        // Where each particle is placed: at its anchor, or where it is now.
+        let place: std::borrow::Cow<[DVec3]> = match anchors {
+            Some(a) => a.into(),
+            None => p.x.as_slice().into(),
+        };
+        let index: FxHashMap<u32, u32> =
+            p.id.iter()
+                .enumerate()
+                .map(|(i, &id)| (id, i as u32))
+                .collect();
+        let kept = |i: usize| d.owned[i] && !gone.contains(&p.id[i]);
+        // The boxes, cut anew when the counts are out of balance.
+        let own: Vec<DVec3> = (0..p.len())
+            .filter(|&i| kept(i))
+            .map(|i| place[i])
+            .collect();
+        let counts: Vec<u64> = d
+            .comm
+            .all_gather((own.len() as u64).to_le_bytes().to_vec())
+            .iter()
+            .map(|c| Reader::new(c).u64())
+            .collect();
+        let mean = counts.iter().sum::<u64>() as f64 / k as f64;
+        let largest = counts.iter().copied().max().unwrap_or(0) as f64;
+        if d.tree.is_none() || largest > REBALANCE * mean.max(1.0) {
+            d.tree = Some(Tree::bisect(&*d.comm, &own));
+            d.cuts += 1;
+        }
+        drop(own);
+        let tree = d.tree.as_ref().expect("cut");
+        // Own particles that left the box to their new owners (the others stay), with the
+        // springs of their contacts. A pair's springs go to the owners of both partners,
+        // sent by the owner of its lower id (the other owner has the same springs), so each
+        // arrives once.
+        let owner = |id: u32| tree.owner(place[index[&id] as usize]);
+        let mine = |id: u32| d.owned[index[&id] as usize];
+        let mut particles_to: Vec<Vec<u32>> = vec![Vec::new(); k];
+        for i in (0..p.len()).filter(|&i| kept(i)) {
+            particles_to[tree.owner(place[i])].push(i as u32);
+        }
+        let mut pairs_to: Vec<Vec<usize>> = vec![Vec::new(); k];
+        for (e, &(a, b, _)) in pairs.iter().enumerate() {
+            if gone.contains(&a) || gone.contains(&b) || !mine(a) {
+                continue;
+            }
+            let (qa, qb) = (owner(a), owner(b));
+            pairs_to[qa].push(e);
+            if qb != qa {
+                pairs_to[qb].push(e);
+            }
+        }
+        let mut faces_to: Vec<Vec<usize>> = vec![Vec::new(); k];
+        for (e, &(a, _, _)) in faces.iter().enumerate() {
+            if !gone.contains(&a) && mine(a) {
+                faces_to[owner(a)].push(e);
+            }
+        }
+        let messages: Vec<Vec<u8>> = (0..k)
+            .map(|q| {
+                let mut w = Writer::default();
+                if q == me {
+                    return w.0; // what stays, stays
+                }
+                w.u64(particles_to[q].len() as u64);
+                for &i in &particles_to[q] {
+                    put_particle(&mut w, p.id[i as usize], &p.get(i as usize));
+                    if carry {
+                        w.vec3(place[i as usize]);
+                    }
+                }
+                w.u64(pairs_to[q].len() as u64);
+                pairs_to[q]
+                    .iter()
+                    .for_each(|&e| put_entry(&mut w, &pairs[e]));
+                w.u64(faces_to[q].len() as u64);
+                faces_to[q]
+                    .iter()
+                    .for_each(|&e| put_entry(&mut w, &faces[e]));
+                w.0
+            })
+            .collect();
+        drop(index);
+        let mut held = Particles {
+            next_id: p.next_id,
+            ..Particles::default()
+        };
+        let mut held_at = carry.then(Vec::new);
+        for &i in &particles_to[me] {
+            held.insert(p.id[i as usize], p.get(i as usize));
+            if let Some(at) = &mut held_at {
+                at.push(place[i as usize]);
+            }
+        }
+        let mut kept_pairs: Vec<_> = pairs_to[me].iter().map(|&e| pairs[e]).collect();
+        let mut kept_faces: Vec<_> = faces_to[me].iter().map(|&e| faces[e]).collect();
+        drop(place);
+        drop((particles_to, pairs_to, faces_to, pairs, faces, old));
+        for (q, m) in d.comm.all_to_all(messages).iter().enumerate() {
+            if q == me {
+                continue;
+            }
+            let mut r = Reader::new(m);
+            for _ in 0..r.u64() {
+                let (id, particle) = get_particle(&mut r);
+                held.insert(id, particle);
+                if let Some(at) = &mut held_at {
+                    at.push(r.vec3());
+                }
+            }
+            for _ in 0..r.u64() {
+                kept_pairs.push(get_entry(&mut r));
+            }
+            for _ in 0..r.u64() {
+                kept_faces.push(get_entry(&mut r));
+            }
+        }
+        let (pairs, faces) = (kept_pairs, kept_faces);
+        // Ghosts: copies of own particles for the processes whose boxes are within reach of
+        // them or, across periodic sides, of their images.
+        let n_own = held.len();
+        let r_max = d.comm.max(held.max_radius()).max(0.0);
+        let skin = self.neighbours.skin;
+        let periodic = self.neighbours.periodic;
+        let mut ghosts_to: Vec<Vec<u32>> = vec![Vec::new(); k];
+        let (mut near, mut images, mut to) = (Vec::new(), Vec::new(), Vec::new());
+        for i in 0..n_own {
+            let x = held_at.as_ref().map_or(held.x[i], |at| at[i]);
+            let reach = held.radius[i] + r_max + skin;
+            to.clear();
+            tree.near(x, reach, &mut near);
+            to.extend_from_slice(&near);
+            if let Some(periodic) = periodic {
+                periodic.image_shifts(x, reach, &mut images);
+                for &(s, _) in &images {
+                    tree.near(x + s, reach, &mut near);
+                    to.extend_from_slice(&near);
+                }
+                to.sort_unstable();
+                to.dedup();
+            }
+            for &q in to.iter().filter(|&&q| q != me) {
+                ghosts_to[q].push(i as u32);
+            }
+        }
+        let messages: Vec<Vec<u8>> = (0..k)
+            .map(|q| {
+                let mut w = Writer::default();
+                w.u64(ghosts_to[q].len() as u64);
+                for &i in &ghosts_to[q] {
+                    put_particle(&mut w, held.id[i as usize], &held.get(i as usize));
+                    if let Some(at) = &held_at {
+                        w.vec3(at[i as usize]);
+                    }
+                }
+                w.0
+            })
+            .collect();
+        let ghosts_to: Vec<Vec<u32>> = ghosts_to
+            .into_iter()
+            .map(|list| list.into_iter().map(|i| held.id[i as usize]).collect())
+            .collect();
+        let mut ghosts_from: Vec<Vec<u32>> = vec![Vec::new(); k];
+        for (q, m) in d.comm.all_to_all(messages).into_iter().enumerate() {
+            let mut r = Reader::new(&m);
+            for _ in 0..r.u64() {
+                let (id, particle) = get_particle(&mut r);
+                held.insert(id, particle);
+                if let Some(at) = &mut held_at {
+                    at.push(r.vec3());
+                }
+                ghosts_from[q].push(id);
+            }
+        }
+        let mut owned: Vec<bool> = (0..held.len()).map(|i| i < n_own).collect();
+        // The lists, with the faces binned for the largest particle of all processes.
+        self.particles = held;
+        let max_radius = self.scenario.geometry.radius_max.max(r_max);
+        if self.mesh_moves() || max_radius > self.face_grid_radius {
+            self.regrid_faces_for(max_radius);
+        }
+        let order = self.neighbours.rebuild_from(
+            &mut self.particles,
+            held_at,
+            &pairs,
+            &faces,
+            &self.mesh.faces,
+            &self.face_grid,
+        );
+        if placement == Placement::Anchors && !carry {
+            // Never built in one process: stale at the first step, as there.
+            self.neighbours.forget_anchors();
+        }
+        owned = order.iter().map(|&o| owned[o as usize]).collect();
+        let at: FxHashMap<u32, u32> = self
+            .particles
+            .id
+            .iter()
+            .enumerate()
+            .map(|(i, &id)| (id, i as u32))
+            .collect();
+        let by_id = |mut ids: Vec<u32>| {
+            ids.sort_unstable();
+            ids.iter().map(|id| at[id]).collect::<Vec<u32>>()
+        };
+        d.send = ghosts_to.into_iter().map(by_id).collect();
+        d.recv = ghosts_from.into_iter().map(by_id).collect();
+        d.owned = owned;
+        self.domain = Some(d);
+        self.built();
+        if carry {
+            (self.steps, self.time) = clock;
+            self.move_meshes();
+        }
+    }
+
+    /// Sends the new states of own particles to the processes that hold them as ghosts,
+    /// and takes theirs (collective).
+    pub(crate) fn refresh_ghosts(&mut self) {
+        let Some(d) = &self.domain else { return };
+        let p = &mut self.particles;
+        let messages: Vec<(usize, Vec<u8>)> = d
+            .send
+            .iter()
+            .enumerate()
+            .filter(|(_, list)| !list.is_empty())
+            .map(|(q, list)| {
+                let mut w = Writer(Vec::with_capacity(list.len() * GHOST_STATE));
+                for &i in list {
+                    let i = i as usize;
+                    w.vec3(p.x[i]);
+                    w.vec3(p.v[i]);
+                    w.quat(p.q[i]);
+                    w.vec3(p.w[i]);
+                    w.u32(p.tag[i]);
+                }
+                (q, w.0)
+            })
+            .collect();
+        // Only the processes that hold ghosts of ours, or ours of theirs, hear from us.
+        let from: Vec<(usize, usize)> = (0..d.recv.len())
+            .filter(|&q| !d.recv[q].is_empty())
+            .map(|q| (q, d.recv[q].len() * GHOST_STATE))
+            .collect();
+        for (m, &(q, _)) in d.comm.exchange(messages, &from).iter().zip(&from) {
+            let mut r = Reader::new(m);
+            for &i in &d.recv[q] {
+                let i = i as usize;
+                p.x[i] = r.vec3();
+                p.v[i] = r.vec3();
+                p.q[i] = r.quat();
+                p.w[i] = r.vec3();
+                p.tag[i] = r.u32();
+            }
+        }
+    }
+
+    /// Stage 1 of a split run (collective): every process draws the same candidates and
+    /// tests them against the particles of all processes near the spawn regions; each keeps
+    /// the new particles in its box.
+    pub(crate) fn spawn_split(&mut self) {
+        let s = &self.scenario;
+        let p = &self.particles;
+        if !self.spawner.active(s, p.next_id, self.time) {
+            return;
+        }
+        let d = self.domain.as_ref().expect("a split run");
+        let mut largest = s.geometry.radius_max;
+        for r in &s.spawn {
+            largest = largest.max(r.radius.largest());
+        }
+        let own_max = (0..p.len())
+            .filter(|&i| d.owned[i])
+            .map(|i| p.radius[i])
+            .fold(0.0, f64::max);
+        let present = d.comm.max(own_max).max(0.0);
+        // Twice the largest radius is the reach of a test; a little more keeps rounding
+        // (of images across the sides) from leaving out a particle at that reach.
+        let margin = DVec3::splat(2.5 * largest.max(present));
+        let regions = Spawner::regions(s);
+        let in_reach = |x: DVec3| {
+            regions
+                .iter()
+                .any(|r| x.cmpge(r.min - margin).all() && x.cmple(r.max + margin).all())
+        };
+        // In a periodic domain, also the particles whose images are near (the spawner sees
+        // them through the sides).
+        let periodic = self.spawner.periodic;
+        let mut images = Vec::new();
+        let mut near = |x: DVec3| match periodic {
+            None => in_reach(x),
+            Some(periodic) => {
+                let x = periodic.wrap(x);
+                periodic.image_shifts(x, margin.x, &mut images);
+                in_reach(x) || images.iter().any(|&(s, _)| in_reach(x + s))
+            }
+        };
+        let picked: Vec<bool> = (0..p.len()).map(|i| d.owned[i] && near(p.x[i])).collect();
+        let old_next = p.next_id;
+        let mut around = gather_by_id(&*d.comm, p, |i| picked[i]);
+        self.spawner.spawn(
+            s,
+            &mut around,
+            &self.mesh.faces,
+            &self.face_grid,
+            self.time,
+            present,
+        );
+        if around.next_id == old_next {
+            return;
+        }
+        let d = self.domain.as_mut().expect("a split run");
+        let tree = d.tree.as_ref().expect("cut");
+        let me = d.comm.rank();
+        for i in (0..around.len()).filter(|&i| around.id[i] >= old_next) {
+            let particle = around.get(i);
+            if tree.owner(particle.x) == me {
+                self.particles.insert(around.id[i], particle);
+                d.owned.push(true);
+            }
+        }
+        self.particles.next_id = around.next_id;
+        self.redistribute(&FxHashSet::default(), Placement::Now);
+    }
+
+    /// Stage 7 of a split run (collective): the own particles that left, counted over all
+    /// processes in id order; then every process rebuilds without them.
+    pub(crate) fn remove_split(&mut self, fate: impl Fn(DVec3) -> Option<u32>) {
+        let d = self.domain.as_ref().expect("a split run");
+        let p = &self.particles;
+        let mut w = Writer::default();
+        for i in (0..p.len()).filter(|&i| d.owned[i]) {
+            if let Some(f) = fate(p.x[i]) {
+                let density = self.densities[p.material[i] as usize];
+                w.u32(p.id[i]);
+                w.u32(f);
+                w.f64(Inertia::mass_with(p.radius[i], density.mass_per_r3));
+            }
+        }
+        let mut gone: Vec<(u32, u32, f64)> = Vec::new();
+        for m in d.comm.all_gather(w.0) {
+            let mut r = Reader::new(&m);
+            while !r.done() {
+                gone.push((r.u32(), r.u32(), r.f64()));
+            }
+        }
+        if gone.is_empty() {
+            return;
+        }
+        // Counted in id order, as in one process.
+        gone.sort_unstable_by_key(|g| g.0);
+        for &(_, f, mass) in &gone {
+            let out: &mut Outflow = match self.removed.outlets.get_mut(f as usize) {
+                Some(o) => o,
+                None => &mut self.removed.domain,
+            };
+            out.count += 1;
+            out.mass += mass;
+        }
+        let ids: FxHashSet<u32> = gone.iter().map(|g| g.0).collect();
+        self.redistribute(&ids, Placement::Now);
+    }
+
+    /// The wall loads of this step over all processes (collective): exact sums, merged.
+    pub(crate) fn reduce_walls(&self, step: &mut [Sum6]) {
+        let Some(d) = &self.domain else { return };
+        let words: Vec<i64> = step.iter().flat_map(|s| s.words()).collect();
+        let total = d.comm.sum_i64(&words);
+        for (s, w) in step.iter_mut().zip(total.chunks(12)) {
+            *s = Sum6::from_words(w.try_into().expect("12 words"));
+            s.carry();
+        }
+    }
+
+    /// All particles of a split run, in id order, on every process (collective); this
+    /// process's particles in one.
+    pub fn gather_particles(&self) -> Particles {
+        let p = &self.particles;
+        match &self.domain {
+            Some(d) => gather_by_id(&*d.comm, p, |i| d.owned[i]),
+            None => gather_by_id(&crate::parallel::comm::Solo, p, |_| true),
+        }
+    }
+
+    /// Bins the faces for particles up to radius `max_radius`.
+    pub(crate) fn regrid_faces_for(&mut self, max_radius: f64) {
+        self.face_grid = face_grid(&self.mesh.faces, max_radius, self.neighbours.skin);
+        self.face_grid_radius = max_radius;
+    }
+}

@@ -1,0 +1,5 @@
+//! Geometry: closest points on triangles, meshes and their faces, analytic surfaces.
+
+pub mod closest;
+pub mod mesh;
+pub mod surface;

@@ -1,0 +1,385 @@
+//! Checkpoints in parts: each process of a split run writes its own piece of the state at
+//! once, with no gather, so that a stop asked by the batch system is on disk within the
+//! second or two a launcher grants before SIGKILL. The first process then joins the parts
+//! into the one-file checkpoint; if it is killed first, reading the checkpoint joins them.
+//!
+//! Part `k` of `n` of the checkpoint of step `s` at `out/checkpoint.bin` is
+//! `out/checkpoint.bin.s.part-k-of-n` (the step in the name, so that the parts of two stops
+//! never mix: the set of a stop killed while writing is incomplete, and ignored): the magic
+//! `TINYDEM PART`, `k` and `n` (u32 each), then a checkpoint (format as in the parent
+//! module, with its own checksum) of that process's particles (with their anchors), the
+//! springs of every contact it holds one of, and the state all processes share. Joined,
+//! the parts give the very snapshot the gathered checkpoint holds (`Simulation::snapshot`
+//! of a split run is made the same way), so resuming from parts or from the joined file
+//! is the same.
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail, ensure};
+use glam::DVec3;
+
+use super::{decode, encode_into};
+use crate::engine::records::Snapshot;
+use crate::model::particles::{Particle, Particles};
+use crate::model::springs::Springs;
+
+const MAGIC: &[u8; 12] = b"TINYDEM PART";
+/// The bytes before a part's checkpoint.
+const HEADER: usize = 12 + 4 + 4;
+/// Where the step is in a checkpoint: after its magic, version and fingerprint.
+const STEP_AT: usize = 12 + 4 + 8;
+
+/// The path of part `k` of `n` of the checkpoint of step `step` at `path`.
+pub fn part_path(path: &Path, step: u64, k: usize, n: usize) -> PathBuf {
+    path.with_file_name(format!("{}.{step}.part-{k}-of-{n}", file_name(path)))
+}
+
+/// Which part a file is: of the checkpoint of a step, part `k` of `n`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+struct Part {
+    step: u64,
+    n: usize,
+    k: usize,
+}
+
+fn file_name(path: &Path) -> String {
+    path.file_name()
+        .map_or_else(|| "checkpoint".into(), |n| n.to_string_lossy().into_owned())
+}
+
+/// Which part `name` is, if it is a part of the checkpoint named `of`.
+fn part_of(name: &str, of: &str) -> Option<Part> {
+    let rest = name.strip_prefix(of)?.strip_prefix('.')?;
+    let (step, rest) = rest.split_once(".part-")?;
+    let (k, n) = rest.split_once("-of-")?;
+    let digits = |t: &str| !t.is_empty() && t.bytes().all(|b| b.is_ascii_digit());
+    if !(digits(step) && digits(k) && digits(n)) {
+        return None;
+    }
+    let part = Part {
+        step: step.parse().ok()?,
+        n: n.parse().ok()?,
+        k: k.parse().ok()?,
+    };
+    (part.k < part.n).then_some(part)
+}
+
+/// Whether `name` is a part of some checkpoint (output of a run, for `--overwrite`).
+pub fn is_part(name: &str) -> bool {
+    let Some(at) = name.find(".part-") else {
+        return false;
+    };
+    name[..at]
+        .rfind('.')
+        .is_some_and(|dot| part_of(name, &name[..dot]).is_some())
+}
+
+/// Writes `piece` as part `k` of `n` of the checkpoint at `path` (atomically), named by
+/// its step.
+pub fn save_part(
+    path: &Path,
+    k: usize,
+    n: usize,
+    piece: &Snapshot,
+    fingerprint: u64,
+) -> Result<()> {
+    let mut bytes = Vec::new();
+    bytes.extend_from_slice(MAGIC);
+    bytes.extend_from_slice(&(k as u32).to_le_bytes());
+    bytes.extend_from_slice(&(n as u32).to_le_bytes());
+    encode_into(&mut bytes, piece, fingerprint);
+    let part = part_path(path, piece.steps, k, n);
+    crate::io::files::write_bytes_atomically(&part, &bytes)
+        .with_context(|| format!("cannot write checkpoint part {}", part.display()))
+}
+
+/// Removes the parts of the checkpoint at `path` of other steps than `keep` (all of them if
+/// none: once the whole file holds the newest state).
+pub fn remove_parts(path: &Path, keep: Option<u64>) {
+    for (part, which) in parts_beside(path, &file_name(path)) {
+        if Some(which.step) != keep {
+            let _ = std::fs::remove_file(part);
+        }
+    }
+}
+
+/// The parts of the checkpoint named `of` in the directory of `path`, in order.
+fn parts_beside(path: &Path, of: &str) -> Vec<(PathBuf, Part)> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    let mut parts: Vec<_> = entries
+        .flatten()
+        .filter_map(|e| {
+            let part = part_of(&e.file_name().to_string_lossy(), of)?;
+            Some((e.path(), part))
+        })
+        .collect();
+    parts.sort_by_key(|p| p.1);
+    parts
+}
+
+/// The step the checkpoint file at `path` is of, if its head can be read.
+fn step_of(path: &Path) -> Option<u64> {
+    let mut head = [0; STEP_AT + 8];
+    crate::io::files::open(path)
+        .ok()?
+        .read_exact(&mut head)
+        .ok()?;
+    Some(u64::from_le_bytes(head[STEP_AT..].try_into().ok()?))
+}
+
+/// The parts to read for the checkpoint at `path`: the newest complete set (every part of
+/// one step and count), if it is of a later step than the file at `path` (a stop whose
+/// joining did not finish). Parts of an unfinished set are left alone: the stop that wrote
+/// them did not complete, and the file at `path` (or an older set) is the last complete
+/// checkpoint.
+pub fn newer_parts(path: &Path) -> Option<Vec<PathBuf>> {
+    let parts = parts_beside(path, &file_name(path));
+    let newest = parts
+        .chunk_by(|a, b| (a.1.step, a.1.n) == (b.1.step, b.1.n))
+        .filter(|set| set.len() == set[0].1.n)
+        .max_by_key(|set| set[0].1.step)?;
+    let step = newest[0].1.step;
+    step_of(path)
+        .is_none_or(|whole| step > whole)
+        .then(|| newest.iter().map(|p| p.0.clone()).collect())
+}
+
+/// Reads and joins the parts `paths` (part 0 to n-1 of one checkpoint).
+pub fn load_parts(paths: &[PathBuf], fingerprint: Option<u64>) -> Result<Snapshot> {
+    let n = paths.len();
+    let pieces = paths
+        .iter()
+        .enumerate()
+        .map(|(k, path)| {
+            let bytes = crate::io::files::read(path)?;
+            read_part(&bytes, k, n, fingerprint)
+                .and_then(|piece| of_its_step(path, &piece).map(|()| piece))
+                .with_context(|| format!("cannot resume from {}", path.display()))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    join(pieces).with_context(|| {
+        format!(
+            "cannot join the parts {} to {}",
+            paths[0].display(),
+            paths[n - 1].display()
+        )
+    })
+}
+
+fn read_part(bytes: &[u8], k: usize, n: usize, fingerprint: Option<u64>) -> Result<Snapshot> {
+    if bytes.len() < HEADER || &bytes[..12] != MAGIC {
+        bail!("not a part of a tinydem checkpoint (no 'TINYDEM PART' header)");
+    }
+    let word = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+    if (word(12), word(16)) != (k, n) {
+        bail!(
+            "corrupt: its header says part {} of {}, its name part {k} of {n}",
+            word(12),
+            word(16)
+        );
+    }
+    decode(&bytes[HEADER..], fingerprint)
+}
+
+/// Checks that the part `path`, read as `piece`, is of the step its name says.
+fn of_its_step(path: &Path, piece: &Snapshot) -> Result<()> {
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned());
+    let named = name.and_then(|n| {
+        let at = n.find(".part-")?;
+        n[..at].rsplit('.').next()?.parse::<u64>().ok()
+    });
+    ensure!(
+        named == Some(piece.steps),
+        "corrupt: it holds step {}, its name says another",
+        piece.steps
+    );
+    Ok(())
+}
+
+/// The snapshot the pieces of all processes make (each the state of one process's
+/// particles, the springs of the contacts it holds one of, and the state all share): all
+/// particles in id order with their anchors, and every contact's springs once.
+pub fn join(pieces: Vec<Snapshot>) -> Result<Snapshot> {
+    let Some(first) = pieces.first() else {
+        bail!("no parts");
+    };
+    for (k, p) in pieces.iter().enumerate() {
+        ensure!(
+            p.steps == first.steps
+                && p.built_at == first.built_at
+                && p.particles.next_id == first.particles.next_id
+                && p.spawner == first.spawner
+                && p.removed == first.removed
+                && p.wall_sums == first.wall_sums
+                && p.scenario == first.scenario
+                && p.mesh_files == first.mesh_files,
+            "corrupt: part {k} is not of the state of part 0 (another step or run)"
+        );
+        ensure!(
+            p.lonely.is_empty(),
+            "corrupt: part {k} lists lonely particles"
+        );
+        let anchored = p.anchors.len() == p.particles.len() || p.particles.is_empty();
+        ensure!(
+            anchored,
+            "corrupt: part {k} lacks the anchors of its particles"
+        );
+    }
+    let mut all: Vec<(u32, Particle, DVec3)> = Vec::new();
+    for p in &pieces {
+        let q = &p.particles;
+        all.extend((0..q.len()).map(|i| (q.id[i], q.get(i), p.anchors[i])));
+    }
+    all.sort_unstable_by_key(|e| e.0);
+    if let Some(w) = all.windows(2).find(|w| w[0].0 == w[1].0) {
+        bail!("corrupt: particle {} is in two parts", w[0].0);
+    }
+    let mut particles = Particles {
+        next_id: first.particles.next_id,
+        ..Particles::default()
+    };
+    let mut anchors = Vec::with_capacity(all.len());
+    for (id, particle, anchor) in all {
+        particles.insert(id, particle);
+        anchors.push(anchor);
+    }
+    let springs = |of: fn(&Snapshot) -> &Vec<(u32, u32, Springs)>| {
+        dedup(pieces.iter().flat_map(|p| of(p).iter().copied()).collect())
+    };
+    Ok(Snapshot {
+        steps: first.steps,
+        built_at: first.built_at,
+        particles,
+        spawner: first.spawner.clone(),
+        anchors,
+        lonely: Vec::new(),
+        pair_history: springs(|p| &p.pair_history),
+        face_history: springs(|p| &p.face_history),
+        removed: first.removed.clone(),
+        wall_sums: first.wall_sums.clone(),
+        scenario: first.scenario.clone(),
+        mesh_files: first.mesh_files.clone(),
+    })
+}
+
+/// Entries sorted by their pair of keys, each once (the copies two processes hold of a
+/// contact are the same bits: both evaluated it from the same states).
+fn dedup(mut entries: Vec<(u32, u32, Springs)>) -> Vec<(u32, u32, Springs)> {
+    entries.sort_unstable_by_key(|e| (e.0, e.1));
+    entries.dedup_by_key(|e| (e.0, e.1));
+    entries
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two pieces of one state (particles 3 and 4, their contact in both) and their join.
+    fn pieces() -> (Vec<Snapshot>, Snapshot) {
+        let mut a = super::super::tests::snapshot();
+        a.lonely.clear();
+        let mut b = a.clone();
+        let mut q = b.particles.get(0);
+        q.x.x += 0.01;
+        b.particles = Particles {
+            next_id: a.particles.next_id,
+            ..Particles::default()
+        };
+        b.particles.insert(4, q);
+        b.face_history.clear();
+        let mut whole = a.clone();
+        whole.particles.insert(4, q);
+        whole.anchors.push(b.anchors[0]);
+        (vec![b, a], whole)
+    }
+
+    #[test]
+    fn pieces_join_in_id_order_with_each_contact_once() {
+        let (pieces, whole) = pieces();
+        assert_eq!(join(pieces.clone()).unwrap(), whole);
+        let mut other = pieces.clone();
+        other[1].steps += 1;
+        let e = join(other).unwrap_err().to_string();
+        assert!(e.contains("part 1 is not of the state of part 0"), "{e}");
+        let twice = vec![pieces[0].clone(), pieces[0].clone()];
+        let e = join(twice).unwrap_err().to_string();
+        assert!(e.contains("particle 4 is in two parts"), "{e}");
+    }
+
+    #[test]
+    fn the_newest_complete_set_of_parts_is_read_and_a_checkpoint_removes_them() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("checkpoint.bin");
+        let (pieces, whole) = pieces();
+        // Part 0 alone (a stop that did not finish): no checkpoint to read.
+        save_part(&path, 0, 2, &pieces[0], 7).unwrap();
+        assert!(newer_parts(&path).is_none());
+        // An older complete set is read while the newer one is unfinished.
+        let mut old = pieces.clone();
+        old.iter_mut()
+            .for_each(|p| (p.steps, p.built_at) = (12000, 11900));
+        save_part(&path, 0, 2, &old[0], 7).unwrap();
+        save_part(&path, 1, 2, &old[1], 7).unwrap();
+        assert_eq!(super::super::load(&path, Some(7)).unwrap().steps, 12000);
+        // Both parts: read, joined.
+        save_part(&path, 1, 2, &pieces[1], 7).unwrap();
+        assert_eq!(super::super::load(&path, Some(7)).unwrap(), whole);
+        // An older whole checkpoint beside them: the parts are newer.
+        let mut older = whole.clone();
+        (older.steps, older.built_at) = (100, 50);
+        std::fs::write(&path, super::super::encode(&older, 7)).unwrap();
+        assert_eq!(super::super::load(&path, Some(7)).unwrap(), whole);
+        // A whole checkpoint of the same step (the join finished): the file is read.
+        let mut same = whole.clone();
+        same.particles.v[0].x = 9.0;
+        std::fs::write(&path, super::super::encode(&same, 7)).unwrap();
+        assert_eq!(super::super::load(&path, Some(7)).unwrap(), same);
+        // A damaged part of the newest set is an error that names it.
+        std::fs::remove_file(&path).unwrap();
+        remove_parts(&path, Some(12345));
+        let part = part_path(&path, 12345, 1, 2);
+        let mut bytes = std::fs::read(&part).unwrap();
+        bytes[60] ^= 1;
+        std::fs::write(&part, &bytes).unwrap();
+        let e = format!("{:#}", super::super::load(&path, Some(7)).unwrap_err());
+        assert!(
+            e.contains("checkpoint.bin.12345.part-1-of-2") && e.contains("checksum"),
+            "{e}"
+        );
+        // A part renamed to another step is refused.
+        std::fs::write(&part, &bytes[..]).unwrap();
+        save_part(&path, 1, 2, &pieces[1], 7).unwrap();
+        std::fs::rename(part_path(&path, 12345, 0, 2), part_path(&path, 12346, 0, 2)).unwrap();
+        std::fs::rename(&part, part_path(&path, 12346, 1, 2)).unwrap();
+        let e = format!("{:#}", super::super::load(&path, Some(7)).unwrap_err());
+        assert!(e.contains("its name says another"), "{e}");
+        // Saving the whole checkpoint removes the parts.
+        super::super::save(&path, &whole, 7).unwrap();
+        let names: Vec<_> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .collect();
+        assert_eq!(names, ["checkpoint.bin"]);
+    }
+
+    #[test]
+    fn part_names() {
+        let path = Path::new("out/checkpoint.bin");
+        assert_eq!(
+            part_path(path, 700, 2, 3),
+            Path::new("out/checkpoint.bin.700.part-2-of-3")
+        );
+        assert!(is_part("checkpoint.bin.700.part-2-of-3"));
+        assert!(!is_part("checkpoint.bin.700.part-3-of-3"));
+        assert!(!is_part("checkpoint.bin.700.part-x-of-3"));
+        assert!(!is_part("checkpoint.bin.part-1-of-3"));
+        assert!(!is_part("particles000001.csv"));
+    }
+}

@@ -1,0 +1,377 @@
+//! Particle frames in the original program's CSV format:
+//! header `x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz`, one particle per line, full round-trip
+//! precision, files `particlesNNNNNN.csv`. Runs that tag particles add a column `tag`; runs
+//! that can remove particles (or have several materials) add `id` and `material` after it.
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use glam::{DQuat, DVec3};
+
+use crate::engine::records::{ContactRecord, Partner};
+use crate::model::particles::{Particle, Particles};
+
+pub const COLUMNS: [&str; 14] = [
+    "x", "y", "z", "R", "vx", "vy", "vz", "q0", "q1", "q2", "q3", "wx", "wy", "wz",
+];
+
+/// Whole-number columns a frame may carry beyond the fourteen.
+pub const INT_COLUMNS: [&str; 3] = ["tag", "id", "material"];
+
+/// The file name of frame `k`.
+pub fn frame_name(k: u64) -> String {
+    format!("particles{k:06}.csv")
+}
+
+/// The columns of a frame beyond the original fourteen.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Extra {
+    /// `tag`
+    pub tag: bool,
+    /// `id` and `material`
+    pub ids: bool,
+}
+
+/// Writes all particles as CSV text in id order, with the `extra` columns.
+pub fn write_particles(out: &mut impl Write, p: &Particles, extra: Extra) -> std::io::Result<()> {
+    let mut line = String::with_capacity(512);
+    out.write_all(COLUMNS.join(",").as_bytes())?;
+    if extra.tag {
+        out.write_all(b",tag")?;
+    }
+    if extra.ids {
+        out.write_all(b",id,material")?;
+    }
+    out.write_all(b"\n")?;
+    let mut buf = ryu::Buffer::new();
+    for (id, q) in p.iter_by_id() {
+        line.clear();
+        let values = [
+            q.x.x, q.x.y, q.x.z, q.radius, q.v.x, q.v.y, q.v.z, q.q.w, q.q.x, q.q.y, q.q.z, q.w.x,
+            q.w.y, q.w.z,
+        ];
+        for (k, value) in values.iter().enumerate() {
+            if k > 0 {
+                line.push(',');
+            }
+            line.push_str(buf.format(*value));
+        }
+        if extra.tag {
+            line.push(',');
+            line.push_str(itoa::Buffer::new().format(q.tag));
+        }
+        if extra.ids {
+            line.push(',');
+            line.push_str(itoa::Buffer::new().format(id));
+            line.push(',');
+            line.push_str(itoa::Buffer::new().format(q.material));
+        }
+        line.push('\n');
+        out.write_all(line.as_bytes())?;
+    }
+    Ok(())
+}
+
+/// Writes a frame file atomically: to a temporary name first, then renamed, so a crash
+/// never leaves a half-written frame behind.
+pub fn write_frame(dir: &Path, k: u64, p: &Particles, extra: Extra) -> Result<PathBuf> {
+    write_frame_as(dir, &frame_name(k), p, extra)
+}
+
+/// Writes particles atomically to `dir/name`.
+pub fn write_frame_as(dir: &Path, name: &str, p: &Particles, extra: Extra) -> Result<PathBuf> {
+    let path = dir.join(name);
+    crate::io::files::write_atomically(&path, |w| write_particles(w, p, extra))
+        .with_context(|| format!("cannot write frame {}", path.display()))?;
+    Ok(path)
+}
+
+/// The header of a contact network file.
+pub const CONTACT_COLUMNS: &str = "id_i,id_j,face,x,y,z,fn_x,fn_y,fn_z,ft_x,ft_y,ft_z,overlap";
+
+/// Writes the contact network atomically to `dir/name`: a line per contact, `id_j` or
+/// `face` -1 where it does not apply.
+pub fn write_contacts(dir: &Path, name: &str, contacts: &[ContactRecord]) -> Result<PathBuf> {
+    let path = dir.join(name);
+    let write = |w: &mut std::io::BufWriter<std::fs::File>| -> std::io::Result<()> {
+        writeln!(w, "{CONTACT_COLUMNS}")?;
+        let mut buf = ryu::Buffer::new();
+        let mut line = String::with_capacity(256);
+        for c in contacts {
+            line.clear();
+            let (j, f) = match c.with {
+                Partner::Particle(j) => (j as i64, -1),
+                Partner::Face(f) => (-1, f as i64),
+            };
+            line.push_str(itoa::Buffer::new().format(c.id));
+            for k in [j, f] {
+                line.push(',');
+                line.push_str(itoa::Buffer::new().format(k));
+            }
+            for x in [
+                c.point.x, c.point.y, c.point.z, c.f_n.x, c.f_n.y, c.f_n.z, c.f_t.x, c.f_t.y,
+                c.f_t.z, c.overlap,
+            ] {
+                line.push(',');
+                line.push_str(buf.format(x));
+            }
+            line.push('\n');
+            w.write_all(line.as_bytes())?;
+        }
+        Ok(())
+    };
+    crate::io::files::write_atomically(&path, write)
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    Ok(path)
+}
+
+/// Reads particles from CSV text. The header names the 14 columns (in any order); every
+/// value must be a finite number, every radius positive, every quaternion non-zero (it
+/// is normalised).
+pub fn read_particles(input: impl Read, file: &str) -> Result<Particles> {
+    let mut lines = BufReader::with_capacity(1 << 16, input);
+    let mut header = String::new();
+    if lines
+        .read_line(&mut header)
+        .map_err(|_| anyhow::anyhow!("{file}:1: cannot read line (not UTF-8 text?)"))?
+        == 0
+    {
+        bail!(
+            "{file}: empty file, expected the header line '{}'",
+            COLUMNS.join(",")
+        );
+    }
+    let names: Vec<&str> = header.trim().split(',').map(str::trim).collect();
+    let mut slot = [usize::MAX; 14];
+    // The optional whole-number columns: tag, id, material.
+    let mut int_column = [None; 3];
+    for (col, name) in names.iter().enumerate() {
+        if let Some(k) = INT_COLUMNS.iter().position(|c| c == name) {
+            if int_column[k].is_some() {
+                bail!("{file}:1: column '{name}' appears twice");
+            }
+            int_column[k] = Some(col);
+            continue;
+        }
+        let Some(k) = COLUMNS.iter().position(|c| c == name) else {
+            bail!(
+                "{file}:1: unknown column '{name}': expected the header '{}' (and optionally {})",
+                COLUMNS.join(","),
+                INT_COLUMNS.join(", ")
+            );
+        };
+        if slot[k] != usize::MAX {
+            bail!("{file}:1: column '{name}' appears twice");
+        }
+        slot[k] = col;
+    }
+    if let Some(k) = slot.iter().position(|&s| s == usize::MAX) {
+        bail!(
+            "{file}:1: column '{}' is missing: expected the header '{}'",
+            COLUMNS[k],
+            COLUMNS.join(",")
+        );
+    }
+
+    // Column of each of the 14 quantities, and which quantity each column holds.
+    let mut quantity_of_column = vec![usize::MAX; names.len()];
+    for (k, &col) in slot.iter().enumerate() {
+        quantity_of_column[col] = k;
+    }
+    let mut particles = Particles::default();
+    let mut ids = Vec::new();
+    let mut values = [0.0f64; 14];
+    let mut reader = lines;
+    let mut buf = String::new();
+    let mut n = 1;
+    loop {
+        buf.clear();
+        n += 1;
+        match reader.read_line(&mut buf) {
+            Ok(0) => break,
+            Ok(_) => {}
+            Err(_) => bail!("{file}:{n}: cannot read line (not UTF-8 text?)"),
+        }
+        let line = buf.trim();
+        if line.is_empty() {
+            continue;
+        }
+        let mut count = 0;
+        let mut ints = [0u32; 3];
+        for (col, text) in line.split(',').enumerate() {
+            count += 1;
+            if col >= names.len() {
+                continue;
+            }
+            let text = text.trim();
+            if let Some(k) = int_column.iter().position(|&c| c == Some(col)) {
+                ints[k] = text.parse().map_err(|_| {
+                    anyhow::anyhow!(
+                        "{file}:{n}: column {} ('{}'): expected a whole number >= 0, found '{text}'",
+                        col + 1,
+                        INT_COLUMNS[k]
+                    )
+                })?;
+                continue;
+            }
+            let k = quantity_of_column[col];
+            let x: f64 = text.parse().map_err(|_| {
+                anyhow::anyhow!(
+                    "{file}:{n}: column {} ('{}'): expected a number, found '{text}'",
+                    col + 1,
+                    COLUMNS[k]
+                )
+            })?;
+            if !x.is_finite() {
+                bail!(
+                    "{file}:{n}: column {} ('{}'): expected a finite number, found '{text}'",
+                    col + 1,
+                    COLUMNS[k]
+                );
+            }
+            values[k] = x;
+        }
+        if count != names.len() {
+            bail!("{file}:{n}: expected {} values, found {count}", names.len());
+        }
+        let v = values;
+        if v[3] <= 0.0 {
+            bail!("{file}:{n}: radius R = {} must be > 0", v[3]);
+        }
+        let q = DQuat::from_xyzw(v[8], v[9], v[10], v[7]);
+        let norm = q.length();
+        if norm == 0.0 {
+            bail!(
+                "{file}:{n}: the quaternion (q0, q1, q2, q3) is zero; use 1,0,0,0 for no rotation"
+            );
+        }
+        particles.push(Particle {
+            x: DVec3::new(v[0], v[1], v[2]),
+            radius: v[3],
+            v: DVec3::new(v[4], v[5], v[6]),
+            q: if (norm - 1.0).abs() < 1e-12 {
+                q
+            } else {
+                q / norm
+            },
+            w: DVec3::new(v[11], v[12], v[13]),
+            tag: ints[0],
+            material: u16::try_from(ints[2])
+                .map_err(|_| anyhow::anyhow!("{file}:{n}: material {} is out of range", ints[2]))?,
+        });
+        if int_column[1].is_some() {
+            ids.push(ints[1]);
+        }
+    }
+    if int_column[1].is_some() {
+        // The particles keep the ids of the file (a frame of a run that removed some).
+        let mut sorted = ids.clone();
+        sorted.sort_unstable();
+        if let Some(w) = sorted.windows(2).find(|w| w[0] == w[1]) {
+            bail!("{file}: particle id {} appears twice", w[0]);
+        }
+        if sorted.last().is_some_and(|&m| m >= u32::MAX / 2) {
+            bail!("{file}: particle ids must be below {}", u32::MAX / 2);
+        }
+        particles.next_id = sorted.last().map_or(0, |&m| m + 1);
+        particles.id = ids;
+    }
+    Ok(particles)
+}
+
+/// Reads a particle CSV file.
+pub fn load_particles(path: &Path) -> Result<Particles> {
+    let f = crate::io::files::open(path)
+        .with_context(|| format!("cannot read particle file {}", path.display()))?;
+    read_particles(f, &path.display().to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn round_trip_is_exact() {
+        let p: Particles = [Particle {
+            x: DVec3::new(0.1, -1e-300, 1.0 / 3.0),
+            radius: 0.004,
+            v: DVec3::new(1e-7, 2.5, -0.0),
+            q: DQuat::from_rotation_x(0.3),
+            w: DVec3::new(1.0, 2.0, 3.0),
+            tag: 42,
+            material: 0,
+        }]
+        .into_iter()
+        .collect();
+        let mut text = Vec::new();
+        write_particles(
+            &mut text,
+            &p,
+            Extra {
+                tag: true,
+                ids: false,
+            },
+        )
+        .unwrap();
+        let back = read_particles(&text[..], "t").unwrap();
+        assert_eq!(back, p);
+    }
+
+    #[test]
+    fn ids_and_materials_round_trip() {
+        let mut p: Particles = (0..3)
+            .map(|k| Particle {
+                x: DVec3::new(k as f64, 0.0, 0.0),
+                radius: 0.004,
+                v: DVec3::ZERO,
+                q: DQuat::IDENTITY,
+                w: DVec3::ZERO,
+                tag: 0,
+                material: k as u16,
+            })
+            .collect();
+        // Ids with gaps (particles 1, 4 and 6 removed), stored out of id order.
+        p.id = vec![7, 2, 5];
+        p.next_id = 8;
+        let mut text = Vec::new();
+        let extra = Extra {
+            tag: false,
+            ids: true,
+        };
+        write_particles(&mut text, &p, extra).unwrap();
+        let text = String::from_utf8(text).unwrap();
+        assert!(text.starts_with("x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz,id,material\n1.0,"));
+        let back = read_particles(text.as_bytes(), "t").unwrap();
+        assert_eq!(back.id, vec![2, 5, 7]);
+        assert_eq!(back.material, vec![1, 2, 0]);
+        assert_eq!(back.next_id, 8);
+        let twice = text.replace(",7,0\n", ",2,0\n");
+        assert!(err(&twice).contains("particle id 2 appears twice"));
+    }
+
+    fn err(text: &str) -> String {
+        format!(
+            "{:#}",
+            read_particles(text.as_bytes(), "p.csv").unwrap_err()
+        )
+    }
+
+    #[test]
+    fn bad_lines_are_named() {
+        let h = "x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz\n";
+        assert!(
+            err(&format!("{h}0,0,0,1,0,0,0,1,0,0,0,0,0\n"))
+                .contains("p.csv:2: expected 14 values, found 13")
+        );
+        assert!(err(&format!("{h}0,0,0,1,0,0,0,1,0,0,0,0,0,abc\n")).contains("found 'abc'"));
+        assert!(
+            err(&format!("{h}0,0,0,-1,0,0,0,1,0,0,0,0,0,0\n"))
+                .contains("radius R = -1 must be > 0")
+        );
+        assert!(err(&format!("{h}0,0,NaN,1,0,0,0,1,0,0,0,0,0,0\n")).contains("finite"));
+        assert!(err("x,y,z\n").contains("column 'R' is missing"));
+        assert!(err("x,y,z,x\n").contains("appears twice"));
+        assert!(err("").contains("empty file"));
+    }
+}

@@ -1,0 +1,8 @@
+//! Files: the only layer that reads or writes them (inputs, frames, checkpoints, the output directory).
+
+pub mod checkpoint;
+pub mod csv;
+pub mod files;
+pub mod lock;
+pub mod output;
+pub mod vtk;

@@ -1,0 +1,318 @@
+//! ParaView-ready output: VTK XML unstructured grids (`.vtu`) with binary (raw appended)
+//! data, and a `.pvd` collection that lists the frames with their times.
+//!
+//! Particles are points with one vertex cell each and the point arrays `radius`,
+//! `velocity`, `angular_velocity`, `orientation` (the quaternion q0, q1, q2, q3) and `tag`; the mesh
+//! is its faces (vertex, line, triangle and quad cells) with the cell array `radius`.
+
+use std::io::Write;
+use std::path::Path;
+
+use anyhow::{Context, Result};
+
+use crate::engine::records::{ContactRecord, Partner};
+use crate::geometry::mesh::{Mesh, Primitive};
+use crate::model::particles::Particles;
+
+/// Where an array goes in the file.
+#[derive(Clone, Copy)]
+enum Section {
+    PointData,
+    CellData,
+    Points,
+    Cells,
+}
+
+/// A `.vtu` file under construction: XML header text and the appended binary block.
+struct Vtu {
+    point_data: String,
+    cell_data: String,
+    points: String,
+    cells: String,
+    appended: Vec<u8>,
+}
+
+/// An array's element type as VTK names it.
+trait VtkType: Copy {
+    const NAME: &'static str;
+    fn put(self, out: &mut Vec<u8>);
+}
+
+/// Little-endian numbers of the named VTK type.
+macro_rules! vtk_number {
+    ($($t:ty => $name:literal),*) => {$(
+        impl VtkType for $t {
+            const NAME: &'static str = $name;
+            fn put(self, out: &mut Vec<u8>) {
+                out.extend_from_slice(&self.to_le_bytes());
+            }
+        }
+    )*};
+}
+
+vtk_number!(f64 => "Float64", i64 => "Int64", u32 => "UInt32");
+
+impl VtkType for u8 {
+    const NAME: &'static str = "UInt8";
+    fn put(self, out: &mut Vec<u8>) {
+        out.push(self);
+    }
+}
+
+impl Vtu {
+    fn new() -> Vtu {
+        Vtu {
+            point_data: String::new(),
+            cell_data: String::new(),
+            points: String::new(),
+            cells: String::new(),
+            appended: Vec::new(),
+        }
+    }
+
+    /// Appends one array of `count` values (UInt64 byte count, then the values) and adds its
+    /// XML element to `section`.
+    fn array<T: VtkType>(
+        &mut self,
+        section: Section,
+        name: &str,
+        components: usize,
+        count: usize,
+        values: impl Iterator<Item = T>,
+    ) {
+        let offset = self.appended.len();
+        let bytes = count * std::mem::size_of::<T>();
+        self.appended
+            .extend_from_slice(&(bytes as u64).to_le_bytes());
+        self.appended.reserve(bytes);
+        let mut written = 0;
+        for v in values {
+            v.put(&mut self.appended);
+            written += 1;
+        }
+        debug_assert_eq!(written, count);
+        let element = format!(
+            "        <DataArray type=\"{}\" Name=\"{name}\" NumberOfComponents=\"{components}\" format=\"appended\" offset=\"{offset}\"/>\n",
+            T::NAME
+        );
+        match section {
+            Section::PointData => self.point_data += &element,
+            Section::CellData => self.cell_data += &element,
+            Section::Points => self.points += &element,
+            Section::Cells => self.cells += &element,
+        }
+    }
+
+    fn write(&self, path: &Path, points: usize, cells: usize) -> Result<()> {
+        self.write_as(
+            path,
+            points,
+            cells,
+            "UnstructuredGrid",
+            "Cells",
+            "NumberOfCells",
+        )
+    }
+
+    /// Writes the file as a `kind` (`UnstructuredGrid`, or `PolyData` whose cells are
+    /// `Lines`).
+    fn write_as(
+        &self,
+        path: &Path,
+        points: usize,
+        cells: usize,
+        kind: &str,
+        cells_tag: &str,
+        count_attribute: &str,
+    ) -> Result<()> {
+        let mut text = String::new();
+        text.push_str("<?xml version=\"1.0\"?>\n");
+        text.push_str(&format!(
+            "<VTKFile type=\"{kind}\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
+        ));
+        text.push_str(&format!("  <{kind}>\n"));
+        text.push_str(&format!(
+            "    <Piece NumberOfPoints=\"{points}\" {count_attribute}=\"{cells}\">\n"
+        ));
+        text.push_str(&format!(
+            "      <PointData>\n{}      </PointData>\n",
+            self.point_data
+        ));
+        text.push_str(&format!(
+            "      <CellData>\n{}      </CellData>\n",
+            self.cell_data
+        ));
+        text.push_str(&format!("      <Points>\n{}      </Points>\n", self.points));
+        text.push_str(&format!(
+            "      <{cells_tag}>\n{}      </{cells_tag}>\n",
+            self.cells
+        ));
+        text.push_str(&format!(
+            "    </Piece>\n  </{kind}>\n  <AppendedData encoding=\"raw\">\n   _"
+        ));
+        let tail = "\n  </AppendedData>\n</VTKFile>\n";
+        atomic_write(path, &[text.as_bytes(), &self.appended, tail.as_bytes()])
+    }
+
+    /// A named array of `n` 3-vectors.
+    fn vectors(
+        &mut self,
+        section: Section,
+        name: &str,
+        n: usize,
+        values: impl Iterator<Item = glam::DVec3>,
+    ) {
+        self.array(section, name, 3, 3 * n, values.flat_map(|a| a.to_array()));
+    }
+}
+
+/// Writes `parts` to a temporary file and renames it to `path`.
+fn atomic_write(path: &Path, parts: &[&[u8]]) -> Result<()> {
+    crate::io::files::write_atomically(path, |w| parts.iter().try_for_each(|p| w.write_all(p)))
+        .with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Writes the particles as a `.vtu` file, in id order.
+pub fn write_particles(path: &Path, p: &Particles) -> Result<()> {
+    use Section::*;
+    let n = p.len();
+    let order = p.id_order();
+    let by_id = || order.iter().copied();
+    let mut v = Vtu::new();
+    v.array(PointData, "id", 1, n, by_id().map(|i| p.id[i]));
+    v.array(PointData, "radius", 1, n, by_id().map(|i| p.radius[i]));
+    v.vectors(PointData, "velocity", n, by_id().map(|i| p.v[i]));
+    v.vectors(PointData, "angular_velocity", n, by_id().map(|i| p.w[i]));
+    v.array(
+        PointData,
+        "orientation",
+        4,
+        4 * n,
+        by_id().flat_map(|i| [p.q[i].w, p.q[i].x, p.q[i].y, p.q[i].z]),
+    );
+    v.array(PointData, "tag", 1, n, by_id().map(|i| p.tag[i]));
+    v.vectors(Points, "points", n, by_id().map(|i| p.x[i]));
+    v.array(Cells, "connectivity", 1, n, 0..n as i64);
+    v.array(Cells, "offsets", 1, n, 1..=n as i64);
+    v.array(Cells, "types", 1, n, std::iter::repeat_n(1u8, n)); // VTK_VERTEX
+    v.write(path, n, n)
+}
+
+/// Writes the mesh faces as a `.vtu` file: one cell per face, with its radius.
+pub fn write_mesh(path: &Path, mesh: &Mesh) -> Result<()> {
+    use Section::*;
+    let mut points = Vec::new();
+    let mut connectivity = Vec::new();
+    let mut offsets = Vec::new();
+    let mut types = Vec::new();
+    for face in &mesh.faces {
+        let (corners, vtk_type): (Vec<glam::DVec3>, u8) = match face.shape {
+            Primitive::Point(a) => (vec![a], 1),         // VTK_VERTEX
+            Primitive::Segment(a, b) => (vec![a, b], 3), // VTK_LINE
+            Primitive::Triangle { a, b, c, .. } => (vec![a, b, c], 5), // VTK_TRIANGLE
+            Primitive::Rectangle { o, e1, e2, .. } => (vec![o, o + e1, o + e1 + e2, o + e2], 9), // VTK_QUAD
+        };
+        for c in corners {
+            connectivity.push(points.len() as i64);
+            points.push(c);
+        }
+        offsets.push(connectivity.len() as i64);
+        types.push(vtk_type);
+    }
+    let (np, nc) = (points.len(), mesh.faces.len());
+    let mut v = Vtu::new();
+    v.array(
+        CellData,
+        "radius",
+        1,
+        nc,
+        mesh.faces.iter().map(|f| f.radius),
+    );
+    v.vectors(Points, "points", points.len(), points.iter().copied());
+    v.array(
+        Cells,
+        "connectivity",
+        1,
+        connectivity.len(),
+        connectivity.into_iter(),
+    );
+    v.array(Cells, "offsets", 1, nc, offsets.into_iter());
+    v.array(Cells, "types", 1, nc, types.into_iter());
+    v.write(path, np, nc)
+}
+
+/// Writes the contact network as `.vtp` lines: particle centre to particle centre for a
+/// pair, centre to contact point for a face, with the cell arrays `normal_force` and
+/// `tangential_force` (magnitudes \[N\]), `overlap` \[m\] and `face` (-1 for pairs).
+pub fn write_contacts(path: &Path, p: &Particles, contacts: &[ContactRecord]) -> Result<()> {
+    use Section::*;
+    let mut at = vec![u32::MAX; p.next_id as usize];
+    for (k, &id) in p.id.iter().enumerate() {
+        at[id as usize] = k as u32;
+    }
+    let mut points = Vec::with_capacity(2 * contacts.len());
+    for c in contacts {
+        let xi = p.x[at[c.id as usize] as usize];
+        points.push(xi);
+        points.push(match c.with {
+            // A pair across a periodic side: to the contact point rather than across the box.
+            Partner::Particle(j)
+                if (p.x[at[j] as usize] - xi).length() <= 4.0 * (c.point - xi).length() =>
+            {
+                p.x[at[j] as usize]
+            }
+            _ => c.point,
+        });
+    }
+    let n = contacts.len();
+    let mut v = Vtu::new();
+    v.array(
+        CellData,
+        "normal_force",
+        1,
+        n,
+        contacts.iter().map(|c| c.f_n.length()),
+    );
+    v.array(
+        CellData,
+        "tangential_force",
+        1,
+        n,
+        contacts.iter().map(|c| c.f_t.length()),
+    );
+    v.array(
+        CellData,
+        "overlap",
+        1,
+        n,
+        contacts.iter().map(|c| c.overlap),
+    );
+    v.array(
+        CellData,
+        "face",
+        1,
+        n,
+        contacts.iter().map(|c| match c.with {
+            Partner::Particle(_) => -1i64,
+            Partner::Face(f) => f as i64,
+        }),
+    );
+    v.vectors(Points, "points", 2 * n, points.into_iter());
+    v.array(Cells, "connectivity", 1, 2 * n, 0..2 * n as i64);
+    v.array(Cells, "offsets", 1, n, (1..=n as i64).map(|k| 2 * k));
+    v.write_as(path, 2 * n, n, "PolyData", "Lines", "NumberOfLines")
+}
+
+/// Writes a `.pvd` collection of `(time, file name)` entries.
+pub fn write_collection(path: &Path, entries: &[(f64, String)]) -> Result<()> {
+    let mut text = String::from(
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"1.0\" byte_order=\"LittleEndian\">\n  <Collection>\n",
+    );
+    for (time, file) in entries {
+        text.push_str(&format!(
+            "    <DataSet timestep=\"{time:e}\" part=\"0\" file=\"{file}\"/>\n"
+        ));
+    }
+    text.push_str("  </Collection>\n</VTKFile>\n");
+    atomic_write(path, &[text.as_bytes()])
+}

@@ -1,0 +1,425 @@
+//! A run split over processes (domain decomposition), with the bits of the run in one.
+//!
+//! Each process owns the particles of a box of space, cut by recursive coordinate
+//! bisection ([`Tree`], balanced by count), and holds copies (ghosts) of the other
+//! processes' particles within reach of its box: `r_i + R_max + skin`, so every pair the
+//! lists of one process would hold is listed on the process of each partner. A process
+//! runs the stages of the step on all it holds; a pair of an own particle and a ghost is
+//! evaluated on both sides, from the same bits, so both keep the same springs. Since the
+//! loads are exact sums (`exact.rs`), an own particle's load is that of the run in one
+//! process, bit for bit, and so is its motion. After integrating, each process sends the
+//! new states of its particles to the processes that hold them as ghosts.
+//!
+//! When the lists must be rebuilt (on any process), every process rebuilds them: its
+//! particles that left its box go to their new owners with their contact history (the
+//! springs of their pairs, keyed by the pair of ids, and of their faces), the ghosts are
+//! made afresh, and the boxes are cut anew when the counts are out of balance. Spawning
+//! draws the same random stream on every process, against the particles of all processes
+//! near the spawn regions; removals are counted in id order over all processes. Wall
+//! loads are exact sums over all processes.
+//!
+//! In a periodic domain a process also holds, at their own places, the particles whose
+//! images across the sides come within reach of its box; its lists pair them across the
+//! sides as the lists of one process do, seen from the particle of the lower id with the
+//! other at the image nearest it (a shift found from the two positions alone), so both
+//! processes of such a pair see it with the same bits. Positions are wrapped into the box
+//! at rebuilds, which rounds them: so the split run rebuilds at the steps the run in one
+//! process does (see `Placement`).
+
+use anyhow::{Result, bail};
+use glam::DVec3;
+
+use crate::model::particles::{Particle, Particles};
+use crate::model::springs::Springs;
+use crate::parallel::comm::{Comm, Reader, Writer};
+
+/// Past this ratio of the largest process's particle count to the mean, the boxes are cut
+/// anew at the next rebuild.
+pub(crate) const REBALANCE: f64 = 1.1;
+
+/// Bisection steps for each cut: the cut lies within 2^-48 of the particles' extent of
+/// the place that halves the count.
+const BISECTIONS: usize = 48;
+
+/// A node of the bisection: a process's box, or a cut across an axis.
+#[derive(Clone, Copy, Debug)]
+enum Cell {
+    Leaf(usize),
+    Cut {
+        axis: usize,
+        at: f64,
+        below: u32,
+        above: u32,
+    },
+}
+
+/// The boxes of the processes: space cut recursively across an axis at a time (the
+/// outermost boxes reach to infinity).
+#[derive(Clone, Debug)]
+pub struct Tree {
+    cells: Vec<Cell>,
+}
+
+impl Tree {
+    /// The process whose box holds `x` (below a cut: `x[axis] < at`).
+    pub fn owner(&self, x: DVec3) -> usize {
+        let mut c = 0;
+        loop {
+            match self.cells[c] {
+                Cell::Leaf(rank) => return rank,
+                Cell::Cut {
+                    axis,
+                    at,
+                    below,
+                    above,
+                } => c = if x[axis] < at { below } else { above } as usize,
+            }
+        }
+    }
+
+    /// The processes whose boxes meet the cube of half-width `reach` around `x`.
+    pub fn near(&self, x: DVec3, reach: f64, out: &mut Vec<usize>) {
+        out.clear();
+        let mut todo = vec![0u32];
+        while let Some(c) = todo.pop() {
+            match self.cells[c as usize] {
+                Cell::Leaf(rank) => out.push(rank),
+                Cell::Cut {
+                    axis,
+                    at,
+                    below,
+                    above,
+                } => {
+                    if x[axis] - reach < at {
+                        todo.push(below);
+                    }
+                    if x[axis] + reach >= at {
+                        todo.push(above);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Cuts space among the processes of `comm` so that each holds about as many of the
+    /// points as the others (`x`: this process's share of them). Level by level: each group
+    /// of processes cuts its box across the longest extent of its points, at the place
+    /// that leaves below as many points as the first half of its processes should hold,
+    /// found by bisection with the counts summed over all processes. Every process gets
+    /// the same tree.
+    pub fn bisect(comm: &dyn Comm, x: &[DVec3]) -> Tree {
+        struct Group {
+            cell: usize,
+            ranks: std::ops::Range<usize>,
+            members: Vec<u32>,
+        }
+        let mut cells = vec![Cell::Leaf(0)];
+        let mut groups = vec![Group {
+            cell: 0,
+            ranks: 0..comm.size(),
+            members: (0..x.len() as u32).collect(),
+        }];
+        loop {
+            let (split, done): (Vec<Group>, Vec<Group>) =
+                groups.into_iter().partition(|g| g.ranks.len() > 1);
+            for g in done {
+                cells[g.cell] = Cell::Leaf(g.ranks.start);
+            }
+            if split.is_empty() {
+                break;
+            }
+            // The extent and count of each group's points over all processes.
+            let mut w = Writer::default();
+            for g in &split {
+                let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+                for &i in &g.members {
+                    (lo, hi) = (lo.min(x[i as usize]), hi.max(x[i as usize]));
+                }
+                w.vec3(lo);
+                w.vec3(hi);
+                w.u64(g.members.len() as u64);
+            }
+            let mut lo = vec![DVec3::INFINITY; split.len()];
+            let mut hi = vec![DVec3::NEG_INFINITY; split.len()];
+            let mut count = vec![0u64; split.len()];
+            for d in comm.all_gather(w.0) {
+                let mut r = Reader::new(&d);
+                for g in 0..split.len() {
+                    lo[g] = lo[g].min(r.vec3());
+                    hi[g] = hi[g].max(r.vec3());
+                    count[g] += r.u64();
+                }
+            }
+            let axis: Vec<usize> = (0..split.len())
+                .map(|g| {
+                    let e = hi[g] - lo[g];
+                    if !e.is_finite() || (e.x >= e.y && e.x >= e.z) {
+                        0
+                    } else if e.y >= e.z {
+                        1
+                    } else {
+                        2
+                    }
+                })
+                .collect();
+            let target: Vec<i64> = (0..split.len())
+                .map(|g| {
+                    let (n, left) = (split[g].ranks.len() as u64, split[g].ranks.len() as u64 / 2);
+                    ((count[g] * left + n / 2) / n) as i64
+                })
+                .collect();
+            let mut a: Vec<f64> = (0..split.len()).map(|g| lo[g][axis[g]]).collect();
+            let mut b: Vec<f64> = (0..split.len()).map(|g| hi[g][axis[g]]).collect();
+            for g in 0..split.len() {
+                if !(a[g].is_finite() && b[g].is_finite()) {
+                    (a[g], b[g]) = (0.0, 0.0);
+                }
+            }
+            for _ in 0..BISECTIONS {
+                let mid: Vec<f64> = (0..split.len())
+                    .map(|g| a[g] + 0.5 * (b[g] - a[g]))
+                    .collect();
+                let below: Vec<i64> = split
+                    .iter()
+                    .enumerate()
+                    .map(|(g, grp)| {
+                        grp.members
+                            .iter()
+                            .filter(|&&i| x[i as usize][axis[g]] < mid[g])
+                            .count() as i64
+                    })
+                    .collect();
+                let below = comm.sum_i64(&below);
+                for g in 0..split.len() {
+                    if below[g] < target[g] {
+                        a[g] = mid[g];
+                    } else {
+                        b[g] = mid[g];
+                    }
+                }
+            }
+            groups = Vec::new();
+            for (g, grp) in split.into_iter().enumerate() {
+                let (at, axis) = (b[g], axis[g]);
+                let (below, above) = (cells.len(), cells.len() + 1);
+                cells.push(Cell::Leaf(0));
+                cells.push(Cell::Leaf(0));
+                cells[grp.cell] = Cell::Cut {
+                    axis,
+                    at,
+                    below: below as u32,
+                    above: above as u32,
+                };
+                let middle = grp.ranks.start + grp.ranks.len() / 2;
+                let (under, over): (Vec<u32>, Vec<u32>) =
+                    grp.members.iter().partition(|&&i| x[i as usize][axis] < at);
+                groups.push(Group {
+                    cell: below,
+                    ranks: grp.ranks.start..middle,
+                    members: under,
+                });
+                groups.push(Group {
+                    cell: above,
+                    ranks: middle..grp.ranks.end,
+                    members: over,
+                });
+            }
+        }
+        Tree { cells }
+    }
+}
+
+/// The bytes of a ghost's new state each step: position, velocity, orientation, angular
+/// velocity and tag.
+pub(crate) const GHOST_STATE: usize = 3 * 8 + 3 * 8 + 4 * 8 + 3 * 8 + 4;
+
+/// Where a redistribution places the particles (for their owners, ghosts and lists).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Placement {
+    /// Where they are now (put back into a periodic box first): a rebuild of the lists.
+    Now,
+    /// Where the lists of the run in one process were last built, its anchors: on
+    /// splitting a simulation made or restored in one process, so that the split run
+    /// rebuilds its lists (and puts particles back into a periodic box) at the steps that
+    /// run would.
+    Anchors,
+}
+
+/// The share of one process in a split run.
+pub struct Domain {
+    pub(crate) comm: Box<dyn Comm>,
+    pub(crate) tree: Option<Tree>,
+    /// Whether each particle held (storage order) is this process's own; the others are
+    /// ghosts, copies of other processes' particles.
+    pub(crate) owned: Vec<bool>,
+    /// For each process, the own particles (storage indices, in id order) it holds as
+    /// ghosts; and the ghosts it sends the states of (storage indices, in id order).
+    pub(crate) send: Vec<Vec<u32>>,
+    pub(crate) recv: Vec<Vec<u32>>,
+    /// Times the boxes were cut.
+    pub cuts: u64,
+}
+
+impl Domain {
+    /// This process and the number of processes.
+    pub fn rank(&self) -> (usize, usize) {
+        (self.comm.rank(), self.comm.size())
+    }
+
+    /// Own particles held.
+    pub fn own_count(&self) -> usize {
+        self.owned.iter().filter(|&&o| o).count()
+    }
+}
+
+pub(crate) fn put_particle(w: &mut Writer, id: u32, p: &Particle) {
+    w.u32(id);
+    w.f64(p.radius);
+    w.vec3(p.x);
+    w.vec3(p.v);
+    w.quat(p.q);
+    w.vec3(p.w);
+    w.u32(p.tag);
+    w.u16(p.material);
+}
+
+pub(crate) fn get_particle(r: &mut Reader) -> (u32, Particle) {
+    let id = r.u32();
+    let p = Particle {
+        radius: r.f64(),
+        x: r.vec3(),
+        v: r.vec3(),
+        q: r.quat(),
+        w: r.vec3(),
+        tag: r.u32(),
+        material: r.u16(),
+    };
+    (id, p)
+}
+
+pub(crate) fn put_entry(w: &mut Writer, (a, b, s): &(u32, u32, Springs)) {
+    w.u32(*a);
+    w.u32(*b);
+    w.vec3(s.u_s);
+    w.vec3(s.u_r);
+    w.f64(s.u_t);
+}
+
+pub(crate) fn get_entry(r: &mut Reader) -> (u32, u32, Springs) {
+    (
+        r.u32(),
+        r.u32(),
+        Springs {
+            u_s: r.vec3(),
+            u_r: r.vec3(),
+            u_t: r.f64(),
+        },
+    )
+}
+
+/// The particles of `p` that `pick` picks (storage indices), of every process
+/// (collective), in id order; `next_id` that of `p`.
+pub(crate) fn gather_by_id(
+    comm: &dyn Comm,
+    p: &Particles,
+    pick: impl Fn(usize) -> bool,
+) -> Particles {
+    let mut w = Writer::default();
+    for i in (0..p.len()).filter(|&i| pick(i)) {
+        put_particle(&mut w, p.id[i], &p.get(i));
+    }
+    let mut all: Vec<(u32, Particle)> = Vec::new();
+    for m in comm.all_gather(w.0) {
+        let mut r = Reader::new(&m);
+        while !r.done() {
+            all.push(get_particle(&mut r));
+        }
+    }
+    all.sort_unstable_by_key(|e| e.0);
+    let mut out = Particles {
+        next_id: p.next_id,
+        ..Particles::default()
+    };
+    for (id, particle) in all {
+        out.insert(id, particle);
+    }
+    out
+}
+
+/// Every process's lines (collective), process by process.
+pub(crate) fn gather_lines(comm: &dyn Comm, mine: Vec<String>) -> Vec<String> {
+    let mut w = Writer::default();
+    mine.iter().for_each(|l| w.bytes(l.as_bytes()));
+    let mut all = Vec::new();
+    for m in comm.all_gather(w.0) {
+        let mut r = Reader::new(&m);
+        while !r.done() {
+            all.push(String::from_utf8_lossy(r.bytes()).into_owned());
+        }
+    }
+    all
+}
+
+/// `r` if every process's `r` is fine (collective); otherwise the first failing
+/// process's error, on every process: one error for the user, and no process left
+/// waiting for the others.
+pub fn agree<T>(comm: &dyn Comm, r: Result<T>) -> Result<T> {
+    let mine = match &r {
+        Ok(_) => Vec::new(),
+        Err(e) => format!("{e:#}").into_bytes(),
+    };
+    let all = comm.all_gather(mine);
+    match r {
+        Err(e) => Err(e),
+        Ok(v) => match all.iter().position(|m| !m.is_empty()) {
+            None => Ok(v),
+            Some(q) => bail!("process {q}: {}", String::from_utf8_lossy(&all[q])),
+        },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::parallel::comm::Threads;
+
+    #[test]
+    fn bisection_shares_the_points_evenly_and_every_process_agrees() {
+        for k in [2usize, 3, 5] {
+            let handles: Vec<_> = Threads::group(k)
+                .into_iter()
+                .map(|c| {
+                    std::thread::spawn(move || {
+                        // Each process holds a different share of a line of points.
+                        let x: Vec<DVec3> = (0..1000)
+                            .filter(|i| i % k == c.rank())
+                            .map(|i| DVec3::new((i as f64 * 0.37).sin(), i as f64 * 1e-3, 0.0))
+                            .collect();
+                        let tree = Tree::bisect(&c, &x);
+                        let all: Vec<DVec3> = (0..1000)
+                            .map(|i| DVec3::new((i as f64 * 0.37).sin(), i as f64 * 1e-3, 0.0))
+                            .collect();
+                        let mut counts = vec![0; k];
+                        all.iter().for_each(|&x| counts[tree.owner(x)] += 1);
+                        let mut near = Vec::new();
+                        tree.near(all[0], 10.0, &mut near);
+                        near.sort();
+                        (counts, near)
+                    })
+                })
+                .collect();
+            let results: Vec<_> = handles
+                .into_iter()
+                .map(|h| h.join().expect("ran"))
+                .collect();
+            for r in &results {
+                assert_eq!(r, &results[0], "the processes disagree");
+            }
+            let (counts, near) = &results[0];
+            for &c in counts {
+                assert!((c as f64 - 1000.0 / k as f64).abs() <= 2.0, "{counts:?}");
+            }
+            assert_eq!(near, &(0..k).collect::<Vec<_>>());
+        }
+    }
+}

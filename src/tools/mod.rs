@@ -1,0 +1,7 @@
+//! Tools on a run's output: render, plot, text, analyze, bench.
+
+pub mod analyze;
+pub mod bench;
+pub mod plot;
+pub mod render;
+pub mod text;

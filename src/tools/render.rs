@@ -1,0 +1,928 @@
+//! Pictures of frames: particles as shaded spheres (coloured by speed, height, radius,
+//! tag or material) with the mesh edges, in an orthographic view, with a colour bar or
+//! legend, a time stamp and a scale bar; one view and colour range for a whole sequence.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use glam::{DMat3, DVec3};
+use image::{Rgb, RgbImage};
+
+use crate::engine::Simulation;
+use crate::geometry::mesh::{Mesh, Primitive};
+use crate::model::particles::Particles;
+use crate::scenario::Scenario;
+use crate::tools::text::{self, put};
+
+/// What the particle colour shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ColorBy {
+    Speed,
+    Height,
+    Radius,
+    Tag,
+    Material,
+}
+
+/// Where the camera looks from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum View {
+    /// Along +y: x to the right, z up.
+    Front,
+    /// Along -x: y to the right, z up.
+    Side,
+    /// Down -z: x to the right, y up.
+    Top,
+    /// From azimuth 45°, elevation 30°.
+    Iso,
+}
+
+/// Picture settings.
+#[derive(Clone, Copy, Debug)]
+pub struct Style {
+    pub width: u32,
+    pub height: u32,
+    pub color: ColorBy,
+    pub view: View,
+    /// Draw a scale bar (a round length) at the bottom left.
+    pub scale_bar: bool,
+}
+
+impl Style {
+    /// Scale of the text and lines: 1 up to 599 pixels high, 2 up to 899, and so on.
+    fn scale(&self) -> u32 {
+        (self.height / 300).clamp(1, 4)
+    }
+}
+
+impl ColorBy {
+    /// The quantity with its unit, for the colour bar.
+    pub fn title(self) -> &'static str {
+        match self {
+            ColorBy::Speed => "speed [m/s]",
+            ColorBy::Height => "height z [m]",
+            ColorBy::Radius => "radius [m]",
+            ColorBy::Tag => "tag",
+            ColorBy::Material => "material",
+        }
+    }
+
+    /// Whether the values are categories (a legend) rather than a scale (a colour bar).
+    fn categorical(self) -> bool {
+        matches!(self, ColorBy::Tag | ColorBy::Material)
+    }
+
+    fn values(self, p: &Particles) -> Vec<f64> {
+        match self {
+            ColorBy::Speed => p.v.iter().map(|v| v.length()).collect(),
+            ColorBy::Height => p.x.iter().map(|x| x.z).collect(),
+            ColorBy::Radius => p.radius.clone(),
+            ColorBy::Tag => p.tag.iter().map(|&t| t as f64).collect(),
+            ColorBy::Material => p.material.iter().map(|&m| m as f64).collect(),
+        }
+    }
+}
+
+/// Ranges set by the user instead of fitted to the frames.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Fixed {
+    /// The box to show, in world coordinates (its corners, any order).
+    pub bounds: Option<(DVec3, DVec3)>,
+    /// The values at the two ends of the colour bar.
+    pub range: Option<(f64, f64)>,
+}
+
+/// What all the pictures of a sequence share, so that the view does not jump and a colour
+/// means the same value in each: the box in view (camera coordinates), the colour range,
+/// the categories of a legend.
+#[derive(Clone, Debug)]
+pub struct Layout {
+    lo: DVec3,
+    hi: DVec3,
+    range: (f64, f64),
+    categories: std::collections::BTreeSet<u32>,
+    /// Names of materials by index, for the legend.
+    pub material_names: Vec<String>,
+}
+
+const BACKGROUND: Rgb<u8> = Rgb([255, 255, 255]);
+const EDGE: Rgb<u8> = Rgb([60, 60, 60]);
+const INK: Rgb<u8> = Rgb([0, 0, 0]);
+
+/// Ten distinct colours for categories (after Tableau 10).
+const CATEGORIES: [[f64; 3]; 10] = [
+    [0.122, 0.467, 0.706],
+    [1.000, 0.498, 0.055],
+    [0.173, 0.627, 0.173],
+    [0.839, 0.153, 0.157],
+    [0.580, 0.404, 0.741],
+    [0.549, 0.337, 0.294],
+    [0.890, 0.467, 0.761],
+    [0.498, 0.498, 0.498],
+    [0.737, 0.741, 0.133],
+    [0.090, 0.745, 0.812],
+];
+
+fn category_colour(k: u32) -> DVec3 {
+    DVec3::from_array(CATEGORIES[k as usize % CATEGORIES.len()])
+}
+
+/// Camera axes: rows are screen right, screen up and the direction toward the viewer.
+fn camera(view: View) -> DMat3 {
+    let (right, up) = match view {
+        View::Front => (DVec3::X, DVec3::Z),
+        View::Side => (-DVec3::Y, DVec3::Z),
+        View::Top => (DVec3::X, DVec3::Y),
+        View::Iso => {
+            let (az, el) = (45f64.to_radians(), 30f64.to_radians());
+            let toward = DVec3::new(el.cos() * az.sin(), -el.cos() * az.cos(), el.sin());
+            let right = DVec3::Z.cross(toward).normalize();
+            (right, toward.cross(right))
+        }
+    };
+    DMat3::from_cols(right, up, right.cross(up)).transpose()
+}
+
+/// A perceptual blue-green-yellow colour map (after viridis), for s in [0, 1].
+fn colormap(s: f64) -> DVec3 {
+    const STOPS: [[f64; 3]; 5] = [
+        [0.267, 0.005, 0.329],
+        [0.230, 0.322, 0.546],
+        [0.128, 0.567, 0.551],
+        [0.369, 0.789, 0.383],
+        [0.993, 0.906, 0.144],
+    ];
+    let x = s.clamp(0.0, 1.0) * (STOPS.len() - 1) as f64;
+    let k = (x.floor() as usize).min(STOPS.len() - 2);
+    let f = x - k as f64;
+    DVec3::from_array(STOPS[k]).lerp(DVec3::from_array(STOPS[k + 1]), f)
+}
+
+fn rgb(c: DVec3) -> Rgb<u8> {
+    let c = (c * 255.0).clamp(DVec3::ZERO, DVec3::splat(255.0));
+    Rgb([c.x as u8, c.y as u8, c.z as u8])
+}
+
+/// Rounded mesh primitives (points and edges with a radius), drawn as grey spheres.
+fn mesh_balls(mesh: &Mesh) -> Vec<(DVec3, f64)> {
+    let mut balls = Vec::new();
+    for face in &mesh.faces {
+        match face.shape {
+            Primitive::Point(a) if face.radius > 0.0 => balls.push((a, face.radius)),
+            Primitive::Segment(a, b) if face.radius > 0.0 => {
+                let n = ((a.distance(b) / (0.25 * face.radius)).ceil() as usize).clamp(1, 4096);
+                balls.extend((0..=n).map(|k| (a.lerp(b, k as f64 / n as f64), face.radius)));
+            }
+            _ => {}
+        }
+    }
+    balls
+}
+
+impl Layout {
+    /// A layout that shows nothing yet: grow it with [`Layout::include`].
+    pub fn empty() -> Layout {
+        Layout {
+            lo: DVec3::splat(f64::INFINITY),
+            hi: DVec3::splat(f64::NEG_INFINITY),
+            range: (f64::INFINITY, f64::NEG_INFINITY),
+            categories: Default::default(),
+            material_names: Vec::new(),
+        }
+    }
+
+    /// The layout of one frame.
+    pub fn of(p: &Particles, mesh: &Mesh, style: &Style) -> Layout {
+        let mut l = Layout::empty();
+        l.include(p, mesh, style);
+        l
+    }
+
+    /// Grows the layout to show the frame `p` with `mesh`: the mesh, the particles without
+    /// the farthest half per cent on each side (a few escaped grains should not shrink the
+    /// picture), and the colour values from the 1 % to the 99 % quantile (radii: all, as a
+    /// few special particles are the point of such a picture).
+    pub fn include(&mut self, p: &Particles, mesh: &Mesh, style: &Style) {
+        let cam = camera(style.view);
+        for face in &mesh.faces {
+            for c in face.corners() {
+                let c = cam * c;
+                self.lo = self.lo.min(c - face.radius);
+                self.hi = self.hi.max(c + face.radius);
+            }
+        }
+        if p.is_empty() {
+            return;
+        }
+        let r_max = p.max_radius();
+        let cut = p.len() / 200;
+        for axis in 0..3 {
+            let mut v: Vec<f64> = p.x.iter().map(|x| (cam * *x)[axis]).collect();
+            v.sort_by(f64::total_cmp);
+            self.lo[axis] = self.lo[axis].min(v[cut] - r_max);
+            self.hi[axis] = self.hi[axis].max(v[v.len() - 1 - cut] + r_max);
+        }
+        let mut values = style.color.values(p);
+        if style.color.categorical() {
+            self.categories.extend(values.iter().map(|&v| v as u32));
+        }
+        values.sort_by(f64::total_cmp);
+        let cut = if style.color == ColorBy::Radius {
+            0
+        } else {
+            values.len() / 100
+        };
+        // Speeds from rest: the bar starts at 0.
+        let low = if style.color == ColorBy::Speed {
+            0.0
+        } else {
+            values[cut]
+        };
+        self.range.0 = self.range.0.min(low);
+        self.range.1 = self.range.1.max(values[values.len() - 1 - cut]);
+    }
+
+    /// Sets what the user fixed.
+    pub fn fix(&mut self, fixed: &Fixed, style: &Style) {
+        if let Some((a, b)) = fixed.bounds {
+            let cam = camera(style.view);
+            self.lo = DVec3::splat(f64::INFINITY);
+            self.hi = DVec3::splat(f64::NEG_INFINITY);
+            for k in 0..8 {
+                let corner = DVec3::new(
+                    if k & 1 == 0 { a.x } else { b.x },
+                    if k & 2 == 0 { a.y } else { b.y },
+                    if k & 4 == 0 { a.z } else { b.z },
+                );
+                self.lo = self.lo.min(cam * corner);
+                self.hi = self.hi.max(cam * corner);
+            }
+        }
+        if let Some(range) = fixed.range {
+            self.range = range;
+        }
+    }
+
+    /// The colour range, (0, 1) if nothing was included.
+    pub fn range(&self) -> (f64, f64) {
+        if self.range.0 <= self.range.1 {
+            self.range
+        } else {
+            (0.0, 1.0)
+        }
+    }
+
+    /// The box in view, in camera coordinates (screen right, up, toward the viewer).
+    pub fn bounds(&self) -> (DVec3, DVec3) {
+        (self.lo, self.hi)
+    }
+
+    fn label(&self, color: ColorBy, k: u32) -> String {
+        match color {
+            ColorBy::Material => match self.material_names.get(k as usize) {
+                Some(name) => format!("{k} {name}"),
+                None => format!("material {k}"),
+            },
+            _ => k.to_string(),
+        }
+    }
+}
+
+/// Renders one frame with its own layout.
+pub fn render(p: &Particles, mesh: &Mesh, style: &Style) -> Result<RgbImage> {
+    render_in(p, mesh, style, &Layout::of(p, mesh, style), None)
+}
+
+/// Renders particles (and mesh edges) in `layout`, with the colour bar or legend, the time
+/// stamp (if `time` is given) and the scale bar (if the style asks).
+pub fn render_in(
+    p: &Particles,
+    mesh: &Mesh,
+    style: &Style,
+    layout: &Layout,
+    time: Option<f64>,
+) -> Result<RgbImage> {
+    if style.width < 64 || style.height < 48 || style.width > 16384 || style.height > 16384 {
+        bail!(
+            "picture size {}x{} must be between 64x48 and 16384x16384 pixels",
+            style.width,
+            style.height
+        );
+    }
+    let cam = camera(style.view);
+    let k = style.scale();
+    let s = k as i64;
+    let (vmin, vmax) = layout.range();
+    // The panel on the right: a colour bar with its tick values, or a legend.
+    let bar_ticks = text::ticks(vmin, vmax, 5);
+    let panel = if style.color.categorical() {
+        let widest = layout
+            .categories
+            .iter()
+            .map(|&c| text::width(&layout.label(style.color, c), k))
+            .max()
+            .unwrap_or(0);
+        widest + 30 * s
+    } else {
+        let widest = bar_ticks
+            .iter()
+            .map(|v| text::width(&text::number(*v), k))
+            .max()
+            .unwrap_or(0);
+        widest + 34 * s
+    };
+    let (w, h) = (style.width as f64, style.height as f64);
+    let top = 14.0 * s as f64;
+    let scene_w = (w - panel as f64).max(16.0);
+    // A band below the scene for the scale bar, so that it never covers the particles.
+    let bottom = if style.scale_bar {
+        14.0 * s as f64
+    } else {
+        0.0
+    };
+    let scene_h = (h - top - bottom).max(16.0);
+    let (mut lo, mut hi) = (layout.lo, layout.hi);
+    if !lo.is_finite() || !hi.is_finite() {
+        lo = DVec3::splat(-1.0);
+        hi = DVec3::splat(1.0);
+    }
+    let span = (hi - lo).max(DVec3::splat(1e-12));
+    let scale = 0.95 * (scene_w / span.x).min(scene_h / span.y);
+    let mid = 0.5 * (lo + hi);
+    let to_px = |c: DVec3| {
+        (
+            0.5 * scene_w + (c.x - mid.x) * scale,
+            top + 0.5 * scene_h - (c.y - mid.y) * scale,
+        )
+    };
+    let values = style.color.values(p);
+    let colour = |v: f64| {
+        if style.color.categorical() {
+            category_colour(v as u32)
+        } else if vmax > vmin {
+            colormap((v - vmin) / (vmax - vmin))
+        } else {
+            colormap(0.5)
+        }
+    };
+
+    let mut img = RgbImage::from_pixel(style.width, style.height, BACKGROUND);
+    let mut depth = vec![f64::NEG_INFINITY; (style.width * style.height) as usize];
+    let light = DVec3::new(-0.4, 0.6, 0.7).normalize();
+    let scene_right = scene_w.min(w);
+    let mut sphere = |centre: DVec3, radius: f64, base: DVec3| {
+        let c = cam * centre;
+        let (cx, cy) = to_px(c);
+        let rp = radius * scale;
+        if cx + rp < 0.0 || cy + rp < 0.0 || cx - rp > scene_right || cy - rp > h {
+            return;
+        }
+        let (x0, x1) = (
+            (cx - rp).floor().max(0.0) as i64,
+            (cx + rp).ceil().min(scene_right - 1.0) as i64,
+        );
+        let (y0, y1) = (
+            (cy - rp).floor().max(0.0) as i64,
+            (cy + rp).ceil().min(h - 1.0) as i64,
+        );
+        for py in y0..=y1 {
+            for px in x0..=x1 {
+                let dx = (px as f64 + 0.5 - cx) / rp.max(1e-9);
+                let dy = (cy - py as f64 - 0.5) / rp.max(1e-9);
+                let d2 = dx * dx + dy * dy;
+                if d2 > 1.0 && rp >= 0.7 {
+                    continue;
+                }
+                let dz = (1.0 - d2).max(0.0).sqrt();
+                let z = c.z + dz * radius;
+                let at = (py as u32 * style.width + px as u32) as usize;
+                if z <= depth[at] {
+                    continue;
+                }
+                depth[at] = z;
+                let shade = 0.35 + 0.65 * DVec3::new(dx, dy, dz).dot(light).max(0.0);
+                img.put_pixel(px as u32, py as u32, rgb(base * shade));
+            }
+        }
+    };
+    for ((x, r), v) in p.x.iter().zip(&p.radius).zip(&values) {
+        sphere(*x, *r, colour(*v));
+    }
+    for (c, r) in mesh_balls(mesh) {
+        sphere(c, r, DVec3::splat(0.75));
+    }
+    // Mesh edges, hidden behind particles that are in front of them.
+    for face in &mesh.faces {
+        let corners = face.corners();
+        let n = corners.len();
+        let edges = if n <= 2 { n - 1 } else { n };
+        for e in 0..edges.max(1) {
+            let (a, b) = (cam * corners[e % n], cam * corners[(e + 1) % n]);
+            let ((ax, ay), (bx, by)) = (to_px(a), to_px(b));
+            let steps = ((bx - ax).abs().max((by - ay).abs()).ceil() as usize).max(1);
+            for st in 0..=steps {
+                let f = st as f64 / steps as f64;
+                let (x, y) = (ax + f * (bx - ax), ay + f * (by - ay));
+                if x < 0.0 || y < 0.0 || x >= scene_right || y >= h {
+                    continue;
+                }
+                let at = (y as u32 * style.width + x as u32) as usize;
+                if a.z + f * (b.z - a.z) >= depth[at] - 1e-9 * span.z {
+                    img.put_pixel(x as u32, y as u32, EDGE);
+                }
+            }
+        }
+    }
+
+    // The time stamp, top left.
+    if let Some(t) = time {
+        text::draw(
+            &mut img,
+            4 * s,
+            3 * s,
+            &format!("t = {} s", text::number(text::rounded(t, 3))),
+            k,
+            INK,
+        );
+    }
+    // The colour bar or the legend, right.
+    let x0 = scene_w as i64 + 6 * s;
+    if style.color.categorical() {
+        let mut y = top as i64 + 8 * s;
+        let title = style.color.title();
+        text::draw(&mut img, x0, top as i64 - 8 * s, title, k, INK);
+        for &c in &layout.categories {
+            let col = rgb(category_colour(c));
+            for dy in 0..8 * s {
+                for dx in 0..8 * s {
+                    put(&mut img, x0 + dx, y + dy, col);
+                }
+            }
+            text::draw(
+                &mut img,
+                x0 + 12 * s,
+                y,
+                &layout.label(style.color, c),
+                k,
+                INK,
+            );
+            y += 12 * s;
+        }
+    } else {
+        let title = style.color.title();
+        let tw = text::width(title, k);
+        text::draw(
+            &mut img,
+            (style.width as i64 - tw - 4 * s).min(x0),
+            3 * s,
+            title,
+            k,
+            INK,
+        );
+        let (bar_top, bar_bottom) = (
+            top as i64 + 10 * s,
+            (h as i64 - 16 * s).max(top as i64 + 40),
+        );
+        let bar_w = 10 * s;
+        for y in bar_top..=bar_bottom {
+            let f = (bar_bottom - y) as f64 / (bar_bottom - bar_top).max(1) as f64;
+            let col = rgb(colormap(f));
+            for x in x0..x0 + bar_w {
+                put(&mut img, x, y, col);
+            }
+        }
+        for x in x0..x0 + bar_w {
+            put(&mut img, x, bar_top, INK);
+            put(&mut img, x, bar_bottom, INK);
+        }
+        for y in bar_top..=bar_bottom {
+            put(&mut img, x0, y, INK);
+            put(&mut img, x0 + bar_w - 1, y, INK);
+        }
+        if vmax > vmin {
+            for v in &bar_ticks {
+                let f = (v - vmin) / (vmax - vmin);
+                let y = bar_bottom - (f * (bar_bottom - bar_top) as f64).round() as i64;
+                for x in x0 + bar_w..x0 + bar_w + 3 * s {
+                    put(&mut img, x, y, INK);
+                }
+                text::draw(
+                    &mut img,
+                    x0 + bar_w + 5 * s,
+                    y - 4 * s,
+                    &text::number(*v),
+                    k,
+                    INK,
+                );
+            }
+        } else {
+            let y = (bar_top + bar_bottom) / 2;
+            text::draw(
+                &mut img,
+                x0 + bar_w + 5 * s,
+                y - 4 * s,
+                &text::number(vmin),
+                k,
+                INK,
+            );
+        }
+    }
+    // The scale bar, bottom left: a round length near a fifth of the scene's width.
+    if style.scale_bar && scale.is_finite() && scale > 0.0 {
+        let want = 0.2 * scene_w / scale;
+        let power = 10f64.powf(want.log10().floor());
+        let length = [5.0, 2.0, 1.0]
+            .iter()
+            .map(|m| m * power)
+            .find(|l| *l <= want)
+            .unwrap_or(power);
+        let px_len = (length * scale).round() as i64;
+        let (x, y) = (8 * s, h as i64 - 4 * s);
+        for dx in 0..=px_len {
+            for dy in 0..2 * s {
+                put(&mut img, x + dx, y - dy, INK);
+            }
+        }
+        for dy in 0..6 * s {
+            put(&mut img, x, y - dy, INK);
+            put(&mut img, x + px_len, y - dy, INK);
+        }
+        let label = if length >= 1.0 {
+            format!("{} m", text::number(length))
+        } else if length >= 0.01 {
+            format!("{} cm", text::number(length * 100.0))
+        } else {
+            format!("{} mm", text::number(length * 1000.0))
+        };
+        text::draw(&mut img, x + px_len + 4 * s, y - 8 * s, &label, k, INK);
+    }
+    Ok(img)
+}
+
+/// What to make of a directory's pictures besides the PNGs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Animation {
+    None,
+    /// `animation.gif`.
+    Gif,
+    /// `animation.mp4` with the system's ffmpeg, or the GIF where there is none.
+    Movie,
+}
+
+impl Animation {
+    /// The animation the flags `gif` and `movie` ask for (a movie if both).
+    pub fn of(gif: bool, movie: bool) -> Animation {
+        match (gif, movie) {
+            (_, true) => Animation::Movie,
+            (true, _) => Animation::Gif,
+            _ => Animation::None,
+        }
+    }
+}
+
+/// What `render_path` made.
+#[derive(Clone, Debug)]
+pub struct Rendered {
+    /// The pictures, in frame order.
+    pub pictures: Vec<PathBuf>,
+    pub animation: Option<PathBuf>,
+    /// Said to the user (a fallback taken).
+    pub notes: Vec<String>,
+}
+
+/// The number of a frame file `particlesNNNNNN.csv`.
+fn frame_number(p: &Path) -> Option<u64> {
+    let name = p.file_stem()?.to_str()?;
+    name.strip_prefix("particles")?.parse().ok()
+}
+
+/// The times of the frames listed in a directory's `frames.csv`, by frame number.
+fn frame_times(dir: &Path) -> std::collections::HashMap<u64, f64> {
+    let Ok(text) = std::fs::read_to_string(dir.join(crate::io::output::FRAMES)) else {
+        return Default::default();
+    };
+    text.lines()
+        .skip(1)
+        .filter_map(|l| {
+            let v: Vec<&str> = l.split(',').collect();
+            Some((v.first()?.parse().ok()?, v.get(2)?.parse().ok()?))
+        })
+        .collect()
+}
+
+/// Renders a frame `particlesNNNNNN.csv` to `output` (default: beside it, as .png), or every
+/// frame of an output directory into `output` (default: the directory), all in one layout
+/// (view and colour range fitted to all frames, or as `fixed`), with an animation if asked.
+/// Meshes come from `scenario` (default: the run's `run.toml`) at each frame's time, and
+/// from the mesh files `meshes`.
+pub fn render_path(
+    path: &Path,
+    output: Option<&Path>,
+    scenario: Option<&Path>,
+    meshes: &[PathBuf],
+    style: &Style,
+    fixed: &Fixed,
+    animation: Animation,
+) -> Result<Rendered> {
+    let dir = if path.is_dir() {
+        path.to_path_buf()
+    } else {
+        path.parent().unwrap_or(Path::new(".")).to_path_buf()
+    };
+    let scenario = scenario
+        .map(Path::to_path_buf)
+        .or_else(|| crate::io::output::run_toml(&dir));
+    let mut sim = match &scenario {
+        Some(s) => Some(Simulation::new(Scenario {
+            particles: None,
+            ..Scenario::load(s)?
+        })?),
+        None => None,
+    };
+    let mut extra = Mesh::default();
+    for m in meshes {
+        // Radii do not show in pictures; accept any radius index of an OFF file.
+        let part = Mesh::load(m, &[0.0; 1024])?;
+        extra.faces.extend(part.faces);
+    }
+    let frames: Vec<PathBuf> = if path.is_dir() {
+        let mut f: Vec<PathBuf> = std::fs::read_dir(path)
+            .with_context(|| format!("cannot read directory {}", path.display()))?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| frame_number(p).is_some() && p.extension().is_some_and(|e| e == "csv"))
+            .collect();
+        f.sort();
+        anyhow::ensure!(
+            !f.is_empty(),
+            "{}: no frames particlesNNNNNN.csv",
+            path.display()
+        );
+        f
+    } else {
+        vec![path.to_path_buf()]
+    };
+    let times = frame_times(&dir);
+    let time_of = |frame: &Path, sim: &Option<Simulation>| -> Option<f64> {
+        let k = frame_number(frame)?;
+        times.get(&k).copied().or_else(|| {
+            sim.as_ref().map(|sim| {
+                let s = &sim.scenario.simulation;
+                k as f64 * s.steps_per_frame as f64 * s.timestep
+            })
+        })
+    };
+    let mesh_of = |t: Option<f64>, sim: &mut Option<Simulation>| -> Mesh {
+        let mut mesh = extra.clone();
+        if let Some(sim) = sim.as_mut() {
+            mesh.faces
+                .extend(sim.mesh_at(t.unwrap_or(0.0)).faces.iter().copied());
+        }
+        mesh
+    };
+    // The layout of all frames, then the pictures in it.
+    let mut layout = Layout::empty();
+    for f in &frames {
+        let p = crate::io::csv::load_particles(f)?;
+        let t = time_of(f, &sim);
+        layout.include(&p, &mesh_of(t, &mut sim), style);
+    }
+    layout.fix(fixed, style);
+    if let Some(sim) = &sim {
+        layout.material_names = sim
+            .scenario
+            .materials
+            .iter()
+            .map(|m| m.name.clone())
+            .collect();
+    }
+    let out_dir = match (path.is_dir(), output) {
+        (true, Some(o)) => o.to_path_buf(),
+        (true, None) => path.to_path_buf(),
+        (false, _) => PathBuf::new(),
+    };
+    if path.is_dir() {
+        std::fs::create_dir_all(&out_dir)
+            .with_context(|| format!("cannot create {}", out_dir.display()))?;
+    }
+    let mut rendered = Rendered {
+        pictures: Vec::new(),
+        animation: None,
+        notes: Vec::new(),
+    };
+    let mut images = Vec::new();
+    for f in &frames {
+        let p = crate::io::csv::load_particles(f)?;
+        let t = time_of(f, &sim);
+        let img = render_in(&p, &mesh_of(t, &mut sim), style, &layout, t)?;
+        let png = if path.is_dir() {
+            out_dir.join(f.with_extension("png").file_name().expect("a file name"))
+        } else {
+            output.map_or_else(|| f.with_extension("png"), Path::to_path_buf)
+        };
+        img.save(&png)
+            .with_context(|| format!("cannot write {}", png.display()))?;
+        rendered.pictures.push(png);
+        if animation != Animation::None {
+            images.push(img);
+        }
+    }
+    if animation == Animation::Movie {
+        let movie = out_dir.join("animation.mp4");
+        match write_movie(&movie, &images) {
+            Ok(()) => rendered.animation = Some(movie),
+            Err(e) => rendered
+                .notes
+                .push(format!("no movie ({e:#}); an animated GIF instead")),
+        }
+    }
+    if animation == Animation::Gif
+        || (animation == Animation::Movie && rendered.animation.is_none())
+    {
+        let gif = out_dir.join("animation.gif");
+        write_gif(&gif, images)?;
+        rendered.animation = Some(gif);
+    }
+    Ok(rendered)
+}
+
+/// Frames per second of animations.
+const FPS: u32 = 10;
+
+/// Writes the pictures as an animated GIF, looping.
+fn write_gif(path: &Path, images: Vec<RgbImage>) -> Result<()> {
+    let file =
+        std::fs::File::create(path).with_context(|| format!("cannot write {}", path.display()))?;
+    let mut enc = image::codecs::gif::GifEncoder::new_with_speed(file, 10);
+    enc.set_repeat(image::codecs::gif::Repeat::Infinite)?;
+    for img in images {
+        let rgba = image::DynamicImage::ImageRgb8(img).to_rgba8();
+        enc.encode_frame(image::Frame::from_parts(
+            rgba,
+            0,
+            0,
+            image::Delay::from_numer_denom_ms(1000 / FPS, 1),
+        ))?;
+    }
+    Ok(())
+}
+
+/// Writes the pictures as an H.264 MP4 (MPEG-4 part 2 where ffmpeg lacks H.264) by piping
+/// them to the system's `ffmpeg`; an error if there is none.
+fn write_movie(path: &Path, images: &[RgbImage]) -> Result<()> {
+    use std::io::Write;
+    use std::process::{Command, Stdio};
+    let Some(first) = images.first() else {
+        bail!("no pictures");
+    };
+    let (w, h) = first.dimensions();
+    let mut last_error = String::new();
+    for codec in [
+        &["-c:v", "libx264", "-pix_fmt", "yuv420p"][..],
+        &["-c:v", "mpeg4", "-q:v", "2"],
+    ] {
+        let child = Command::new("ffmpeg")
+            .args([
+                "-y",
+                "-loglevel",
+                "error",
+                "-f",
+                "rawvideo",
+                "-pix_fmt",
+                "rgb24",
+            ])
+            .args(["-s", &format!("{w}x{h}"), "-r", &FPS.to_string(), "-i", "-"])
+            // Even sizes, as the encoders' 4:2:0 colour needs.
+            .args(["-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2:color=white"])
+            .args(codec)
+            .arg(path)
+            .stdin(Stdio::piped())
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn();
+        let mut child = match child {
+            Ok(c) => c,
+            Err(e) => bail!("cannot start ffmpeg: {e}"),
+        };
+        let mut stdin = child.stdin.take().expect("piped");
+        let fed = images
+            .iter()
+            .try_for_each(|img| stdin.write_all(img.as_raw()));
+        drop(stdin);
+        let out = child.wait_with_output().context("ffmpeg")?;
+        if fed.is_ok() && out.status.success() {
+            return Ok(());
+        }
+        last_error = String::from_utf8_lossy(&out.stderr).trim().to_string();
+    }
+    bail!("ffmpeg failed: {last_error}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::particles::Particle;
+    use glam::DQuat;
+
+    #[test]
+    fn a_sphere_is_drawn_in_the_middle() {
+        let style = Style {
+            width: 320,
+            height: 240,
+            color: ColorBy::Speed,
+            view: View::Iso,
+            scale_bar: true,
+        };
+        let img = render(&one(DVec3::ZERO, DVec3::ZERO), &Mesh::default(), &style).unwrap();
+        assert_eq!(img.dimensions(), (320, 240));
+        // The scene is left of the colour bar and below the line of the time stamp.
+        assert_ne!(*img.get_pixel(139, 127), BACKGROUND);
+        assert_eq!(*img.get_pixel(0, 0), BACKGROUND);
+        assert!(
+            render(
+                &one(DVec3::ZERO, DVec3::ZERO),
+                &Mesh::default(),
+                &Style { width: 10, ..style }
+            )
+            .is_err()
+        );
+    }
+
+    fn one(x: DVec3, v: DVec3) -> Particles {
+        [Particle {
+            x,
+            radius: 1.0,
+            v,
+            q: DQuat::IDENTITY,
+            w: DVec3::ZERO,
+            tag: 0,
+            material: 0,
+        }]
+        .into_iter()
+        .collect()
+    }
+
+    /// In one layout the view and the colour bar stay put: a slow particle that moved has
+    /// its speed's colour on the bar of the fast one, the bar and the frame do not change.
+    #[test]
+    fn one_layout_keeps_the_view_and_the_colours() {
+        let style = Style {
+            width: 400,
+            height: 300,
+            color: ColorBy::Speed,
+            view: View::Front,
+            scale_bar: false,
+        };
+        let a = one(DVec3::ZERO, DVec3::new(4.0, 0.0, 0.0));
+        let b = one(DVec3::new(5.0, 0.0, 0.0), DVec3::new(1.0, 0.0, 0.0));
+        let mut layout = Layout::of(&a, &Mesh::default(), &style);
+        layout.include(&b, &Mesh::default(), &style);
+        assert_eq!(layout.range(), (0.0, 4.0));
+        let ia = render_in(&a, &Mesh::default(), &style, &layout, Some(0.0)).unwrap();
+        let ib = render_in(&b, &Mesh::default(), &style, &layout, Some(0.0)).unwrap();
+        // The colour bar and its labels (right of the scene) are the same pixels.
+        for y in 0..300 {
+            for x in 362..400 {
+                assert_eq!(ia.get_pixel(x, y), ib.get_pixel(x, y), "({x}, {y})");
+            }
+        }
+        // The particles are where they are, not each re-centred: a left of b.
+        let centre_x = |img: &RgbImage| {
+            let xs: Vec<u32> = (0..300)
+                .flat_map(|x| (20..300).map(move |y| (x, y)))
+                .filter(|&(x, y)| *img.get_pixel(x, y) != BACKGROUND)
+                .map(|(x, _)| x)
+                .collect();
+            xs.iter().sum::<u32>() as f64 / xs.len() as f64
+        };
+        assert!(centre_x(&ia) + 100.0 < centre_x(&ib));
+        // A fixed range and box replace the fitted ones.
+        layout.fix(
+            &Fixed {
+                bounds: Some((DVec3::splat(-10.0), DVec3::splat(10.0))),
+                range: Some((0.0, 10.0)),
+            },
+            &style,
+        );
+        assert_eq!(layout.range(), (0.0, 10.0));
+        assert_eq!(layout.bounds().0.x, -10.0);
+    }
+
+    #[test]
+    fn categories_get_a_legend_with_names() {
+        let style = Style {
+            width: 400,
+            height: 300,
+            color: ColorBy::Material,
+            view: View::Front,
+            scale_bar: false,
+        };
+        let mut p = one(DVec3::ZERO, DVec3::ZERO);
+        p.material[0] = 1;
+        let mut layout = Layout::of(&p, &Mesh::default(), &style);
+        layout.material_names = vec!["glass".into(), "steel".into()];
+        assert_eq!(layout.label(ColorBy::Material, 1), "1 steel");
+        let img = render_in(&p, &Mesh::default(), &style, &layout, None).unwrap();
+        let swatch = rgb(category_colour(1));
+        assert!(img.pixels().filter(|&&c| c == swatch).count() >= 64);
+    }
+}
