@@ -33,13 +33,13 @@ mod faces;
 mod pairs;
 pub mod records;
 mod report;
-mod setup;
+pub mod setup;
 pub mod spawn;
 mod split;
 use crate::engine::spawn::{Spawner, SpawnerState};
 use crate::geometry::surface::{self, Candidate, Fate};
 use crate::model::springs::Springs;
-use crate::scenario::{MeshSource, Scenario};
+use crate::scenario::Scenario;
 
 /// Contacts per group evaluated together: 8 doubles fill an AVX-512 register, two AVX ones.
 const WIDTH: usize = 8;

@@ -1,22 +1,24 @@
-//! Making a simulation: from a scenario (`new`, `from_parts`), from a checkpoint of the same
-//! run (`restore`: bit for bit) or as a new stage after another run (`stage`).
+//! Making a simulation: from a scenario and what its files hold (`from_inputs`,
+//! `from_parts`), from a checkpoint of the same run (`restore_from`: bit for bit) or as a
+//! new stage after another run (`stage_from`). The constructors that read the files first
+//! (`new`, `restore`, `stage`) are in `io/inputs.rs`.
 
 use super::*;
 
+/// What the files a scenario names hold, read (`io::inputs`): the main mesh (`[geometry]
+/// mesh`) and each `[[meshes]]` file in order, each with its name, and the initial
+/// particles (`[input] particles`).
+pub struct Inputs {
+    pub meshes: Vec<(Mesh, String)>,
+    pub particles: Particles,
+}
+
 impl Simulation {
-    /// Sets up a simulation: reads the mesh and the initial particles.
-    pub fn new(scenario: Scenario) -> Result<Simulation> {
+    /// Sets up a simulation from a scenario and what its files hold.
+    pub fn from_inputs(scenario: Scenario, inputs: Inputs) -> Result<Simulation> {
         let g = &scenario.geometry;
-        let (mut mesh, name) = match &g.mesh {
-            MeshSource::None => (Mesh::default(), String::new()),
-            MeshSource::File(path) => {
-                (Mesh::load(path, &g.mesh_radii)?, path.display().to_string())
-            }
-            MeshSource::Embedded { name, text } => (
-                Mesh::parse_off(text, name, &g.mesh_radii)?,
-                name.to_string(),
-            ),
-        };
+        let mut meshes = inputs.meshes.into_iter();
+        let (mut mesh, name) = meshes.next().unwrap_or_default();
         mesh = mesh.with_contacts(g.mesh_contacts);
         let mut files = vec![MeshFile {
             name,
@@ -26,8 +28,8 @@ impl Simulation {
             material: g.mesh_material,
         }];
         let mut moving = Vec::new();
-        for spec in &scenario.meshes {
-            let part = Mesh::load(&spec.file, &spec.radii)?.with_contacts(spec.contacts);
+        for (spec, (part, _)) in scenario.meshes.iter().zip(meshes) {
+            let part = part.with_contacts(spec.contacts);
             let faces = mesh.faces.len()..mesh.faces.len() + part.faces.len();
             if let Some(motion) = spec.motion {
                 moving.push((faces.clone(), motion));
@@ -44,11 +46,7 @@ impl Simulation {
             });
             mesh.append(part);
         }
-        let particles = match &scenario.particles {
-            Some(path) => crate::io::csv::load_particles(path)?,
-            None => Particles::default(),
-        };
-        let mut sim = Simulation::from_parts(scenario, mesh, particles)?;
+        let mut sim = Simulation::from_parts(scenario, mesh, inputs.particles)?;
         sim.mesh_files = files;
         for file in &sim.mesh_files {
             sim.face_material[file.faces.clone()].fill(file.material);
@@ -75,13 +73,21 @@ impl Simulation {
     }
 
     /// Continues a run from a snapshot taken by [`Simulation::snapshot`] with the same
-    /// scenario: the result is bitwise the same as if the run had not stopped.
-    pub fn restore(scenario: Scenario, snapshot: Snapshot) -> Result<Simulation> {
+    /// scenario (and its meshes in `inputs`; the particles are the snapshot's): the result
+    /// is bitwise the same as if the run had not stopped.
+    pub fn restore_from(
+        scenario: Scenario,
+        inputs: Inputs,
+        snapshot: Snapshot,
+    ) -> Result<Simulation> {
         let input = scenario.particles.clone();
-        let mut sim = Simulation::new(Scenario {
-            particles: None,
-            ..scenario
-        })?;
+        let mut sim = Simulation::from_inputs(
+            Scenario {
+                particles: None,
+                ..scenario
+            },
+            inputs,
+        )?;
         // The particles come from the snapshot; the scenario keeps its input file, so that
         // its `run.toml` reruns the run.
         sim.scenario.particles = input;
@@ -174,14 +180,14 @@ impl Simulation {
     /// it stands in the list; the spawner continues its random stream if the seed is the
     /// same. When the mesh is the same too, the lists are rebuilt as the run had them, so a
     /// stage that only adds frames gives the bits of one uninterrupted run. Returns what was
-    /// carried and dropped, for the user.
-    pub fn stage(scenario: Scenario, snapshot: Snapshot) -> Result<(Simulation, Vec<String>)> {
-        if scenario.particles.is_some() {
-            bail!(
-                "[input] particles cannot be combined with --from: the particles are those of the checkpoint"
-            );
-        }
-        let mut sim = Simulation::new(scenario)?;
+    /// carried and dropped, for the user. `scenario` names no particle file (`stage`
+    /// refuses one).
+    pub fn stage_from(
+        scenario: Scenario,
+        inputs: Inputs,
+        snapshot: Snapshot,
+    ) -> Result<(Simulation, Vec<String>)> {
+        let mut sim = Simulation::from_inputs(scenario, inputs)?;
         let misfit = |what: String| anyhow::anyhow!("the checkpoint does not fit: {what}");
         let mut notes = Vec::new();
         let p = snapshot.particles;
@@ -303,7 +309,7 @@ impl Simulation {
         let skin = scenario.simulation.skin * g.radius_max;
         let face_grid = face_grid(&mesh.faces, max_radius, skin);
         let mut sim = Simulation {
-            law: ContactLaw::of(&scenario),
+            law: contact_law(&scenario),
             neighbours: Neighbours::with_periodic(skin, scenario.periodicity()),
             face_grid,
             spawner: Spawner::new(scenario.simulation.seed),
@@ -351,4 +357,11 @@ impl Simulation {
         sim.sum_wall_loads();
         Ok(sim)
     }
+}
+
+/// The contact law of the scenario's materials and interactions.
+fn contact_law(s: &Scenario) -> ContactLaw {
+    let materials: Vec<_> = s.materials.iter().map(|m| m.properties.clone()).collect();
+    let (dt, springs) = (s.simulation.timestep, s.simulation.friction_springs);
+    ContactLaw::of(&materials, |a, b| s.pair(a, b), dt, springs)
 }

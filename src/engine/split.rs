@@ -105,14 +105,14 @@ impl Simulation {
     /// same checkpoint. An error if some process's state is not one a checkpoint may hold.
     pub(crate) fn snapshot_split(&self) -> Result<Snapshot> {
         let d = self.domain.as_ref().expect("a split run");
-        let mine = crate::io::checkpoint::encode(&self.snapshot_piece(), 0);
+        let mine = super::records::encode(&self.snapshot_piece(), 0);
         let pieces = d
             .comm
             .all_gather(mine)
             .iter()
-            .map(|bytes| crate::io::checkpoint::decode(bytes, Some(0)))
+            .map(|bytes| super::records::decode(bytes, Some(0)))
             .collect::<Result<Vec<_>>>()?;
-        crate::io::checkpoint::join(pieces)
+        super::records::join(pieces)
     }
 
     /// This process's piece of the state of a split run: its own particles (with their

@@ -366,22 +366,6 @@ impl Mesh {
         self.vertices.extend(other.vertices);
     }
 
-    /// Reads a mesh file: STL (ASCII or binary) if its name ends in `.stl`, else OFF.
-    pub fn load(path: &std::path::Path, radii: &[f64]) -> Result<Mesh> {
-        let bytes = crate::io::files::read(path)
-            .map_err(|e| anyhow::anyhow!("cannot read mesh file {}: {e}", path.display()))?;
-        let name = path.display().to_string();
-        let is_stl = path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("stl"));
-        if is_stl {
-            return Mesh::parse_stl(&bytes, &name, radii[0]);
-        }
-        let text = std::str::from_utf8(&bytes)
-            .map_err(|_| anyhow::anyhow!("{name}: not a text file, expected an OFF mesh"))?;
-        Mesh::parse_off(text, &name, radii)
-    }
-
     /// Parses an STL file, binary (80-byte header, triangle count, 50 bytes per triangle) or
     /// ASCII (`solid`, then `facet normal ... outer loop vertex x y z (3x) endloop endfacet`,
     /// `endsolid`). Every triangle gets the radius `radius` (STL has no per-face data).

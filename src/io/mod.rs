@@ -3,6 +3,7 @@
 pub mod checkpoint;
 pub mod csv;
 pub mod files;
+pub mod inputs;
 pub mod lock;
 pub mod output;
 pub mod vtk;

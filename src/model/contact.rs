@@ -22,9 +22,9 @@
 use glam::DVec3;
 
 use crate::model::lanes::{Displacement, Gather, Lanes};
+use crate::model::materials::{FrictionSprings, Material, PairCoefficients};
 use crate::model::motion::RigidVelocity;
 pub use crate::model::springs::Springs;
-use crate::scenario::{FrictionSprings, Material, PairCoefficients, Scenario};
 
 /// The constants of the contact law for one pair of materials (a particle's with another
 /// particle's, or with a wall's), derived once: one per pair, or one per lane of a group.
@@ -252,21 +252,28 @@ impl ContactLaw {
         }
     }
 
-    /// The law for every pair of the scenario's materials.
-    pub fn of(s: &Scenario) -> Self {
-        let n = s.materials.len();
-        let m = |a: usize| &s.materials[a].properties;
+    /// The law for every pair of `materials`, with the coefficients `pair(a, b)` of the
+    /// contacts between materials `a` and `b` (`Scenario::pair`), the time step `dt` and the
+    /// springs' update in `springs`' order.
+    pub fn of(
+        materials: &[Material],
+        pair: impl Fn(u16, u16) -> PairCoefficients,
+        dt: f64,
+        springs: FrictionSprings,
+    ) -> Self {
+        let n = materials.len();
+        let m = |a: usize| &materials[a];
         let mut law = ContactLaw {
             materials: n,
             pairs: Vec::with_capacity(n * n),
             walls: Vec::with_capacity(n * n),
             cohesive: false,
-            dt: s.simulation.timestep,
-            advance_first: s.simulation.friction_springs == FrictionSprings::AdvanceFirst,
+            dt,
+            advance_first: springs == FrictionSprings::AdvanceFirst,
         };
         for a in 0..n {
             for b in 0..n {
-                let pair = s.pair(a as u16, b as u16);
+                let pair = pair(a as u16, b as u16);
                 law.pairs.push(Self::particles(m(a), m(b), &pair));
                 law.walls.push(Self::wall(m(a), &pair));
                 law.cohesive |= pair.cohesion > 0.0;

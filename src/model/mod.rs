@@ -1,9 +1,10 @@
-//! The model: lanes of particles, exact sums, particles, springs, the contact law (Sec. 2.2 of the paper), integration and rigid motion. Imports nothing of the crate above it.
+//! The model: lanes of particles, exact sums, particles, springs, the contact law (Sec. 2.2 of the paper), materials and their mixing, integration and rigid motion. Imports nothing of the crate above it.
 
 pub mod contact;
 pub mod exact;
 pub mod integrate;
 pub mod lanes;
+pub mod materials;
 pub mod motion;
 pub mod particles;
 pub mod springs;

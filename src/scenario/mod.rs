@@ -33,6 +33,7 @@ use glam::DVec3;
 use serde::Deserialize;
 
 use crate::geometry::mesh::Contacts;
+pub use crate::model::materials::{FrictionSprings, Material, PairCoefficients};
 use crate::model::motion::Motion;
 
 /// The geometry of the paper's default hourglass (Fig. 5A), embedded so that `tinydem`
@@ -82,27 +83,6 @@ pub struct Geometry {
 }
 
 #[derive(Clone, Debug, PartialEq)]
-pub struct Material {
-    /// ρ [M/L³]
-    pub density: f64,
-    /// E [M/LT²]
-    pub youngs_modulus: f64,
-    /// ν [-]
-    pub poisson_ratio: f64,
-    /// e_n [-]
-    pub restitution: f64,
-    /// μ_s, μ_r, μ_t [-]
-    pub friction_sliding: f64,
-    pub friction_rolling: f64,
-    pub friction_twisting: f64,
-    /// η [M/LT]
-    pub viscosity: f64,
-    /// k_c [M/LT²] = [J/m³]: the simplified JKR cohesion, a pull k_c A over the contact
-    /// area A.
-    pub cohesion: f64,
-}
-
-#[derive(Clone, Debug, PartialEq)]
 pub struct Kinetics {
     /// v_0 [L/T]
     pub initial_velocity: DVec3,
@@ -132,28 +112,6 @@ pub struct Simulation {
     pub skin: f64,
     /// The order of the friction springs' update, Sec. 2.3.
     pub friction_springs: FrictionSprings,
-}
-
-/// When a friction spring is advanced by Δt v relative to the force taken from it
-/// (`[simulation] friction_springs`; the derivation is at `coulomb_spring` in `contact.rs`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum FrictionSprings {
-    /// Advance the spring, then take its force: symplectic, creates no energy (the default).
-    #[default]
-    AdvanceFirst,
-    /// The paper's Eqs. (53)-(55): the force of the previous step's spring, then advance.
-    /// It creates energy at Eq. (50)'s time step; the original program's order.
-    Paper,
-}
-
-impl FrictionSprings {
-    /// The value of the scenario key.
-    pub fn key(self) -> &'static str {
-        match self {
-            FrictionSprings::AdvanceFirst => "advance_first",
-            FrictionSprings::Paper => "paper",
-        }
-    }
 }
 
 impl Simulation {
@@ -196,18 +154,6 @@ impl Interaction {
             ("cohesion", "k_c", self.cohesion),
         ]
     }
-}
-
-/// The coefficients of the contact between two materials: e_n, μ_s, μ_r, μ_t, k_c.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PairCoefficients {
-    pub restitution: f64,
-    pub friction_sliding: f64,
-    pub friction_rolling: f64,
-    pub friction_twisting: f64,
-    pub cohesion: f64,
-    /// Whether `[[interactions]]` set any of them (otherwise the means).
-    pub given: bool,
 }
 
 /// One mesh file with its radii and, optionally, a prescribed motion (`[[meshes]]`).
@@ -1036,13 +982,6 @@ impl Default for Scenario {
 }
 
 impl Scenario {
-    /// Reads and validates a scenario file.
-    pub fn load(path: &Path) -> Result<Scenario> {
-        let text = crate::io::files::read_to_string(path)
-            .with_context(|| format!("cannot read scenario file {}", path.display()))?;
-        Scenario::parse(&text, path)
-    }
-
     /// Parses and validates scenario text; `path` names the file in messages and anchors
     /// relative paths.
     pub fn parse(text: &str, path: &Path) -> Result<Scenario> {

@@ -6,8 +6,8 @@
 //! Part `k` of `n` of the checkpoint of step `s` at `out/checkpoint.bin` is
 //! `out/checkpoint.bin.s.part-k-of-n` (the step in the name, so that the parts of two stops
 //! never mix: the set of a stop killed while writing is incomplete, and ignored): the magic
-//! `TINYDEM PART`, `k` and `n` (u32 each), then a checkpoint (format as in the parent
-//! module, with its own checksum) of that process's particles (with their anchors), the
+//! `TINYDEM PART`, `k` and `n` (u32 each), then a checkpoint (format as in
+//! `engine::records::bytes`, with its own checksum) of that process's particles (with their anchors), the
 //! springs of every contact it holds one of, and the state all processes share. Joined,
 //! the parts give the very snapshot the gathered checkpoint holds (`Simulation::snapshot`
 //! of a split run is made the same way), so resuming from parts or from the joined file
@@ -17,12 +17,9 @@ use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail, ensure};
-use glam::DVec3;
 
-use super::{decode, encode_into};
+use super::{decode, encode_into, join};
 use crate::engine::records::Snapshot;
-use crate::model::particles::{Particle, Particles};
-use crate::model::springs::Springs;
 
 const MAGIC: &[u8; 12] = b"TINYDEM PART";
 /// The bytes before a part's checkpoint.
@@ -203,83 +200,10 @@ fn of_its_step(path: &Path, piece: &Snapshot) -> Result<()> {
     Ok(())
 }
 
-/// The snapshot the pieces of all processes make (each the state of one process's
-/// particles, the springs of the contacts it holds one of, and the state all share): all
-/// particles in id order with their anchors, and every contact's springs once.
-pub fn join(pieces: Vec<Snapshot>) -> Result<Snapshot> {
-    let Some(first) = pieces.first() else {
-        bail!("no parts");
-    };
-    for (k, p) in pieces.iter().enumerate() {
-        ensure!(
-            p.steps == first.steps
-                && p.built_at == first.built_at
-                && p.particles.next_id == first.particles.next_id
-                && p.spawner == first.spawner
-                && p.removed == first.removed
-                && p.wall_sums == first.wall_sums
-                && p.scenario == first.scenario
-                && p.mesh_files == first.mesh_files,
-            "corrupt: part {k} is not of the state of part 0 (another step or run)"
-        );
-        ensure!(
-            p.lonely.is_empty(),
-            "corrupt: part {k} lists lonely particles"
-        );
-        let anchored = p.anchors.len() == p.particles.len() || p.particles.is_empty();
-        ensure!(
-            anchored,
-            "corrupt: part {k} lacks the anchors of its particles"
-        );
-    }
-    let mut all: Vec<(u32, Particle, DVec3)> = Vec::new();
-    for p in &pieces {
-        let q = &p.particles;
-        all.extend((0..q.len()).map(|i| (q.id[i], q.get(i), p.anchors[i])));
-    }
-    all.sort_unstable_by_key(|e| e.0);
-    if let Some(w) = all.windows(2).find(|w| w[0].0 == w[1].0) {
-        bail!("corrupt: particle {} is in two parts", w[0].0);
-    }
-    let mut particles = Particles {
-        next_id: first.particles.next_id,
-        ..Particles::default()
-    };
-    let mut anchors = Vec::with_capacity(all.len());
-    for (id, particle, anchor) in all {
-        particles.insert(id, particle);
-        anchors.push(anchor);
-    }
-    let springs = |of: fn(&Snapshot) -> &Vec<(u32, u32, Springs)>| {
-        dedup(pieces.iter().flat_map(|p| of(p).iter().copied()).collect())
-    };
-    Ok(Snapshot {
-        steps: first.steps,
-        built_at: first.built_at,
-        particles,
-        spawner: first.spawner.clone(),
-        anchors,
-        lonely: Vec::new(),
-        pair_history: springs(|p| &p.pair_history),
-        face_history: springs(|p| &p.face_history),
-        removed: first.removed.clone(),
-        wall_sums: first.wall_sums.clone(),
-        scenario: first.scenario.clone(),
-        mesh_files: first.mesh_files.clone(),
-    })
-}
-
-/// Entries sorted by their pair of keys, each once (the copies two processes hold of a
-/// contact are the same bits: both evaluated it from the same states).
-fn dedup(mut entries: Vec<(u32, u32, Springs)>) -> Vec<(u32, u32, Springs)> {
-    entries.sort_unstable_by_key(|e| (e.0, e.1));
-    entries.dedup_by_key(|e| (e.0, e.1));
-    entries
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::particles::Particles;
 
     /// Two pieces of one state (particles 3 and 4, their contact in both) and their join.
     fn pieces() -> (Vec<Snapshot>, Snapshot) {

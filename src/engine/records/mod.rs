@@ -4,6 +4,11 @@
 
 use glam::DVec3;
 
+pub mod bytes;
+mod join;
+pub use bytes::{decode, encode, encode_into};
+pub use join::join;
+
 use crate::engine::spawn::SpawnerState;
 use crate::model::particles::Particles;
 use crate::model::springs::Springs;

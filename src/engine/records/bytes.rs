@@ -1,0 +1,397 @@
+//! The bytes of a snapshot: the checkpoint format (written to files by `io::checkpoint`, and
+//! sent between processes to gather a split run's snapshot), versioned, with a checksum, so
+//! that a resumed run is bitwise identical to an uninterrupted one.
+//!
+//! Layout (little endian): magic `TINYDEM CKPT`, format version (u32), scenario fingerprint
+//! (u64), step (u64), step of the last neighbour-list rebuild (u64), spawner word position
+//! (u128), pending radius flag (u8) and value (f64), the next particle id (u32), particle
+//! count (u64) and per particle, in storage order: its id (u32), 14 f64 (x, y, z, R, vx, vy,
+//! vz, q0..q3, wx, wy, wz), its tag (u32) and material (u16); whether the lists were built (u8) and if so
+//! each particle's position at the last rebuild (3 f64); the lonely particles of the last
+//! rebuild: count (u64) and per entry storage index (u32) and allowance (f64); then the particle-pair and particle-face histories: count (u64) and per
+//! entry the ids (lower, higher) or the id and face (u32, u32) and the springs u_s, u_r (3 f64
+//! each), u_t (f64); last a CRC-32 of everything before it.
+//!
+//! The storage order and the positions of the last rebuild let a resumed run rebuild the
+//! very lists the interrupted one had; its results depend on them (the order in which
+//! forces are summed), so that is what makes it bitwise identical.
+
+use anyhow::{Result, bail};
+use glam::{DQuat, DVec3};
+
+use super::{Outflow, Removed, Snapshot, Wrench};
+use crate::engine::spawn::{RegionState, SpawnerState};
+use crate::model::particles::{Particle, Particles};
+use crate::model::springs::Springs;
+
+const MAGIC: &[u8; 12] = b"TINYDEM CKPT";
+const VERSION: u32 = 3;
+/// The oldest version this program reads.
+const OLDEST: u32 = 2;
+
+fn put_f64s(out: &mut Vec<u8>, values: &[f64]) {
+    for v in values {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+}
+
+fn put_history(out: &mut Vec<u8>, h: &[(u32, u32, Springs)]) {
+    out.extend_from_slice(&(h.len() as u64).to_le_bytes());
+    for (i, j, s) in h {
+        out.extend_from_slice(&i.to_le_bytes());
+        out.extend_from_slice(&j.to_le_bytes());
+        put_f64s(
+            out,
+            &[s.u_s.x, s.u_s.y, s.u_s.z, s.u_r.x, s.u_r.y, s.u_r.z, s.u_t],
+        );
+    }
+}
+
+/// Encodes a snapshot.
+pub fn encode(snapshot: &Snapshot, fingerprint: u64) -> Vec<u8> {
+    let mut out = Vec::new();
+    encode_into(&mut out, snapshot, fingerprint);
+    out
+}
+
+/// The bytes a checkpoint of `snapshot` takes (a bound).
+fn encoded_size(s: &Snapshot) -> usize {
+    let records = s.particles.len() * (122 + 24)
+        + s.lonely.len() * 12
+        + (s.pair_history.len() + s.face_history.len()) * 64;
+    256 + records
+        + s.scenario.len()
+        + 16 * s.mesh_files.len()
+        + 48 * s.wall_sums.len()
+        + 16 * s.removed.outlets.len()
+        + 17 * s.spawner.regions.len()
+}
+
+/// Appends the checkpoint of `snapshot` to `out` (its checksum covers what it appends).
+pub fn encode_into(out: &mut Vec<u8>, snapshot: &Snapshot, fingerprint: u64) {
+    let start = out.len();
+    out.reserve(encoded_size(snapshot));
+    let p = &snapshot.particles;
+    out.extend_from_slice(MAGIC);
+    out.extend_from_slice(&VERSION.to_le_bytes());
+    out.extend_from_slice(&fingerprint.to_le_bytes());
+    out.extend_from_slice(&snapshot.steps.to_le_bytes());
+    out.extend_from_slice(&snapshot.built_at.to_le_bytes());
+    out.extend_from_slice(&snapshot.spawner.word_pos.to_le_bytes());
+    out.push(snapshot.spawner.pending_radius.is_some() as u8);
+    put_f64s(out, &[snapshot.spawner.pending_radius.unwrap_or(0.0)]);
+    out.extend_from_slice(&p.next_id.to_le_bytes());
+    out.extend_from_slice(&(p.len() as u64).to_le_bytes());
+    for (k, q) in p.iter().enumerate() {
+        out.extend_from_slice(&p.id[k].to_le_bytes());
+        put_f64s(
+            out,
+            &[
+                q.x.x, q.x.y, q.x.z, q.radius, q.v.x, q.v.y, q.v.z, q.q.w, q.q.x, q.q.y, q.q.z,
+                q.w.x, q.w.y, q.w.z,
+            ],
+        );
+        out.extend_from_slice(&q.tag.to_le_bytes());
+        out.extend_from_slice(&q.material.to_le_bytes());
+    }
+    let built = snapshot.anchors.len() == p.len() && !p.is_empty();
+    out.push(built as u8);
+    if built {
+        for a in &snapshot.anchors {
+            put_f64s(out, &[a.x, a.y, a.z]);
+        }
+    }
+    out.extend_from_slice(&(snapshot.lonely.len() as u64).to_le_bytes());
+    for &(i, allowance) in &snapshot.lonely {
+        out.extend_from_slice(&i.to_le_bytes());
+        put_f64s(out, &[allowance]);
+    }
+    put_history(out, &snapshot.pair_history);
+    put_history(out, &snapshot.face_history);
+    let removed = &snapshot.removed;
+    let put_outflow = |out: &mut Vec<u8>, o: &Outflow| {
+        out.extend_from_slice(&o.count.to_le_bytes());
+        put_f64s(out, &[o.mass]);
+    };
+    put_outflow(out, &removed.domain);
+    out.extend_from_slice(&(removed.outlets.len() as u64).to_le_bytes());
+    for o in &removed.outlets {
+        put_outflow(out, o);
+    }
+    out.extend_from_slice(&(snapshot.wall_sums.len() as u64).to_le_bytes());
+    for w in &snapshot.wall_sums {
+        put_f64s(out, &[w.f.x, w.f.y, w.f.z, w.tau.x, w.tau.y, w.tau.z]);
+    }
+    out.extend_from_slice(&(snapshot.scenario.len() as u64).to_le_bytes());
+    out.extend_from_slice(snapshot.scenario.as_bytes());
+    out.extend_from_slice(&(snapshot.mesh_files.len() as u64).to_le_bytes());
+    for &(faces, hash) in &snapshot.mesh_files {
+        out.extend_from_slice(&faces.to_le_bytes());
+        out.extend_from_slice(&hash.to_le_bytes());
+    }
+    let regions = &snapshot.spawner.regions;
+    out.extend_from_slice(&(regions.len() as u64).to_le_bytes());
+    for r in regions {
+        out.extend_from_slice(&r.inserted.to_le_bytes());
+        out.push(r.pending_radius.is_some() as u8);
+        put_f64s(out, &[r.pending_radius.unwrap_or(0.0)]);
+    }
+    let crc = crc32fast::hash(&out[start..]);
+    out.extend_from_slice(&crc.to_le_bytes());
+}
+
+/// A cursor over the checkpoint bytes that reports truncation clearly.
+struct Reader<'a> {
+    bytes: &'a [u8],
+    at: usize,
+}
+
+impl Reader<'_> {
+    fn take(&mut self, n: usize) -> Result<&[u8]> {
+        if self.bytes.len() - self.at < n {
+            bail!(
+                "truncated: ends at byte {} while reading {n} more bytes",
+                self.bytes.len()
+            );
+        }
+        self.at += n;
+        Ok(&self.bytes[self.at - n..self.at])
+    }
+    fn u8(&mut self) -> Result<u8> {
+        Ok(self.take(1)?[0])
+    }
+    fn u16(&mut self) -> Result<u16> {
+        Ok(u16::from_le_bytes(self.take(2)?.try_into()?))
+    }
+    fn u32(&mut self) -> Result<u32> {
+        Ok(u32::from_le_bytes(self.take(4)?.try_into()?))
+    }
+    fn u64(&mut self) -> Result<u64> {
+        Ok(u64::from_le_bytes(self.take(8)?.try_into()?))
+    }
+    fn u128(&mut self) -> Result<u128> {
+        Ok(u128::from_le_bytes(self.take(16)?.try_into()?))
+    }
+    fn f64(&mut self) -> Result<f64> {
+        Ok(f64::from_le_bytes(self.take(8)?.try_into()?))
+    }
+    fn vec3(&mut self) -> Result<DVec3> {
+        Ok(DVec3::new(self.f64()?, self.f64()?, self.f64()?))
+    }
+    /// A count of records of `size` bytes each, checked against the bytes left.
+    fn count(&mut self, size: usize) -> Result<usize> {
+        let n = self.u64()?;
+        if n > ((self.bytes.len() - self.at) / size) as u64 {
+            bail!("corrupt: announces {n} records, more than the file holds");
+        }
+        Ok(n as usize)
+    }
+    fn history(&mut self) -> Result<Vec<(u32, u32, Springs)>> {
+        let n = self.count(8 + 56)?;
+        (0..n)
+            .map(|_| {
+                let (i, j) = (self.u32()?, self.u32()?);
+                let s = Springs {
+                    u_s: self.vec3()?,
+                    u_r: self.vec3()?,
+                    u_t: self.f64()?,
+                };
+                if !(bounded(s.u_s) && bounded(s.u_r) && bounded(DVec3::splat(s.u_t))) {
+                    bail!(
+                        "corrupt checkpoint: the friction springs of contact ({i}, {j}) are {s:?}"
+                    );
+                }
+                Ok((i, j, s))
+            })
+            .collect()
+    }
+}
+
+/// The largest magnitude a coordinate of a checkpoint's state may have (SI units): far
+/// beyond any run, and small enough that its squares and products stay finite.
+const STATE_BOUND: f64 = 1e30;
+
+/// Whether every component of `x` is finite and within [`STATE_BOUND`].
+fn bounded(x: DVec3) -> bool {
+    x.is_finite() && x.abs().max_element() <= STATE_BOUND
+}
+
+/// Checks the particles of a checkpoint as any input is checked: finite states within
+/// [`STATE_BOUND`], radii > 0, unit quaternions. A checksum only says the bytes are those
+/// written, not that what was written is a state.
+fn check_states(ids: &[u32], p: &Particles) -> Result<()> {
+    for (k, &id) in ids.iter().enumerate() {
+        let fields = [
+            ("position", p.x[k]),
+            ("velocity", p.v[k]),
+            ("angular velocity", p.w[k]),
+        ];
+        for (what, x) in fields {
+            if !bounded(x) {
+                bail!("corrupt checkpoint: particle {id} has the {what} {x}");
+            }
+        }
+        let r = p.radius[k];
+        if !(r > 0.0 && r < STATE_BOUND) {
+            bail!("corrupt checkpoint: particle {id} has the radius {r}");
+        }
+        let q = p.q[k];
+        if !q.is_finite() || (q.length() - 1.0).abs() > 1e-9 {
+            bail!(
+                "corrupt checkpoint: particle {id} has the orientation {q}, not a unit quaternion"
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Decodes a checkpoint, checking magic, version, checksum and, if given, the fingerprint
+/// (a resume needs the scenario it was written with; a staged run does not).
+pub fn decode(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<Snapshot> {
+    if bytes.len() < MAGIC.len() + 4 || &bytes[..MAGIC.len()] != MAGIC {
+        bail!("not a tinydem checkpoint (no 'TINYDEM CKPT' header)");
+    }
+    let (body, crc) = bytes.split_at(bytes.len() - 4);
+    let version = u32::from_le_bytes(bytes[12..16].try_into()?);
+    if !(OLDEST..=VERSION).contains(&version) {
+        bail!(
+            "checkpoint format version {version}; this tinydem reads versions {OLDEST} to {VERSION}"
+        );
+    }
+    if crc32fast::hash(body).to_le_bytes() != crc {
+        bail!("corrupt checkpoint: the checksum does not match (truncated or damaged file)");
+    }
+    let mut r = Reader {
+        bytes: body,
+        at: 16,
+    };
+    let fingerprint = r.u64()?;
+    if expected_fingerprint.is_some_and(|f| f != fingerprint) {
+        bail!(
+            "the checkpoint was written for a different scenario or mesh (material, time step, \
+             spawning, geometry): resume it with the scenario it was written with"
+        );
+    }
+    let steps = r.u64()?;
+    let built_at = r.u64()?;
+    if built_at > steps {
+        bail!("corrupt checkpoint: last rebuild at step {built_at}, after step {steps}");
+    }
+    let word_pos = r.u128()?;
+    let has_pending = r.u8()? != 0;
+    let pending = r.f64()?;
+    let next_id = r.u32()?;
+    let v3 = version >= 3;
+    let n = r.count(4 + 14 * 8 + 4 + if v3 { 2 } else { 0 })?;
+    let mut particles = Particles::default();
+    let mut ids = Vec::with_capacity(n);
+    for _ in 0..n {
+        ids.push(r.u32()?);
+        let x = r.vec3()?;
+        let radius = r.f64()?;
+        let v = r.vec3()?;
+        let (w0, q1, q2, q3) = (r.f64()?, r.f64()?, r.f64()?, r.f64()?);
+        let w = r.vec3()?;
+        let tag = r.u32()?;
+        let material = if v3 { r.u16()? } else { 0 };
+        particles.push(Particle {
+            x,
+            radius,
+            v,
+            q: DQuat::from_xyzw(q1, q2, q3, w0),
+            w,
+            tag,
+            material,
+        });
+    }
+    let anchors = match r.u8()? {
+        0 => Vec::new(),
+        _ => (0..n).map(|_| r.vec3()).collect::<Result<_>>()?,
+    };
+    check_states(&ids, &particles)?;
+    let mut sorted = ids.clone();
+    sorted.sort_unstable();
+    if sorted.windows(2).any(|w| w[0] == w[1]) || sorted.last().is_some_and(|&m| m >= next_id) {
+        bail!("corrupt checkpoint: particle ids repeat or reach the next id {next_id}");
+    }
+    (particles.id, particles.next_id) = (ids, next_id);
+    let lonely_count = r.count(4 + 8)?;
+    let lonely = (0..lonely_count)
+        .map(|_| Ok((r.u32()?, r.f64()?)))
+        .collect::<Result<Vec<(u32, f64)>>>()?;
+    if lonely.iter().any(|&(i, _)| i as usize >= n) || !lonely.is_sorted_by_key(|l| l.0) {
+        bail!("corrupt checkpoint: lonely particles out of order or range");
+    }
+    let pair_history = r.history()?;
+    let face_history = r.history()?;
+    let mut removed = Removed::default();
+    let mut wall_sums = Vec::new();
+    let mut scenario = String::new();
+    let mut mesh_files = Vec::new();
+    let mut regions = Vec::new();
+    if v3 {
+        let outflow = |r: &mut Reader| -> Result<Outflow> {
+            Ok(Outflow {
+                count: r.u64()?,
+                mass: r.f64()?,
+            })
+        };
+        removed.domain = outflow(&mut r)?;
+        let outlets = r.count(16)?;
+        removed.outlets = (0..outlets)
+            .map(|_| outflow(&mut r))
+            .collect::<Result<_>>()?;
+        let files = r.count(48)?;
+        wall_sums = (0..files)
+            .map(|_| {
+                Ok(Wrench {
+                    f: r.vec3()?,
+                    tau: r.vec3()?,
+                })
+            })
+            .collect::<Result<_>>()?;
+        let len = r.count(1)?;
+        scenario = String::from_utf8(r.take(len)?.to_vec())
+            .map_err(|_| anyhow::anyhow!("corrupt checkpoint: its scenario is not UTF-8"))?;
+        let files = r.count(16)?;
+        mesh_files = (0..files)
+            .map(|_| Ok((r.u64()?, r.u64()?)))
+            .collect::<Result<_>>()?;
+        let count = r.count(17)?;
+        regions = (0..count)
+            .map(|_| {
+                let inserted = r.u64()?;
+                let has = r.u8()? != 0;
+                let radius = r.f64()?;
+                Ok(RegionState {
+                    inserted,
+                    pending_radius: has.then_some(radius),
+                })
+            })
+            .collect::<Result<_>>()?;
+    }
+    if r.at != body.len() {
+        bail!(
+            "corrupt checkpoint: {} unexpected bytes at the end",
+            body.len() - r.at
+        );
+    }
+    Ok(Snapshot {
+        steps,
+        built_at,
+        particles,
+        spawner: SpawnerState {
+            word_pos,
+            pending_radius: has_pending.then_some(pending),
+            regions,
+        },
+        anchors,
+        lonely,
+        pair_history,
+        face_history,
+        removed,
+        wall_sums,
+        scenario,
+        mesh_files,
+    })
+}
