@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Remakes the README's pictures: runs the default simulation and every example (about an hour
+"""Remakes the guide's pictures (docs/book/src/pictures): runs the default simulation and every example (about an hour
 on 2 cores, most of it D's 20,000-grain pile and F at the paper's size), then draws them with
 the renderer. Needs the Python package
 (`python3 -m pip install ./python`), the built binary (`cargo build --release`, for
@@ -9,7 +9,7 @@ the renderer. Needs the Python package
 
 (--reuse: draw from the runs already in /tmp/tinydem-pictures.)
 
-Runs go to /tmp/tinydem-pictures/NAME; pictures to docs/.
+Runs go to /tmp/tinydem-pictures/NAME; pictures to docs/book/src/pictures/.
 """
 
 import subprocess
@@ -22,7 +22,7 @@ import numpy as np
 import tinydem
 
 ROOT = Path(__file__).resolve().parents[1]
-DOCS = ROOT / "docs"
+DOCS = ROOT / "docs" / "book" / "src" / "pictures"
 EXAMPLES = ROOT / "examples"
 WORK = Path("/tmp/tinydem-pictures")
 BINARY = ROOT / "target" / "release" / "tinydem"

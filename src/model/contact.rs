@@ -157,7 +157,7 @@ impl<T: Lanes> Kinematics<T> {
             delta,
             r_i,
             r_j,
-            // Eq. (26), sign as in the README
+            // Eq. (26), sign as in the guide's "Physics notes"
             v: i.v - j.v + T::cross(n, i.w * r_i + j.w * r_j),
             omega: i.w - j.w, // Eq. (38)
         }
