@@ -1,0 +1,371 @@
+//! The resolved scenario as TOML (`to_toml`: every default filled in, stored in run.toml and
+//! in checkpoints) and what one resolved scenario changes with respect to another
+//! (`changes`, for staged runs).
+
+use std::fmt::Write;
+
+use glam::DVec3;
+
+use super::*;
+
+impl Scenario {
+    /// The scenario as TOML with every default filled in: parsed again (from a file in the
+    /// current directory) it gives the same scenario. A built-in mesh is named in a comment.
+    pub fn to_toml(&self) -> String {
+        let mut o = String::new();
+        self.geometry_toml(&mut o);
+        self.materials_toml(&mut o);
+        self.kinetics_toml(&mut o);
+        self.simulation_toml(&mut o);
+        self.meshes_toml(&mut o);
+        self.regions_toml(&mut o);
+        self.spawn_toml(&mut o);
+        self.output_toml(&mut o);
+        o
+    }
+
+    /// The name of material `k`, as TOML.
+    fn material_name(&self, k: u16) -> String {
+        text(&self.materials[k as usize].name)
+    }
+
+    fn geometry_toml(&self, o: &mut String) {
+        let g = &self.geometry;
+        *o += "[geometry]\n";
+        let _ = writeln!(o, "radius_min = {}", num(g.radius_min));
+        let _ = writeln!(o, "radius_max = {}", num(g.radius_max));
+        match &g.mesh {
+            MeshSource::None => {}
+            MeshSource::File(p) => {
+                let _ = writeln!(o, "mesh = {}", path(p));
+            }
+            MeshSource::Embedded { name, .. } => {
+                let _ = writeln!(o, "mesh = {}  # {name}", text(BUILTIN_HOURGLASS));
+            }
+        }
+        let _ = writeln!(o, "mesh_radii = {}", list(&g.mesh_radii));
+        let _ = writeln!(o, "mesh_contacts = {}", contacts(g.mesh_contacts));
+        if self.uses_materials() {
+            let _ = writeln!(o, "mesh_material = {}", self.material_name(g.mesh_material));
+        }
+        let _ = writeln!(o, "spawn_min = {}", vec3(g.spawn_min));
+        let _ = writeln!(o, "spawn_max = {}", vec3(g.spawn_max));
+    }
+
+    fn materials_toml(&self, o: &mut String) {
+        let properties = |o: &mut String, m: &Material| {
+            for (key, x) in [
+                ("density", m.density),
+                ("youngs_modulus", m.youngs_modulus),
+                ("poisson_ratio", m.poisson_ratio),
+                ("restitution", m.restitution),
+                ("friction_sliding", m.friction_sliding),
+                ("friction_rolling", m.friction_rolling),
+                ("friction_twisting", m.friction_twisting),
+                ("cohesion", m.cohesion),
+            ] {
+                let _ = writeln!(o, "{key} = {}", num(x));
+            }
+        };
+        if self.uses_materials() {
+            for m in &self.materials {
+                let _ = writeln!(o, "\n[[materials]]\nname = {}", text(&m.name));
+                properties(o, &m.properties);
+            }
+            for i in &self.interactions {
+                let name = |k: u16| text(&self.materials[k as usize].name);
+                let _ = writeln!(
+                    o,
+                    "\n[[interactions]]\nmaterials = [{}, {}]",
+                    name(i.materials.0),
+                    name(i.materials.1)
+                );
+                for (key, _, x) in i.coefficients() {
+                    if let Some(x) = x {
+                        let _ = writeln!(o, "{key} = {}", num(x));
+                    }
+                }
+            }
+            *o += "\n[material]\n";
+        } else {
+            *o += "\n[material]\n";
+            properties(o, &self.material);
+        }
+        let _ = writeln!(o, "viscosity = {}", num(self.material.viscosity));
+    }
+
+    fn kinetics_toml(&self, o: &mut String) {
+        let k = &self.kinetics;
+        *o += "\n[kinetics]\n";
+        let _ = writeln!(o, "initial_velocity = {}", vec3(k.initial_velocity));
+        let _ = writeln!(
+            o,
+            "initial_angular_velocity = {}",
+            vec3(k.initial_angular_velocity)
+        );
+        let _ = writeln!(o, "gravity = {}", vec3(k.gravity));
+    }
+
+    fn simulation_toml(&self, o: &mut String) {
+        let s = &self.simulation;
+        *o += "\n[simulation]\n";
+        let _ = writeln!(o, "timestep = {}", num(s.timestep));
+        for (key, n) in [
+            ("max_particles", s.max_particles),
+            ("frames", s.frames),
+            ("steps_per_frame", s.steps_per_frame),
+            ("spawn_attempts", s.spawn_attempts),
+            ("seed", s.seed),
+        ] {
+            let _ = writeln!(o, "{key} = {n}");
+        }
+        let _ = writeln!(o, "skin = {}", num(s.skin));
+        let _ = writeln!(o, "friction_springs = {}", text(s.friction_springs.key()));
+    }
+
+    fn meshes_toml(&self, o: &mut String) {
+        for mesh in &self.meshes {
+            *o += "\n[[meshes]]\n";
+            let _ = writeln!(o, "file = {}", path(&mesh.file));
+            let _ = writeln!(o, "radii = {}", list(&mesh.radii));
+            let _ = writeln!(o, "contacts = {}", contacts(mesh.contacts));
+            if self.uses_materials() {
+                let _ = writeln!(o, "material = {}", self.material_name(mesh.material));
+            }
+            if let Some(m) = mesh.motion {
+                let _ = writeln!(o, "motion = {}", motion(m));
+            }
+        }
+    }
+
+    /// `[[tags]]`, `[domain]` and `[[outlets]]`.
+    fn regions_toml(&self, o: &mut String) {
+        for t in &self.tags {
+            *o += "\n[[tags]]\n";
+            let _ = writeln!(
+                o,
+                "min = {}\nmax = {}\ntag = {}",
+                vec3(t.min),
+                vec3(t.max),
+                t.tag
+            );
+        }
+        if let Some(d) = self.domain {
+            let _ = writeln!(
+                o,
+                "\n[domain]\nmin = {}\nmax = {}",
+                vec3(d.min),
+                vec3(d.max)
+            );
+            let [x, y, z] = self.periodic;
+            let _ = writeln!(o, "periodic = [{x}, {y}, {z}]");
+            if let Some((velocity, s, g)) = self.lees_edwards {
+                let name = |a: usize| ["x", "y", "z"][a];
+                let _ = writeln!(
+                    o,
+                    "lees_edwards = {{ velocity = {}, shear_axis = \"{}\", gradient_axis = \"{}\" }}",
+                    num(velocity),
+                    name(s),
+                    name(g)
+                );
+            }
+        }
+        for b in &self.outlets {
+            let _ = writeln!(
+                o,
+                "\n[[outlets]]\nmin = {}\nmax = {}",
+                vec3(b.min),
+                vec3(b.max)
+            );
+        }
+    }
+
+    fn spawn_toml(&self, o: &mut String) {
+        for r in &self.spawn {
+            let _ = writeln!(
+                o,
+                "\n[[spawn]]\nmin = {}\nmax = {}\nvelocity = {}",
+                vec3(r.region.min),
+                vec3(r.region.max),
+                vec3(r.velocity)
+            );
+            if self.uses_materials() {
+                let _ = writeln!(o, "material = {}", self.material_name(r.material));
+            }
+            if let Some(n) = r.count {
+                let _ = writeln!(o, "count = {n}");
+            }
+            if let Some(rate) = r.rate {
+                let _ = writeln!(o, "rate = {}", num(rate));
+            }
+            let _ = writeln!(o, "start = {}", num(r.start));
+            if r.stop.is_finite() {
+                let _ = writeln!(o, "stop = {}", num(r.stop));
+            }
+            let _ = writeln!(o, "radius = {}", radius(&r.radius));
+        }
+    }
+
+    fn output_toml(&self, o: &mut String) {
+        if let Some(p) = &self.particles {
+            let _ = writeln!(o, "\n[input]\nparticles = {}", path(p));
+        }
+        *o += "\n[output]\n";
+        let _ = writeln!(o, "dir = {}", path(&self.output_dir));
+        let _ = writeln!(o, "checkpoint_every = {}", self.checkpoint_every);
+        let _ = writeln!(o, "checkpoint_minutes = {}", num(self.checkpoint_minutes));
+        let mut formats = Vec::new();
+        if self.formats.csv {
+            formats.push("\"csv\"");
+        }
+        if self.formats.vtk {
+            formats.push("\"vtk\"");
+        }
+        let _ = writeln!(o, "formats = [{}]", formats.join(", "));
+        let _ = writeln!(o, "wall_forces = {}", self.wall_forces);
+        let _ = writeln!(o, "contacts = {}", self.contact_network);
+    }
+}
+
+fn num(x: f64) -> String {
+    format!("{x:?}")
+}
+
+fn vec3(x: DVec3) -> String {
+    format!("[{:?}, {:?}, {:?}]", x.x, x.y, x.z)
+}
+
+fn list(xs: &[f64]) -> String {
+    let items: Vec<String> = xs.iter().map(|&x| num(x)).collect();
+    format!("[{}]", items.join(", "))
+}
+
+fn text(t: &str) -> String {
+    toml::Value::String(t.to_string()).to_string()
+}
+
+fn path(p: &Path) -> String {
+    text(&p.display().to_string())
+}
+
+fn contacts(c: Contacts) -> &'static str {
+    match c {
+        Contacts::Merged => "\"merged\"",
+        Contacts::PerFace => "\"per_face\"",
+    }
+}
+
+/// A mesh's motion as an inline table.
+fn motion(m: Motion) -> String {
+    match m {
+        Motion::Harmonic {
+            amplitude,
+            frequency,
+            direction,
+            phase,
+        } => format!(
+            "{{ type = \"harmonic\", amplitude = {}, frequency = {}, direction = {}, phase = {} }}",
+            num(amplitude),
+            num(frequency),
+            vec3(direction),
+            num(phase)
+        ),
+        Motion::Velocity { velocity } => {
+            format!("{{ type = \"velocity\", velocity = {} }}", vec3(velocity))
+        }
+        Motion::Rotation {
+            center,
+            axis,
+            angular_velocity,
+        } => format!(
+            "{{ type = \"rotation\", center = {}, axis = {}, angular_velocity = {} }}",
+            vec3(center),
+            vec3(axis),
+            num(angular_velocity)
+        ),
+    }
+}
+
+/// A spawn region's radius distribution as an inline table.
+fn radius(r: &RadiusDistribution) -> String {
+    match r {
+        RadiusDistribution::Uniform { min, max } => format!(
+            "{{ distribution = \"uniform\", min = {}, max = {} }}",
+            num(*min),
+            num(*max)
+        ),
+        RadiusDistribution::Normal {
+            mean,
+            std,
+            min,
+            max,
+        } => format!(
+            "{{ distribution = \"normal\", mean = {}, std = {}, min = {}, max = {} }}",
+            num(*mean),
+            num(*std),
+            num(*min),
+            num(*max)
+        ),
+        RadiusDistribution::LogNormal {
+            mean,
+            std,
+            min,
+            max,
+        } => format!(
+            "{{ distribution = \"lognormal\", mean = {}, std = {}, min = {}, max = {} }}",
+            num(*mean),
+            num(*std),
+            num(*min),
+            num(*max)
+        ),
+        RadiusDistribution::Table { radii, weights } => format!(
+            "{{ distribution = \"table\", radii = {}, weights = {} }}",
+            list(radii),
+            list(weights)
+        ),
+    }
+}
+
+/// What `new` changes with respect to `old` (both resolved scenarios, `Scenario::to_toml`),
+/// one line per key: `[material] friction_sliding: 0.3 -> 0.5`, `[[meshes]] #2 file: added
+/// "plug.off"`.
+pub fn changes(old: &str, new: &str) -> Vec<String> {
+    // `section key` -> value, in the order of the text.
+    fn flat(text: &str) -> Vec<(String, String)> {
+        let mut out = Vec::new();
+        let mut section = String::new();
+        let mut counts: std::collections::HashMap<String, usize> = Default::default();
+        for line in text.lines().map(str::trim) {
+            if line.starts_with("[[") {
+                let n = counts.entry(line.to_string()).or_default();
+                *n += 1;
+                section = format!("{line} #{n}");
+            } else if line.starts_with('[') {
+                section = line.to_string();
+            } else if let Some(mesh) = line.strip_prefix("# mesh: ") {
+                out.push((format!("{section} mesh"), format!("{mesh:?}")));
+            } else if let Some((k, v)) = line.split_once(" = ") {
+                out.push((format!("{section} {k}"), v.to_string()));
+            }
+        }
+        out
+    }
+    let (old, new) = (flat(old), flat(new));
+    let find = |list: &[(String, String)], key: &str| {
+        list.iter().find(|(k, _)| k == key).map(|(_, v)| v.clone())
+    };
+    let mut lines = Vec::new();
+    for (key, value) in &new {
+        match find(&old, key) {
+            Some(was) if was != *value => lines.push(format!("{key}: {was} -> {value}")),
+            Some(_) => {}
+            None => lines.push(format!("{key}: added {value}")),
+        }
+    }
+    for (key, value) in &old {
+        if find(&new, key).is_none() {
+            lines.push(format!("{key}: removed (was {value})"));
+        }
+    }
+    lines
+}
