@@ -1,0 +1,176 @@
+//! Contact history: the springs of touching contacts keyed by particle (id or storage
+//! index) and partner, to carry them across rebuilds and into checkpoints.
+
+use super::*;
+
+/// A contact history: the springs of particle pairs keyed by (lower, higher) and of
+/// particle-face contacts by (particle, face), where particles are named by id (in
+/// checkpoints) or by their storage index after a rebuild's re-sort (to carry the springs
+/// into the new lists). Compressed by the first key, each run ordered by the second.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct History {
+    /// The entries of `a` are `start[a]..start[a+1]`, ordered by the other key.
+    pub(crate) start: Vec<u32>,
+    pub(crate) other: Vec<u32>,
+    pub(crate) springs: Vec<Springs>,
+}
+
+impl History {
+    /// The history of `(a, other, springs)` entries, `a` below `keys`: a counting sort by
+    /// `a`, then each run by `other`. `visit` hands every entry to its argument, the same
+    /// entries in the same order each time it is called (twice: to count, then to place).
+    pub(crate) fn from_visits(
+        keys: usize,
+        visit: impl Fn(&mut dyn FnMut(u32, u32, Springs)),
+    ) -> History {
+        let mut start = vec![0u32; keys + 1];
+        visit(&mut |a, _, _| start[a as usize + 1] += 1);
+        for k in 0..keys {
+            start[k + 1] += start[k];
+        }
+        let total = start[keys] as usize;
+        let mut fill = start.clone();
+        let mut other = vec![0u32; total];
+        let mut springs = vec![Springs::default(); total];
+        visit(&mut |a, o, s| {
+            let k = fill[a as usize] as usize;
+            (other[k], springs[k]) = (o, s);
+            fill[a as usize] += 1;
+        });
+        drop(fill);
+        // Runs are short: insertion sort, in place.
+        for a in 0..keys {
+            let run = start[a] as usize..start[a + 1] as usize;
+            for k in run.start + 1..run.end {
+                let mut m = k;
+                while m > run.start && other[m - 1] > other[m] {
+                    other.swap(m - 1, m);
+                    springs.swap(m - 1, m);
+                    m -= 1;
+                }
+            }
+        }
+        History {
+            start,
+            other,
+            springs,
+        }
+    }
+
+    /// The history of saved `(id, other, springs)` entries (a checkpoint's) for `particles`
+    /// (in storage order): keyed by storage index, `pairs` or not. An entry naming a
+    /// particle that `particles` lacks is an error.
+    pub fn in_storage(
+        particles: &Particles,
+        entries: &[(u32, u32, Springs)],
+        pairs: bool,
+    ) -> Result<History, String> {
+        Self::keyed(
+            &storage_index(particles),
+            particles.len(),
+            entries,
+            pairs,
+            false,
+        )
+    }
+
+    /// [`History::in_storage`] for `n` particles, whose storage indices by id are `index`
+    /// ([`storage_index`]), of the entries that name only them; the others are left out.
+    pub(crate) fn of_present(
+        index: &[u32],
+        n: usize,
+        entries: &[(u32, u32, Springs)],
+        pairs: bool,
+    ) -> History {
+        Self::keyed(index, n, entries, pairs, true).expect("entries of absent particles left out")
+    }
+
+    pub(crate) fn keyed(
+        index: &[u32],
+        n: usize,
+        entries: &[(u32, u32, Springs)],
+        pairs: bool,
+        skip_absent: bool,
+    ) -> Result<History, String> {
+        let at = |id: u32| index.get(id as usize).copied().filter(|&k| k != NONE);
+        if !skip_absent {
+            let named = |e: &(u32, u32, Springs)| [Some(e.0), pairs.then_some(e.1)];
+            if let Some(id) = entries
+                .iter()
+                .flat_map(named)
+                .flatten()
+                .find(|&id| at(id).is_none())
+            {
+                return Err(format!(
+                    "contact of particle id {id}, which the checkpoint lacks"
+                ));
+            }
+        }
+        Ok(History::from_visits(n, |f| {
+            for &(a, b, s) in entries {
+                let Some(a) = at(a) else { continue };
+                if pairs {
+                    let Some(b) = at(b) else { continue };
+                    f(a.min(b), a.max(b), s);
+                } else {
+                    f(a, b, s);
+                }
+            }
+        }))
+    }
+
+    /// Every entry, ordered by the first key and then by the other.
+    pub fn entries(&self) -> Vec<(u32, u32, Springs)> {
+        (0..self.start.len().saturating_sub(1))
+            .flat_map(|a| {
+                (self.start[a] as usize..self.start[a + 1] as usize)
+                    .map(move |k| (a as u32, self.other[k], self.springs[k]))
+            })
+            .collect()
+    }
+
+    pub fn len(&self) -> usize {
+        self.other.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.other.is_empty()
+    }
+
+    /// The entries of `a`: the other keys (ascending) and their springs.
+    #[inline]
+    pub(crate) fn run(&self, a: usize) -> (&[u32], &[Springs]) {
+        if a + 1 >= self.start.len() {
+            return (&[], &[]);
+        }
+        let run = self.start[a] as usize..self.start[a + 1] as usize;
+        (&self.other[run.clone()], &self.springs[run])
+    }
+}
+
+/// Contact histories as lists of entries: particle pairs and particle-face contacts.
+pub type Entries = (Vec<(u32, u32, Springs)>, Vec<(u32, u32, Springs)>);
+
+/// The contact histories of both lists.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Histories {
+    pub pairs: History,
+    pub faces: History,
+}
+
+/// The storage index of each id of `particles` (by id; [`NONE`] for ids it lacks).
+pub(crate) fn storage_index(particles: &Particles) -> Vec<u32> {
+    let mut index = vec![NONE; particles.next_id as usize];
+    for (k, &id) in particles.id.iter().enumerate() {
+        index[id as usize] = k as u32;
+    }
+    index
+}
+
+/// The history of particle pairs of a list, by (lower id, higher id).
+pub(crate) fn pair_key(ids: &[u32]) -> impl Fn(usize, u32) -> Option<(u32, u32)> + Sync + '_ {
+    move |i, j| {
+        let (a, b) = (ids[i], ids[j as usize]);
+        Some((a.min(b), a.max(b)))
+    }
+}
