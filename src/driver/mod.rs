@@ -1,4 +1,6 @@
 //! The driver: the run loop and the checks before a run.
 
 pub mod check;
+mod outputs;
 pub mod run;
+mod status;

@@ -1,0 +1,258 @@
+//! The outputs of a run but its checkpoints: frames in each format (and the ParaView
+//! collections), the CSV logs with a row per frame, and `run.toml`.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+
+use crate::engine::{Simulation, Thermo};
+use crate::io::csv::{Extra, write_frame};
+use crate::io::output::{FRAMES, LOG, LOG_HEADER, OUTLETS, RUN_TOML, WALLS};
+use crate::scenario::{Formats, Scenario};
+
+/// Writes frames in the scenario's formats, and the ParaView collection.
+pub(super) struct Frames<'a> {
+    dir: &'a Path,
+    formats: Formats,
+    /// The CSV frames' columns beyond the fourteen.
+    pub(super) extra: Extra,
+    /// Simulated time between frames.
+    frame_time: f64,
+}
+
+impl<'a> Frames<'a> {
+    /// The frames of `sim` into `dir`.
+    pub(super) fn of(dir: &'a Path, sim: &Simulation) -> Frames<'a> {
+        Frames {
+            dir,
+            formats: sim.scenario.formats,
+            extra: Extra {
+                tag: sim.has_tags(),
+                ids: sim.frames_carry_ids(),
+            },
+            frame_time: sim.scenario.simulation.steps_per_frame as f64
+                * sim.scenario.simulation.timestep,
+        }
+    }
+
+    /// Files that do not change during the run (the static mesh).
+    pub(super) fn start(&self, sim: &Simulation) -> Result<()> {
+        if self.formats.vtk && !sim.mesh_moves() && sim.is_writer() {
+            crate::io::vtk::write_mesh(&self.dir.join("mesh.vtu"), &sim.mesh)?;
+        }
+        Ok(())
+    }
+
+    /// Frame `k` (collective in a split run: all processes gather, the first writes).
+    pub(super) fn write(&self, k: u64, sim: &Simulation) -> Result<()> {
+        let particles = sim.particles_in_domain();
+        let contacts = sim.scenario.contact_network.then(|| sim.contact_network());
+        if !sim.is_writer() {
+            return Ok(());
+        }
+        if self.formats.csv {
+            write_frame(self.dir, k, &particles, self.extra)?;
+        }
+        if let Some(contacts) = contacts {
+            crate::io::csv::write_contacts(self.dir, &format!("contacts{k:06}.csv"), &contacts)?;
+            if self.formats.vtk {
+                let name = format!("contacts{k:06}.vtp");
+                crate::io::vtk::write_contacts(&self.dir.join(&name), &particles, &contacts)?;
+                let entries: Vec<(f64, String)> = (0..=k)
+                    .map(|f| (f as f64 * self.frame_time, format!("contacts{f:06}.vtp")))
+                    .collect();
+                crate::io::vtk::write_collection(&self.dir.join("contacts.pvd"), &entries)?;
+            }
+        }
+        if self.formats.vtk {
+            let name = format!("particles{k:06}.vtu");
+            crate::io::vtk::write_particles(&self.dir.join(&name), &particles)?;
+            let entries: Vec<(f64, String)> = (0..=k)
+                .map(|f| (f as f64 * self.frame_time, format!("particles{f:06}.vtu")))
+                .collect();
+            crate::io::vtk::write_collection(&self.dir.join("particles.pvd"), &entries)?;
+            if sim.mesh_moves() {
+                crate::io::vtk::write_mesh(&self.dir.join(format!("mesh{k:06}.vtu")), &sim.mesh)?;
+                let entries: Vec<(f64, String)> = (0..=k)
+                    .map(|f| (f as f64 * self.frame_time, format!("mesh{f:06}.vtu")))
+                    .collect();
+                crate::io::vtk::write_collection(&self.dir.join("mesh.pvd"), &entries)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Writes `run.toml`: the resolved scenario of the run (every default filled in, paths
+/// absolute), with the program version and command line, so that the output directory says
+/// what made it and `analyze` and `render` need no `--scenario`.
+fn write_run_toml(dir: &Path, s: &Scenario) -> Result<()> {
+    let command: Vec<String> = std::env::args().collect();
+    let text = format!(
+        "# The resolved scenario of the run whose output is in this directory: every default\n\
+         # filled in, paths absolute. Written by tinydem {}.\n# command: {}\n{}",
+        env!("CARGO_PKG_VERSION"),
+        command.join(" "),
+        s.absolute().to_toml()
+    );
+    let path = dir.join(RUN_TOML);
+    crate::io::files::write_bytes_atomically(&path, text.as_bytes())
+        .with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// A CSV log in the output directory with a row per frame (or several).
+struct Log {
+    out: std::io::BufWriter<std::fs::File>,
+    path: PathBuf,
+    line: String,
+}
+
+impl Log {
+    /// Creates `dir/name` with `header`, or, when resuming after frame `resumed_at`, keeps
+    /// the rows of frames up to it (a later checkpoint's rows, or a half-written last line,
+    /// are dropped) and continues it.
+    fn open(dir: &Path, name: &str, header: &str, resumed_at: Option<u64>) -> Result<Log> {
+        let path = dir.join(name);
+        let mut text = format!("{header}\n");
+        if let Some(last) = resumed_at
+            && let Ok(old) = std::fs::read_to_string(&path)
+        {
+            for line in old.lines().skip(1) {
+                let frame = line.split(',').next().and_then(|f| f.parse::<u64>().ok());
+                if frame.is_some_and(|f| f <= last)
+                    && line.split(',').count() == header.split(',').count()
+                {
+                    text += line;
+                    text.push('\n');
+                }
+            }
+        }
+        std::fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))?;
+        let file = std::fs::OpenOptions::new()
+            .append(true)
+            .open(&path)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        Ok(Log {
+            out: std::io::BufWriter::new(file),
+            path,
+            line: String::new(),
+        })
+    }
+
+    /// Appends a row (numbers in full precision) and flushes it.
+    fn row(&mut self, values: &[&dyn LogValue]) -> Result<()> {
+        use std::io::Write;
+        self.line.clear();
+        for (k, v) in values.iter().enumerate() {
+            if k > 0 {
+                self.line.push(',');
+            }
+            v.put(&mut self.line);
+        }
+        self.line.push('\n');
+        self.out
+            .write_all(self.line.as_bytes())
+            .and_then(|()| self.out.flush())
+            .with_context(|| format!("cannot write {}", self.path.display()))
+    }
+}
+
+/// A value of a log row.
+trait LogValue {
+    fn put(&self, line: &mut String);
+}
+
+impl LogValue for f64 {
+    fn put(&self, line: &mut String) {
+        line.push_str(ryu::Buffer::new().format(*self));
+    }
+}
+
+macro_rules! whole_log_values {
+    ($($t:ty),*) => {$(
+        impl LogValue for $t {
+            fn put(&self, line: &mut String) {
+                line.push_str(itoa::Buffer::new().format(*self));
+            }
+        }
+    )*};
+}
+whole_log_values!(u64, usize, i32);
+
+/// The logs of a run: `frames.csv` and `log.csv`, `outlets.csv` and `walls.csv` when the
+/// scenario asks for them.
+pub(super) struct Logs {
+    frames: Log,
+    thermo: Log,
+    outlets: Option<Log>,
+    walls: Option<Log>,
+    steps_per_frame: u64,
+}
+
+impl Logs {
+    /// The logs of scenario `s` in `dir`, continued after frame `resumed_at` when resuming;
+    /// and `run.toml`.
+    pub(super) fn open(dir: &Path, s: &Scenario, resumed_at: Option<u64>) -> Result<Logs> {
+        let outlets = (!s.outlets.is_empty())
+            .then(|| Log::open(dir, OUTLETS, "frame,time,outlet,count,mass", resumed_at))
+            .transpose()?;
+        let walls = s
+            .wall_forces
+            .then(|| Log::open(dir, WALLS, "frame,time,mesh,fx,fy,fz,tx,ty,tz", resumed_at))
+            .transpose()?;
+        write_run_toml(dir, s)?;
+        Ok(Logs {
+            frames: Log::open(dir, FRAMES, "frame,step,time", resumed_at)?,
+            thermo: Log::open(dir, LOG, LOG_HEADER, resumed_at)?,
+            outlets,
+            walls,
+            steps_per_frame: s.simulation.steps_per_frame,
+        })
+    }
+
+    /// A frame's lines in the logs (collective in a split run: the state over all
+    /// processes; the first writes, holding the logs), and its state.
+    pub(super) fn frame(
+        logs: Option<&mut Logs>,
+        sim: &mut Simulation,
+        frame: u64,
+    ) -> Result<Thermo> {
+        let th = sim.thermo();
+        let loads = if frame > 0 {
+            sim.take_wall_loads()
+        } else {
+            Vec::new()
+        };
+        let Some(logs) = logs else {
+            return Ok(th);
+        };
+        logs.frames.row(&[&frame, &sim.steps, &sim.time])?;
+        logs.thermo.row(&[
+            &frame,
+            &sim.steps,
+            &sim.time,
+            &th.particles,
+            &th.kinetic_energy,
+            &th.rotational_energy,
+            &th.contacts_per_particle(),
+            &th.pair_contacts,
+            &th.wall_contacts,
+            &th.max_overlap,
+            &th.removed,
+        ])?;
+        if let Some(log) = &mut logs.outlets {
+            for (k, o) in sim.removed.outlets.iter().enumerate() {
+                log.row(&[&frame, &sim.time, &k, &o.count, &o.mass])?;
+            }
+        }
+        if let Some(log) = logs.walls.as_mut().filter(|_| frame > 0) {
+            // The mean over the steps since the last frame.
+            let steps = logs.steps_per_frame as f64;
+            for (k, w) in loads.iter().enumerate() {
+                let (f, t) = (w.f / steps, w.tau / steps);
+                log.row(&[&frame, &sim.time, &k, &f.x, &f.y, &f.z, &t.x, &t.y, &t.z])?;
+            }
+        }
+        Ok(th)
+    }
+}
