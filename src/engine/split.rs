@@ -4,6 +4,7 @@
 //! removal over all processes, and the gathers of particles, contacts and snapshots.
 
 use super::*;
+use crate::neighbours::Entries;
 use crate::parallel::comm::{Comm, Reader, Writer};
 use crate::parallel::domain::{
     Domain, GHOST_STATE, Placement, REBALANCE, Tree, agree, gather_by_id, get_entry, get_particle,
@@ -228,185 +229,15 @@ impl Simulation {
             }
         }
         let mut d = self.domain.take().expect("a split run");
-        let (me, k) = (d.comm.rank(), d.comm.size());
         // The old lists and particles go as soon as what they hold is out.
-        let (pairs, faces) = self.neighbours.entries_by_id(&self.particles.id);
+        let springs = self.neighbours.entries_by_id(&self.particles.id);
         self.neighbours.clear_lists();
         let old = std::mem::take(&mut self.particles);
-        let p = &old;
-        // Where each particle is placed: at its anchor, or where it is now.
-        let place: std::borrow::Cow<[DVec3]> = match anchors {
-            Some(a) => a.into(),
-            None => p.x.as_slice().into(),
-        };
-        let index: FxHashMap<u32, u32> =
-            p.id.iter()
-                .enumerate()
-                .map(|(i, &id)| (id, i as u32))
-                .collect();
-        let kept = |i: usize| d.owned[i] && !gone.contains(&p.id[i]);
-        // The boxes, cut anew when the counts are out of balance.
-        let own: Vec<DVec3> = (0..p.len())
-            .filter(|&i| kept(i))
-            .map(|i| place[i])
-            .collect();
-        let counts: Vec<u64> = d
-            .comm
-            .all_gather((own.len() as u64).to_le_bytes().to_vec())
-            .iter()
-            .map(|c| Reader::new(c).u64())
-            .collect();
-        let mean = counts.iter().sum::<u64>() as f64 / k as f64;
-        let largest = counts.iter().copied().max().unwrap_or(0) as f64;
-        if d.tree.is_none() || largest > REBALANCE * mean.max(1.0) {
-            d.tree = Some(Tree::bisect(&*d.comm, &own));
-            d.cuts += 1;
-        }
-        drop(own);
-        let tree = d.tree.as_ref().expect("cut");
-        // Own particles that left the box to their new owners (the others stay), with the
-        // springs of their contacts. A pair's springs go to the owners of both partners,
-        // sent by the owner of its lower id (the other owner has the same springs), so each
-        // arrives once.
-        let owner = |id: u32| tree.owner(place[index[&id] as usize]);
-        let mine = |id: u32| d.owned[index[&id] as usize];
-        let mut particles_to: Vec<Vec<u32>> = vec![Vec::new(); k];
-        for i in (0..p.len()).filter(|&i| kept(i)) {
-            particles_to[tree.owner(place[i])].push(i as u32);
-        }
-        let mut pairs_to: Vec<Vec<usize>> = vec![Vec::new(); k];
-        for (e, &(a, b, _)) in pairs.iter().enumerate() {
-            if gone.contains(&a) || gone.contains(&b) || !mine(a) {
-                continue;
-            }
-            let (qa, qb) = (owner(a), owner(b));
-            pairs_to[qa].push(e);
-            if qb != qa {
-                pairs_to[qb].push(e);
-            }
-        }
-        let mut faces_to: Vec<Vec<usize>> = vec![Vec::new(); k];
-        for (e, &(a, _, _)) in faces.iter().enumerate() {
-            if !gone.contains(&a) && mine(a) {
-                faces_to[owner(a)].push(e);
-            }
-        }
-        let messages: Vec<Vec<u8>> = (0..k)
-            .map(|q| {
-                let mut w = Writer::default();
-                if q == me {
-                    return w.0; // what stays, stays
-                }
-                w.u64(particles_to[q].len() as u64);
-                for &i in &particles_to[q] {
-                    put_particle(&mut w, p.id[i as usize], &p.get(i as usize));
-                    if carry {
-                        w.vec3(place[i as usize]);
-                    }
-                }
-                w.u64(pairs_to[q].len() as u64);
-                pairs_to[q]
-                    .iter()
-                    .for_each(|&e| put_entry(&mut w, &pairs[e]));
-                w.u64(faces_to[q].len() as u64);
-                faces_to[q]
-                    .iter()
-                    .for_each(|&e| put_entry(&mut w, &faces[e]));
-                w.0
-            })
-            .collect();
-        drop(index);
-        let mut held = Particles {
-            next_id: p.next_id,
-            ..Particles::default()
-        };
-        let mut held_at = carry.then(Vec::new);
-        for &i in &particles_to[me] {
-            held.insert(p.id[i as usize], p.get(i as usize));
-            if let Some(at) = &mut held_at {
-                at.push(place[i as usize]);
-            }
-        }
-        let mut kept_pairs: Vec<_> = pairs_to[me].iter().map(|&e| pairs[e]).collect();
-        let mut kept_faces: Vec<_> = faces_to[me].iter().map(|&e| faces[e]).collect();
-        drop(place);
-        drop((particles_to, pairs_to, faces_to, pairs, faces, old));
-        for (q, m) in d.comm.all_to_all(messages).iter().enumerate() {
-            if q == me {
-                continue;
-            }
-            let mut r = Reader::new(m);
-            for _ in 0..r.u64() {
-                let (id, particle) = get_particle(&mut r);
-                held.insert(id, particle);
-                if let Some(at) = &mut held_at {
-                    at.push(r.vec3());
-                }
-            }
-            for _ in 0..r.u64() {
-                kept_pairs.push(get_entry(&mut r));
-            }
-            for _ in 0..r.u64() {
-                kept_faces.push(get_entry(&mut r));
-            }
-        }
-        let (pairs, faces) = (kept_pairs, kept_faces);
-        // Ghosts: copies of own particles for the processes whose boxes are within reach of
-        // them or, across periodic sides, of their images.
+        let (mut held, mut held_at, (pairs, faces)) = migrate(&mut d, old, anchors, gone, springs);
         let n_own = held.len();
         let r_max = d.comm.max(held.max_radius()).max(0.0);
-        let skin = self.neighbours.skin;
-        let periodic = self.neighbours.periodic;
-        let mut ghosts_to: Vec<Vec<u32>> = vec![Vec::new(); k];
-        let (mut near, mut images, mut to) = (Vec::new(), Vec::new(), Vec::new());
-        for i in 0..n_own {
-            let x = held_at.as_ref().map_or(held.x[i], |at| at[i]);
-            let reach = held.radius[i] + r_max + skin;
-            to.clear();
-            tree.near(x, reach, &mut near);
-            to.extend_from_slice(&near);
-            if let Some(periodic) = periodic {
-                periodic.image_shifts(x, reach, &mut images);
-                for &(s, _) in &images {
-                    tree.near(x + s, reach, &mut near);
-                    to.extend_from_slice(&near);
-                }
-                to.sort_unstable();
-                to.dedup();
-            }
-            for &q in to.iter().filter(|&&q| q != me) {
-                ghosts_to[q].push(i as u32);
-            }
-        }
-        let messages: Vec<Vec<u8>> = (0..k)
-            .map(|q| {
-                let mut w = Writer::default();
-                w.u64(ghosts_to[q].len() as u64);
-                for &i in &ghosts_to[q] {
-                    put_particle(&mut w, held.id[i as usize], &held.get(i as usize));
-                    if let Some(at) = &held_at {
-                        w.vec3(at[i as usize]);
-                    }
-                }
-                w.0
-            })
-            .collect();
-        let ghosts_to: Vec<Vec<u32>> = ghosts_to
-            .into_iter()
-            .map(|list| list.into_iter().map(|i| held.id[i as usize]).collect())
-            .collect();
-        let mut ghosts_from: Vec<Vec<u32>> = vec![Vec::new(); k];
-        for (q, m) in d.comm.all_to_all(messages).into_iter().enumerate() {
-            let mut r = Reader::new(&m);
-            for _ in 0..r.u64() {
-                let (id, particle) = get_particle(&mut r);
-                held.insert(id, particle);
-                if let Some(at) = &mut held_at {
-                    at.push(r.vec3());
-                }
-                ghosts_from[q].push(id);
-            }
-        }
+        let reach = (r_max, self.neighbours.skin, self.neighbours.periodic);
+        let (ghosts_to, ghosts_from) = exchange_ghosts(&d, &mut held, &mut held_at, reach);
         let mut owned: Vec<bool> = (0..held.len()).map(|i| i < n_own).collect();
         // The lists, with the faces binned for the largest particle of all processes.
         self.particles = held;
@@ -622,4 +453,208 @@ impl Simulation {
         self.face_grid = face_grid(&self.mesh.faces, max_radius, self.neighbours.skin);
         self.face_grid_radius = max_radius;
     }
+}
+
+/// The boxes cut anew (collective) when the counts of own particles, at `own`, are out of
+/// balance (or never cut).
+fn recut(d: &mut Domain, own: &[DVec3]) {
+    let k = d.comm.size();
+    let counts: Vec<u64> = d
+        .comm
+        .all_gather((own.len() as u64).to_le_bytes().to_vec())
+        .iter()
+        .map(|c| Reader::new(c).u64())
+        .collect();
+    let mean = counts.iter().sum::<u64>() as f64 / k as f64;
+    let largest = counts.iter().copied().max().unwrap_or(0) as f64;
+    if d.tree.is_none() || largest > REBALANCE * mean.max(1.0) {
+        d.tree = Some(Tree::bisect(&*d.comm, own));
+        d.cuts += 1;
+    }
+}
+
+/// Own particles of `p` (but those of ids in `gone`) to the owners of the boxes they are
+/// in, placed at `anchors` if given (collective; the boxes cut anew first if need be), with
+/// the springs of their contacts: the particles this process owns afterwards, their
+/// anchors if given, and their springs. A pair's springs go to the owners of both
+/// partners, sent by the owner of its lower id (the other owner has the same springs), so
+/// each arrives once.
+fn migrate(
+    d: &mut Domain,
+    p: Particles,
+    anchors: Option<Vec<DVec3>>,
+    gone: &FxHashSet<u32>,
+    (pairs, faces): Entries,
+) -> (Particles, Option<Vec<DVec3>>, Entries) {
+    let carry = anchors.is_some();
+    // Where each particle is placed: at its anchor, or where it is now.
+    let place: std::borrow::Cow<[DVec3]> = match anchors {
+        Some(a) => a.into(),
+        None => p.x.as_slice().into(),
+    };
+    let index: FxHashMap<u32, u32> =
+        p.id.iter()
+            .enumerate()
+            .map(|(i, &id)| (id, i as u32))
+            .collect();
+    let kept = |i: usize| d.owned[i] && !gone.contains(&p.id[i]);
+    let own: Vec<DVec3> = (0..p.len())
+        .filter(|&i| kept(i))
+        .map(|i| place[i])
+        .collect();
+    recut(d, &own);
+    drop(own);
+    let d = &*d;
+    let kept = |i: usize| d.owned[i] && !gone.contains(&p.id[i]);
+    let (me, k) = (d.comm.rank(), d.comm.size());
+    let tree = d.tree.as_ref().expect("cut");
+    let owner = |id: u32| tree.owner(place[index[&id] as usize]);
+    let mine = |id: u32| d.owned[index[&id] as usize];
+    let mut particles_to: Vec<Vec<u32>> = vec![Vec::new(); k];
+    for i in (0..p.len()).filter(|&i| kept(i)) {
+        particles_to[tree.owner(place[i])].push(i as u32);
+    }
+    let mut pairs_to: Vec<Vec<usize>> = vec![Vec::new(); k];
+    for (e, &(a, b, _)) in pairs.iter().enumerate() {
+        if gone.contains(&a) || gone.contains(&b) || !mine(a) {
+            continue;
+        }
+        let (qa, qb) = (owner(a), owner(b));
+        pairs_to[qa].push(e);
+        if qb != qa {
+            pairs_to[qb].push(e);
+        }
+    }
+    let mut faces_to: Vec<Vec<usize>> = vec![Vec::new(); k];
+    for (e, &(a, _, _)) in faces.iter().enumerate() {
+        if !gone.contains(&a) && mine(a) {
+            faces_to[owner(a)].push(e);
+        }
+    }
+    let messages: Vec<Vec<u8>> = (0..k)
+        .map(|q| {
+            let mut w = Writer::default();
+            if q == me {
+                return w.0; // what stays, stays
+            }
+            w.u64(particles_to[q].len() as u64);
+            for &i in &particles_to[q] {
+                put_particle(&mut w, p.id[i as usize], &p.get(i as usize));
+                if carry {
+                    w.vec3(place[i as usize]);
+                }
+            }
+            w.u64(pairs_to[q].len() as u64);
+            pairs_to[q]
+                .iter()
+                .for_each(|&e| put_entry(&mut w, &pairs[e]));
+            w.u64(faces_to[q].len() as u64);
+            faces_to[q]
+                .iter()
+                .for_each(|&e| put_entry(&mut w, &faces[e]));
+            w.0
+        })
+        .collect();
+    drop(index);
+    let mut held = Particles {
+        next_id: p.next_id,
+        ..Particles::default()
+    };
+    let mut held_at = carry.then(Vec::new);
+    for &i in &particles_to[me] {
+        held.insert(p.id[i as usize], p.get(i as usize));
+        if let Some(at) = &mut held_at {
+            at.push(place[i as usize]);
+        }
+    }
+    let mut kept_pairs: Vec<_> = pairs_to[me].iter().map(|&e| pairs[e]).collect();
+    let mut kept_faces: Vec<_> = faces_to[me].iter().map(|&e| faces[e]).collect();
+    drop(place);
+    drop((particles_to, pairs_to, faces_to, pairs, faces, p));
+    for (q, m) in d.comm.all_to_all(messages).iter().enumerate() {
+        if q == me {
+            continue;
+        }
+        let mut r = Reader::new(m);
+        for _ in 0..r.u64() {
+            let (id, particle) = get_particle(&mut r);
+            held.insert(id, particle);
+            if let Some(at) = &mut held_at {
+                at.push(r.vec3());
+            }
+        }
+        for _ in 0..r.u64() {
+            kept_pairs.push(get_entry(&mut r));
+        }
+        for _ in 0..r.u64() {
+            kept_faces.push(get_entry(&mut r));
+        }
+    }
+    (held, held_at, (kept_pairs, kept_faces))
+}
+
+/// Ghosts: copies of own particles (all `held` holds) for the processes whose boxes are
+/// within reach of them or, across periodic sides, of their images (collective); `reach`
+/// is the largest radius of all processes, the skin and the periodic sides. Returns the ids
+/// sent to and received from each process.
+fn exchange_ghosts(
+    d: &Domain,
+    held: &mut Particles,
+    held_at: &mut Option<Vec<DVec3>>,
+    (r_max, skin, periodic): (f64, f64, Option<crate::neighbours::Periodic>),
+) -> (Vec<Vec<u32>>, Vec<Vec<u32>>) {
+    let (me, k) = (d.comm.rank(), d.comm.size());
+    let tree = d.tree.as_ref().expect("cut");
+    let n_own = held.len();
+    let mut ghosts_to: Vec<Vec<u32>> = vec![Vec::new(); k];
+    let (mut near, mut images, mut to) = (Vec::new(), Vec::new(), Vec::new());
+    for i in 0..n_own {
+        let x = held_at.as_ref().map_or(held.x[i], |at| at[i]);
+        let reach = held.radius[i] + r_max + skin;
+        to.clear();
+        tree.near(x, reach, &mut near);
+        to.extend_from_slice(&near);
+        if let Some(periodic) = periodic {
+            periodic.image_shifts(x, reach, &mut images);
+            for &(s, _) in &images {
+                tree.near(x + s, reach, &mut near);
+                to.extend_from_slice(&near);
+            }
+            to.sort_unstable();
+            to.dedup();
+        }
+        for &q in to.iter().filter(|&&q| q != me) {
+            ghosts_to[q].push(i as u32);
+        }
+    }
+    let messages: Vec<Vec<u8>> = (0..k)
+        .map(|q| {
+            let mut w = Writer::default();
+            w.u64(ghosts_to[q].len() as u64);
+            for &i in &ghosts_to[q] {
+                put_particle(&mut w, held.id[i as usize], &held.get(i as usize));
+                if let Some(at) = held_at.as_ref() {
+                    w.vec3(at[i as usize]);
+                }
+            }
+            w.0
+        })
+        .collect();
+    let ghosts_to: Vec<Vec<u32>> = ghosts_to
+        .into_iter()
+        .map(|list| list.into_iter().map(|i| held.id[i as usize]).collect())
+        .collect();
+    let mut ghosts_from: Vec<Vec<u32>> = vec![Vec::new(); k];
+    for (q, m) in d.comm.all_to_all(messages).into_iter().enumerate() {
+        let mut r = Reader::new(&m);
+        for _ in 0..r.u64() {
+            let (id, particle) = get_particle(&mut r);
+            held.insert(id, particle);
+            if let Some(at) = held_at.as_mut() {
+                at.push(r.vec3());
+            }
+            ghosts_from[q].push(id);
+        }
+    }
+    (ghosts_to, ghosts_from)
 }
