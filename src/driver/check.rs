@@ -40,131 +40,9 @@ fn describe_start(s: &Scenario, out: &Path, sim: Simulation) -> Result<String> {
     let period = std::f64::consts::PI * (0.5 * m_min / k_10).sqrt();
     let max_n = most_particles(s, sim.particles.len());
     let size = OutputEstimate::of(s, max_n, sim.mesh.faces.len());
-    let mut meshes = String::new();
-    for (k, file) in sim.mesh_files.iter().enumerate() {
-        if file.faces.is_empty() && k == 0 {
-            meshes += "mesh                   none\n";
-            continue;
-        }
-        let faces = &sim.mesh.faces[file.faces.clone()];
-        let surfaces: std::collections::BTreeSet<u32> = faces.iter().map(|f| f.surface).collect();
-        let contacts = match file.contacts {
-            Contacts::Merged => format!(
-                "merged (one per touch of a connected surface; {} {})",
-                surfaces.len(),
-                if surfaces.len() == 1 {
-                    "surface"
-                } else {
-                    "surfaces"
-                }
-            ),
-            Contacts::PerFace => "per face (the original program's)".to_string(),
-        };
-        let contacts = if s.materials.len() > 1 {
-            format!(
-                "{contacts}, material \"{}\"",
-                s.materials[file.material as usize].name
-            )
-        } else {
-            contacts
-        };
-        meshes += &format!(
-            "{:<23}{}: {} faces, contacts {contacts}\n",
-            if k == 0 {
-                "mesh".to_string()
-            } else {
-                format!("mesh {k}")
-            },
-            file.name,
-            faces.len()
-        );
-    }
-    let mut bounds = String::new();
-    if let Some(d) = s.domain {
-        bounds += &format!(
-            "domain                 {} .. {} (particles leaving it are removed)\n",
-            d.min, d.max
-        );
-        let outside = sim.particles.x.iter().filter(|&&x| !d.contains(x)).count();
-        if outside > 0 {
-            bounds += &format!(
-                "                       warning: {outside} initial particles lie outside it and are removed at the first step\n"
-            );
-        }
-    }
-    for (k, o) in s.outlets.iter().enumerate() {
-        bounds += &format!(
-            "outlet {k:<16}{} .. {} (removes particles entering it; {OUTLETS})\n",
-            o.min, o.max
-        );
-    }
-    if s.wall_forces {
-        bounds += &format!(
-            "wall loads             force and torque on each mesh file, mean per frame ({WALLS})\n"
-        );
-    }
-    let mut materials = String::new();
-    if s.materials.len() > 1 || s.materials[0].name != "default" {
-        for (k, m) in s.materials.iter().enumerate() {
-            let p = &m.properties;
-            materials += &format!(
-                "{:<23}{k} \"{}\": density {}, E {:e}, nu {}, e_n {}, mu_s {}, mu_r {}, mu_t {}{}\n",
-                if k == 0 { "materials" } else { "" },
-                m.name,
-                num(p.density),
-                p.youngs_modulus,
-                num(p.poisson_ratio),
-                num(p.restitution),
-                num(p.friction_sliding),
-                num(p.friction_rolling),
-                num(p.friction_twisting),
-                if p.cohesion > 0.0 {
-                    format!(", cohesion {} J/m^3", num(p.cohesion))
-                } else {
-                    String::new()
-                }
-            );
-        }
-        let n = s.materials.len() as u16;
-        let mut first = true;
-        for a in 0..n {
-            for b in a..n {
-                let c = s.pair(a, b);
-                let how = if a == b {
-                    "its own".to_string()
-                } else {
-                    let given: Vec<&str> = s
-                        .interactions
-                        .iter()
-                        .find(|i| i.materials == (a, b))
-                        .map_or_else(Vec::new, |i| {
-                            i.coefficients()
-                                .iter()
-                                .filter(|c| c.2.is_some())
-                                .map(|c| c.1)
-                                .collect()
-                        });
-                    match given.len() {
-                        0 => "means of the two".to_string(),
-                        5 => "[[interactions]]".to_string(),
-                        _ => format!("{} from [[interactions]], the rest means", given.join(", ")),
-                    }
-                };
-                materials += &format!(
-                    "{:<23}{} - {}: e_n {}, mu_s {}, mu_r {}, mu_t {}, k_c {} ({how})\n",
-                    if first { "pairs" } else { "" },
-                    s.materials[a as usize].name,
-                    s.materials[b as usize].name,
-                    num(c.restitution),
-                    num(c.friction_sliding),
-                    num(c.friction_rolling),
-                    num(c.friction_twisting),
-                    num(c.cohesion)
-                );
-                first = false;
-            }
-        }
-    }
+    let meshes = mesh_lines(s, &sim);
+    let bounds = bound_lines(s, &sim);
+    let materials = material_lines(s);
     let default_dt = s.eq50_timestep();
     Ok(format!(
         "scenario is valid\n\
@@ -206,6 +84,151 @@ fn describe_start(s: &Scenario, out: &Path, sim: Simulation) -> Result<String> {
             .map(|r| format!("warning: {r} (run refuses it unless --force)\n"))
             .collect::<String>(),
     ))
+}
+
+/// A line per mesh file: its faces, contact mode (and surfaces) and material.
+fn mesh_lines(s: &Scenario, sim: &Simulation) -> String {
+    let mut meshes = String::new();
+    for (k, file) in sim.mesh_files.iter().enumerate() {
+        if file.faces.is_empty() && k == 0 {
+            meshes += "mesh                   none\n";
+            continue;
+        }
+        let faces = &sim.mesh.faces[file.faces.clone()];
+        let surfaces: std::collections::BTreeSet<u32> = faces.iter().map(|f| f.surface).collect();
+        let contacts = match file.contacts {
+            Contacts::Merged => format!(
+                "merged (one per touch of a connected surface; {} {})",
+                surfaces.len(),
+                if surfaces.len() == 1 {
+                    "surface"
+                } else {
+                    "surfaces"
+                }
+            ),
+            Contacts::PerFace => "per face (the original program's)".to_string(),
+        };
+        let contacts = if s.materials.len() > 1 {
+            format!(
+                "{contacts}, material \"{}\"",
+                s.materials[file.material as usize].name
+            )
+        } else {
+            contacts
+        };
+        meshes += &format!(
+            "{:<23}{}: {} faces, contacts {contacts}\n",
+            if k == 0 {
+                "mesh".to_string()
+            } else {
+                format!("mesh {k}")
+            },
+            file.name,
+            faces.len()
+        );
+    }
+    meshes
+}
+
+/// The domain (and the initial particles outside it), the outlets and the wall loads.
+fn bound_lines(s: &Scenario, sim: &Simulation) -> String {
+    let mut bounds = String::new();
+    if let Some(d) = s.domain {
+        bounds += &format!(
+            "domain                 {} .. {} (particles leaving it are removed)\n",
+            d.min, d.max
+        );
+        let outside = sim.particles.x.iter().filter(|&&x| !d.contains(x)).count();
+        if outside > 0 {
+            bounds += &format!(
+                "                       warning: {outside} initial particles lie outside it and are removed at the first step\n"
+            );
+        }
+    }
+    for (k, o) in s.outlets.iter().enumerate() {
+        bounds += &format!(
+            "outlet {k:<16}{} .. {} (removes particles entering it; {OUTLETS})\n",
+            o.min, o.max
+        );
+    }
+    if s.wall_forces {
+        bounds += &format!(
+            "wall loads             force and torque on each mesh file, mean per frame ({WALLS})\n"
+        );
+    }
+    bounds
+}
+
+/// The materials and the coefficients of each pair of them (where named).
+fn material_lines(s: &Scenario) -> String {
+    let mut materials = String::new();
+    if s.materials.len() > 1 || s.materials[0].name != "default" {
+        for (k, m) in s.materials.iter().enumerate() {
+            let p = &m.properties;
+            materials += &format!(
+                "{:<23}{k} \"{}\": density {}, E {:e}, nu {}, e_n {}, mu_s {}, mu_r {}, mu_t {}{}\n",
+                if k == 0 { "materials" } else { "" },
+                m.name,
+                num(p.density),
+                p.youngs_modulus,
+                num(p.poisson_ratio),
+                num(p.restitution),
+                num(p.friction_sliding),
+                num(p.friction_rolling),
+                num(p.friction_twisting),
+                if p.cohesion > 0.0 {
+                    format!(", cohesion {} J/m^3", num(p.cohesion))
+                } else {
+                    String::new()
+                }
+            );
+        }
+        let n = s.materials.len() as u16;
+        let mut first = true;
+        for a in 0..n {
+            for b in a..n {
+                let c = s.pair(a, b);
+                let how = pair_origin(s, a, b);
+                materials += &format!(
+                    "{:<23}{} - {}: e_n {}, mu_s {}, mu_r {}, mu_t {}, k_c {} ({how})\n",
+                    if first { "pairs" } else { "" },
+                    s.materials[a as usize].name,
+                    s.materials[b as usize].name,
+                    num(c.restitution),
+                    num(c.friction_sliding),
+                    num(c.friction_rolling),
+                    num(c.friction_twisting),
+                    num(c.cohesion)
+                );
+                first = false;
+            }
+        }
+    }
+    materials
+}
+
+/// Where the coefficients of the pair of materials `a`, `b` come from.
+fn pair_origin(s: &Scenario, a: u16, b: u16) -> String {
+    if a == b {
+        "its own".to_string()
+    } else {
+        let given: Vec<&str> = s
+            .interactions
+            .iter()
+            .find(|i| i.materials == (a, b))
+            .map_or_else(Vec::new, |i| {
+                i.coefficients()
+                    .iter()
+                    .filter(|c| c.2.is_some())
+                    .map(|c| c.1)
+                    .collect()
+            });
+        match given.len() {
+            0 => "means of the two".to_string(),
+            5 => "[[interactions]]".to_string(),
+            _ => format!("{} from [[interactions]], the rest means", given.join(", ")),
+        }
+    }
 }
 
 /// What `tinydem check SCENARIO --from CHECKPOINT` prints: the scenario's derived

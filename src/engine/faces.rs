@@ -27,6 +27,31 @@ struct MeshScratch {
     fates: Vec<Fate>,
 }
 
+/// What stage 4 reads, shared by the tasks of all pieces.
+struct FaceStage<'a> {
+    p: &'a Particles,
+    law: &'a ContactLaw,
+    faces: &'a [Face],
+    face_part: &'a [u32],
+    moving: &'a [MovingPart],
+    densities: &'a [Density],
+    face_material: &'a [u16],
+    uniform: bool,
+    one_wall: Coefficients<Group>,
+    scales: &'a LoadScales,
+    /// Per face its mesh file, the number of files whose loads are summed (0: none) and
+    /// the files (for their torques' reference points).
+    face_file: &'a [u32],
+    files: usize,
+    about: &'a [MeshFile],
+    wall_scales: &'a Scales8,
+    /// The own particles of a split run.
+    owned: Option<&'a [bool]>,
+    /// The particle-face list's run starts and faces.
+    start: &'a [u32],
+    partner: &'a [u32],
+}
+
 impl Simulation {
     /// Stage 4 (Sections 2.2, 3.3): the force of every particle-face contact. Returns the
     /// overlaps deeper than the particle's radius.
@@ -39,16 +64,8 @@ impl Simulation {
     /// lanes (bit for bit as alone).
     #[inline(never)] // a stage of its own in profiles
     pub(super) fn mesh_contacts(&mut self) -> Vec<Deep> {
-        let deep = Mutex::new(Vec::new());
-        let beyond = AtomicBool::new(false);
-        let scales = &self.scales;
-        let p = &self.particles;
+        let found = Found::default();
         let law = &self.law;
-        let faces = &self.mesh.faces;
-        let (face_part, moving) = (&self.face_part, &self.moving);
-        let (densities, face_material) = (&self.densities, &self.face_material);
-        let uniform = law.uniform();
-        let one_wall: Coefficients<Group> = law.with_wall(0, 0).splat();
         let ContactList {
             start,
             partner,
@@ -56,212 +73,43 @@ impl Simulation {
             pieces: bounds,
             stores,
         } = &mut self.neighbours.faces;
-        let (start, partner) = (&*start, &*partner);
+        let stage = FaceStage {
+            p: &self.particles,
+            law,
+            faces: &self.mesh.faces,
+            face_part: &self.face_part,
+            moving: &self.moving,
+            densities: &self.densities,
+            face_material: &self.face_material,
+            uniform: law.uniform(),
+            one_wall: law.with_wall(0, 0).splat(),
+            scales: &self.scales,
+            face_file: &self.face_file,
+            files: self.wall_sums.len(),
+            about: &self.mesh_files,
+            wall_scales: &self.wall_scales,
+            owned: self.domain.as_ref().map(|d| &d.owned[..]),
+            start,
+            partner,
+        };
         thread_local! {
             static SCRATCH: std::cell::RefCell<MeshScratch> = Default::default();
         }
-        let (face_file, files, about) = (&self.face_file, self.wall_sums.len(), &self.mesh_files);
-        let wall_scales = &self.wall_scales;
-        let owned = self.domain.as_ref().map(|d| &d.owned[..]);
         let all = pieces(bounds, &mut self.loads, start, contact, stores);
         let walls: Vec<(Vec<Sum6>, bool)> = all
             .into_par_iter()
             .with_min_len(MIN_PARALLEL_LEN.div_ceil(FACE_PIECE))
-            .map(|piece| {
-                SCRATCH.with_borrow_mut(|scratch| {
-                    let Piece {
-                        owners,
-                        first,
-                        loads,
-                        contact,
-                        store,
-                    } = piece;
-                    let MeshScratch {
-                        near,
-                        candidates,
-                        contacts,
-                        order,
-                        fates,
-                    } = scratch;
-                    // The faces within reach, each with its closest point and kinematics; the
-                    // slots of a particle are consecutive, so are its candidates.
-                    near.clear();
-                    for i in owners.clone() {
-                        let run = start[i] as usize..start[i + 1] as usize;
-                        if run.is_empty() {
-                            continue;
-                        }
-                        let body = Body {
-                            x: p.x[i],
-                            radius: p.radius[i],
-                            v: p.v[i],
-                            w: p.w[i],
-                        };
-                        for (k, &f) in run.clone().zip(&partner[run]) {
-                            let kl = k - first;
-                            let face = &faces[f as usize];
-                            let touch = if face.certainly_beyond(body.x, body.radius + face.radius)
-                            {
-                                None
-                            } else {
-                                let wall = match face_part[f as usize] {
-                                    STATIC => RigidVelocity::default(),
-                                    part => moving[part as usize].velocity,
-                                };
-                                let (d, feature) = face.separation_and_feature(body.x);
-                                let (d, interior) =
-                                    surface::snap(face, body.x, body.radius, d, feature);
-                                Kinematics::with_wall(&body, d, face.radius, &wall)
-                                    .map(|kin| (kin, d, interior))
-                            };
-                            match touch {
-                                Some((kin, d, interior)) => near.push(Near {
-                                    owner: i as u32,
-                                    slot: kl,
-                                    kin,
-                                    d,
-                                    interior,
-                                }),
-                                None if contact[kl] != NONE => {
-                                    // The contact ended: forget its history.
-                                    store.close(contact[kl]);
-                                    contact[kl] = NONE;
-                                }
-                                None => {}
-                            }
-                        }
-                    }
-                    // One contact per touch, particle by particle; the absorbed hand over
-                    // their springs and are treated as apart.
-                    contacts.clear();
-                    let mut a = 0;
-                    while a < near.len() {
-                        let i = near[a].owner as usize;
-                        let mut b = a + 1;
-                        while b < near.len() && near[b].owner as usize == i {
-                            b += 1;
-                        }
-                        let (x, radius) = (p.x[i], p.radius[i]);
-                        let several = b - a > 1;
-                        if several {
-                            candidates.clear();
-                            candidates.extend(near[a..b].iter().map(|c| Candidate {
-                                face: partner[first + c.slot],
-                                point: x - c.d,
-                                dist2: c.d.length_squared(),
-                                interior: c.interior,
-                            }));
-                            let tol = surface::tolerance(x, radius);
-                            surface::resolve(candidates, faces, tol, order, fates);
-                            for (c, fate) in near[a..b].iter().zip(fates.iter()) {
-                                let Fate::Absorbed(s) = *fate else { continue };
-                                let (k, s) = (c.slot, near[a + s].slot);
-                                let none = |e: u32| {
-                                    e == NONE || store.springs[e as usize] == Springs::default()
-                                };
-                                if none(contact[s]) && contact[k] != NONE {
-                                    if contact[s] == NONE {
-                                        // The absorbing contact takes over the entry.
-                                        (contact[s], contact[k]) = (contact[k], NONE);
-                                    } else {
-                                        let e = contact[k] as usize;
-                                        store.springs[contact[s] as usize] = store.springs[e];
-                                    }
-                                }
-                            }
-                        }
-                        for (c, near) in near[a..b].iter().enumerate() {
-                            let k = near.slot;
-                            if !several || fates[c] == Fate::Contact {
-                                if near.kin.delta > radius {
-                                    deep.lock().expect("not poisoned").push(Deep {
-                                        i,
-                                        other: Partner::Face(partner[first + k] as usize),
-                                        delta: near.kin.delta,
-                                        limit: radius,
-                                    });
-                                }
-                                if contact[k] == NONE {
-                                    contact[k] = store.open();
-                                }
-                                contacts.push((a + c) as u32);
-                            } else if contact[k] != NONE {
-                                store.close(contact[k]);
-                                contact[k] = NONE;
-                            }
-                        }
-                        a = b;
-                    }
-                    // The law, `WIDTH` contacts at a time (as for particle pairs), added to
-                    // the particles' loads, and their reactions (of own particles, in a split
-                    // run) to the piece's exact sum for each mesh file.
-                    let (mut wall, mut wall_fine) = (vec![Sum6::default(); files], true);
-                    for group in contacts.chunks(WIDTH) {
-                        let c: [&Near; WIDTH] =
-                            std::array::from_fn(|l| &near[group[l.min(group.len() - 1)] as usize]);
-                        let e = c.map(|c| contact[c.slot]);
-                        let i = c.map(|c| c.owner as usize);
-                        let scalar =
-                            |get: fn(&Kinematics) -> f64| Group::gather(c.map(|c| get(&c.kin)));
-                        let vector = |get: fn(&Kinematics) -> DVec3| {
-                            Group::gather_vec(c.map(|c| get(&c.kin)))
-                        };
-                        let kin = Kinematics::<Group> {
-                            n: vector(|k| k.n),
-                            delta: scalar(|k| k.delta),
-                            r_i: scalar(|k| k.r_i),
-                            r_j: scalar(|k| k.r_j),
-                            v: vector(|k| k.v),
-                            omega: vector(|k| k.omega),
-                        };
-                        let radius = Group::gather(i.map(|i| p.radius[i]));
-                        let (mass, coef) = if uniform {
-                            (
-                                Inertia::mass_with(radius, Group::splat(densities[0].mass_per_r3)),
-                                one_wall,
-                            )
-                        } else {
-                            let m = i.map(|i| p.material[i]);
-                            let f = c.map(|c| face_material[partner[first + c.slot] as usize]);
-                            (
-                                Inertia::mass_with(
-                                    radius,
-                                    Group::gather(m.map(|m| densities[m as usize].mass_per_r3)),
-                                ),
-                                Coefficients::gather(std::array::from_fn(|l| {
-                                    law.with_wall(m[l], f[l])
-                                })),
-                            )
-                        };
-                        let mut lanes = gather_springs(store, e);
-                        let force =
-                            law.evaluate(&coef, radius, mass, Other::Wall, &kin, &mut lanes);
-                        scatter_springs(lanes, store, &e[..group.len()]);
-                        let (f, tau) =
-                            (Group::scatter_vec(force.f), Group::scatter_vec(force.tau_i));
-                        let mut fine = true;
-                        for l in 0..group.len() {
-                            let load = &mut loads[i[l] - owners.start];
-                            fine &= load.add(pack(f[l], tau[l]), &scales.lanes);
-                        }
-                        if !fine {
-                            beyond.store(true, Ordering::Relaxed);
-                        }
-                        if files > 0 {
-                            // The reaction on the mesh file (Newton's third law for the
-                            // force and for the torque about the file's reference point).
-                            for l in (0..group.len()).filter(|&l| owned.is_none_or(|o| o[i[l]])) {
-                                let k = face_file[partner[first + c[l].slot] as usize] as usize;
-                                let arm = p.x[i[l]] - about[k].torque_about;
-                                let reaction = pack(-f[l], -(arm.cross(f[l]) + tau[l]));
-                                wall_fine &= wall[k].add(reaction, wall_scales);
-                            }
-                        }
-                    }
-                    (wall, wall_fine)
-                })
-            })
+            .map(|piece| SCRATCH.with_borrow_mut(|scratch| stage.piece(piece, scratch, &found)))
             .collect();
+        self.sum_wall_loads_of(walls);
+        let (deep, beyond) = found.into_inner();
+        self.beyond_range |= beyond;
+        deep
+    }
+
+    /// The pieces' sums of the loads on the mesh files, added to the files' sums (over all
+    /// processes of a split run).
+    fn sum_wall_loads_of(&mut self, walls: Vec<(Vec<Sum6>, bool)>) {
         if !self.wall_sums.is_empty() {
             let mut step = vec![Sum6::default(); self.wall_sums.len()];
             for (piece, fine) in walls {
@@ -279,7 +127,249 @@ impl Simulation {
                 };
             }
         }
-        self.beyond_range |= beyond.into_inner();
-        deep.into_inner().expect("not poisoned")
+    }
+}
+
+impl FaceStage<'_> {
+    /// One piece of the particle-face list: its contacts' loads added to its particles',
+    /// and the piece's sum of the reactions on each mesh file (and whether it was in range).
+    #[inline]
+    fn piece(&self, piece: Piece, scratch: &mut MeshScratch, found: &Found) -> (Vec<Sum6>, bool) {
+        let Piece {
+            owners,
+            first,
+            loads,
+            contact,
+            store,
+        } = piece;
+        let MeshScratch {
+            near,
+            candidates,
+            contacts,
+            order,
+            fates,
+        } = scratch;
+        self.near(owners.clone(), first, contact, store, near);
+        self.one_per_touch(
+            first,
+            (contact, store),
+            near,
+            (candidates, order, fates),
+            contacts,
+            found,
+        );
+        // The law, `WIDTH` contacts at a time (as for particle pairs), added to the
+        // particles' loads, and their reactions (of own particles, in a split run) to the
+        // piece's exact sum for each mesh file.
+        let (mut wall, mut wall_fine) = (vec![Sum6::default(); self.files], true);
+        for group in contacts.chunks(WIDTH) {
+            let loads = (&mut *loads, owners.start);
+            let slots = (&mut *contact, &mut *store);
+            wall_fine &= self.law_of((group, near), first, slots, loads, &mut wall, found);
+        }
+        (wall, wall_fine)
+    }
+
+    /// The faces within reach of the particles `owners` (their slots from `first`), each with
+    /// its closest point and kinematics, into `near`; the slots of a particle are
+    /// consecutive, so are its candidates. A contact that ended forgets its springs.
+    #[inline]
+    fn near(
+        &self,
+        owners: std::ops::Range<usize>,
+        first: usize,
+        contact: &mut [u32],
+        store: &mut Store,
+        near: &mut Vec<Near>,
+    ) {
+        near.clear();
+        for i in owners {
+            let run = self.start[i] as usize..self.start[i + 1] as usize;
+            if run.is_empty() {
+                continue;
+            }
+            let body = Body {
+                x: self.p.x[i],
+                radius: self.p.radius[i],
+                v: self.p.v[i],
+                w: self.p.w[i],
+            };
+            for (k, &f) in run.clone().zip(&self.partner[run]) {
+                let kl = k - first;
+                let face = &self.faces[f as usize];
+                let touch = if face.certainly_beyond(body.x, body.radius + face.radius) {
+                    None
+                } else {
+                    let wall = match self.face_part[f as usize] {
+                        STATIC => RigidVelocity::default(),
+                        part => self.moving[part as usize].velocity,
+                    };
+                    let (d, feature) = face.separation_and_feature(body.x);
+                    let (d, interior) = surface::snap(face, body.x, body.radius, d, feature);
+                    Kinematics::with_wall(&body, d, face.radius, &wall)
+                        .map(|kin| (kin, d, interior))
+                };
+                match touch {
+                    Some((kin, d, interior)) => near.push(Near {
+                        owner: i as u32,
+                        slot: kl,
+                        kin,
+                        d,
+                        interior,
+                    }),
+                    None if contact[kl] != NONE => {
+                        // The contact ended: forget its history.
+                        store.close(contact[kl]);
+                        contact[kl] = NONE;
+                    }
+                    None => {}
+                }
+            }
+        }
+    }
+
+    /// One contact per touch, particle by particle, into `contacts` (indices of `near`); the
+    /// absorbed hand over their springs and are treated as apart. Deep overlaps go to
+    /// `found`.
+    #[inline]
+    fn one_per_touch(
+        &self,
+        first: usize,
+        (contact, store): (&mut [u32], &mut Store),
+        near: &[Near],
+        (candidates, order, fates): (&mut Vec<Candidate>, &mut Vec<usize>, &mut Vec<Fate>),
+        contacts: &mut Vec<u32>,
+        found: &Found,
+    ) {
+        contacts.clear();
+        let mut a = 0;
+        while a < near.len() {
+            let i = near[a].owner as usize;
+            let mut b = a + 1;
+            while b < near.len() && near[b].owner as usize == i {
+                b += 1;
+            }
+            let (x, radius) = (self.p.x[i], self.p.radius[i]);
+            let several = b - a > 1;
+            if several {
+                candidates.clear();
+                candidates.extend(near[a..b].iter().map(|c| Candidate {
+                    face: self.partner[first + c.slot],
+                    point: x - c.d,
+                    dist2: c.d.length_squared(),
+                    interior: c.interior,
+                }));
+                let tol = surface::tolerance(x, radius);
+                surface::resolve(candidates, self.faces, tol, order, fates);
+                for (c, fate) in near[a..b].iter().zip(fates.iter()) {
+                    let Fate::Absorbed(s) = *fate else { continue };
+                    let (k, s) = (c.slot, near[a + s].slot);
+                    let none =
+                        |e: u32| e == NONE || store.springs[e as usize] == Springs::default();
+                    if none(contact[s]) && contact[k] != NONE {
+                        if contact[s] == NONE {
+                            // The absorbing contact takes over the entry.
+                            (contact[s], contact[k]) = (contact[k], NONE);
+                        } else {
+                            let e = contact[k] as usize;
+                            store.springs[contact[s] as usize] = store.springs[e];
+                        }
+                    }
+                }
+            }
+            for (c, near) in near[a..b].iter().enumerate() {
+                let k = near.slot;
+                if !several || fates[c] == Fate::Contact {
+                    if near.kin.delta > radius {
+                        found.deep.lock().expect("not poisoned").push(Deep {
+                            i,
+                            other: Partner::Face(self.partner[first + k] as usize),
+                            delta: near.kin.delta,
+                            limit: radius,
+                        });
+                    }
+                    if contact[k] == NONE {
+                        contact[k] = store.open();
+                    }
+                    contacts.push((a + c) as u32);
+                } else if contact[k] != NONE {
+                    store.close(contact[k]);
+                    contact[k] = NONE;
+                }
+            }
+            a = b;
+        }
+    }
+
+    /// The law for one group of `WIDTH` contacts (indices of `near`), added to the loads of
+    /// their particles (`loads` from owner `loads.1`) and their reactions to `wall`; whether
+    /// the wall sums stayed in range.
+    #[inline]
+    fn law_of(
+        &self,
+        (group, near): (&[u32], &[Near]),
+        first: usize,
+        (contact, store): (&mut [u32], &mut Store),
+        (loads, owners_start): (&mut [Load], usize),
+        wall: &mut [Sum6],
+        found: &Found,
+    ) -> bool {
+        let mut wall_fine = true;
+        let c: [&Near; WIDTH] =
+            std::array::from_fn(|l| &near[group[l.min(group.len() - 1)] as usize]);
+        let e = c.map(|c| contact[c.slot]);
+        let i = c.map(|c| c.owner as usize);
+        let scalar = |get: fn(&Kinematics) -> f64| Group::gather(c.map(|c| get(&c.kin)));
+        let vector = |get: fn(&Kinematics) -> DVec3| Group::gather_vec(c.map(|c| get(&c.kin)));
+        let kin = Kinematics::<Group> {
+            n: vector(|k| k.n),
+            delta: scalar(|k| k.delta),
+            r_i: scalar(|k| k.r_i),
+            r_j: scalar(|k| k.r_j),
+            v: vector(|k| k.v),
+            omega: vector(|k| k.omega),
+        };
+        let radius = Group::gather(i.map(|i| self.p.radius[i]));
+        let (mass, coef) = if self.uniform {
+            (
+                Inertia::mass_with(radius, Group::splat(self.densities[0].mass_per_r3)),
+                self.one_wall,
+            )
+        } else {
+            let m = i.map(|i| self.p.material[i]);
+            let f = c.map(|c| self.face_material[self.partner[first + c.slot] as usize]);
+            (
+                Inertia::mass_with(
+                    radius,
+                    Group::gather(m.map(|m| self.densities[m as usize].mass_per_r3)),
+                ),
+                Coefficients::gather(std::array::from_fn(|l| self.law.with_wall(m[l], f[l]))),
+            )
+        };
+        let mut lanes = gather_springs(store, e);
+        let force = self
+            .law
+            .evaluate(&coef, radius, mass, Other::Wall, &kin, &mut lanes);
+        scatter_springs(lanes, store, &e[..group.len()]);
+        let (f, tau) = (Group::scatter_vec(force.f), Group::scatter_vec(force.tau_i));
+        let mut fine = true;
+        for l in 0..group.len() {
+            let load = &mut loads[i[l] - owners_start];
+            fine &= load.add(pack(f[l], tau[l]), &self.scales.lanes);
+        }
+        if !fine {
+            found.beyond.store(true, Ordering::Relaxed);
+        }
+        if self.files > 0 {
+            // The reaction on the mesh file (Newton's third law for the
+            // force and for the torque about the file's reference point).
+            for l in (0..group.len()).filter(|&l| self.owned.is_none_or(|o| o[i[l]])) {
+                let k = self.face_file[self.partner[first + c[l].slot] as usize] as usize;
+                let arm = self.p.x[i[l]] - self.about[k].torque_about;
+                let reaction = pack(-f[l], -(arm.cross(f[l]) + tau[l]));
+                wall_fine &= wall[k].add(reaction, self.wall_scales);
+            }
+        }
+        wall_fine
     }
 }

@@ -115,6 +115,23 @@ impl LoadScales {
     }
 }
 
+/// What the tasks of a contact stage find beside the loads: the overlaps deeper than
+/// allowed, and whether a load left the range of its exact sum.
+#[derive(Default)]
+struct Found {
+    deep: Mutex<Vec<Deep>>,
+    beyond: AtomicBool,
+}
+
+impl Found {
+    fn into_inner(self) -> (Vec<Deep>, bool) {
+        (
+            self.deep.into_inner().expect("not poisoned"),
+            self.beyond.into_inner(),
+        )
+    }
+}
+
 /// A piece of owners `owners` of a contact list: their loads, and the contacts of their
 /// slots (which start at slot `first`) with the piece's store.
 struct Piece<'a> {

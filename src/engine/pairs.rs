@@ -16,6 +16,28 @@ fn pair_mut<T>(v: &mut [T], a: usize, b: usize) -> (&mut T, &mut T) {
     }
 }
 
+/// What stage 3 reads, shared by the tasks of all slabs.
+struct PairStage<'a> {
+    p: &'a Particles,
+    law: &'a ContactLaw,
+    densities: &'a [Density],
+    /// One material: the same coefficients and density in every lane, set up once.
+    uniform: bool,
+    one_pair: Coefficients<Group>,
+    scales: &'a LoadScales,
+    /// The pair list's run starts and partners.
+    start: &'a [u32],
+    partner: &'a [u32],
+}
+
+/// The loads of a slab (from owner `.0`, to owner `.1`) and of the next one (from its first
+/// owner).
+type SlabLoads<'s, 'l> = (
+    (usize, usize),
+    &'s mut [Load],
+    &'s mut Option<(usize, &'l mut [Load])>,
+);
+
 impl Simulation {
     /// Stage 3 (Section 2.2): the force of every touching particle pair, once per pair,
     /// added to the loads of both particles (with the reactions of Eqs. 56-60). Returns the
@@ -30,22 +52,8 @@ impl Simulation {
     /// the lower id, so a pair's force and springs do not depend on the storage order.
     #[inline(never)] // a stage of its own in profiles
     pub(super) fn particle_contacts(&mut self) -> Vec<Deep> {
-        let deep = Mutex::new(Vec::new());
-        let beyond = AtomicBool::new(false);
-        let scales = &self.scales;
-        let p = &self.particles;
+        let found = Found::default();
         let law = &self.law;
-        let densities = &self.densities;
-        // One material: the same coefficients and density in every lane, set up once.
-        let uniform = law.uniform();
-        let one_pair: Coefficients<Group> = law.pair(0, 0).splat();
-        let mass_per_r3 = |idx: &[usize; WIDTH]| {
-            if uniform {
-                Group::splat(densities[0].mass_per_r3)
-            } else {
-                Group::gather(idx.map(|k| densities[p.material[k] as usize].mass_per_r3))
-            }
-        };
         let ContactList {
             start,
             partner,
@@ -54,6 +62,16 @@ impl Simulation {
             stores,
         } = &mut self.neighbours.pairs;
         let (start, partner, slabs) = (&*start, &*partner, &*slabs);
+        let stage = PairStage {
+            p: &self.particles,
+            law,
+            densities: &self.densities,
+            uniform: law.uniform(),
+            one_pair: law.pair(0, 0).splat(),
+            scales: &self.scales,
+            start,
+            partner,
+        };
         thread_local! {
             static TOUCHING: std::cell::RefCell<Vec<[u32; 3]>> = Default::default();
         }
@@ -72,126 +90,11 @@ impl Simulation {
                 })
                 .collect();
             tasks.into_par_iter().for_each(|(slab, next)| {
-                TOUCHING.with_borrow_mut(|touching| {
-                    let Piece {
-                        owners,
-                        first,
-                        loads,
-                        contact,
-                        store,
-                    } = slab;
-                    let mut next_loads = next.map(|n| (n.owners.start, n.loads));
-                    // The touching pairs: the particle of the lower id (body i of the law,
-                    // whatever the storage order), the other, and the contact's entry in the
-                    // slab's store (opened at first touch, closed when the pair parts).
-                    touching.clear();
-                    for i in owners.clone() {
-                        let (xi, ri) = (p.x[i], p.radius[i]);
-                        let run = start[i] as usize - first..start[i + 1] as usize - first;
-                        for kl in run {
-                            let j = partner[first + kl] as usize;
-                            let reach = ri + p.radius[j];
-                            if (xi - p.x[j]).length_squared() < reach * reach {
-                                let (a, b) = if p.id[i] < p.id[j] { (i, j) } else { (j, i) };
-                                if contact[kl] == NONE {
-                                    contact[kl] = store.open();
-                                }
-                                touching.push([a as u32, b as u32, contact[kl]]);
-                            } else if contact[kl] != NONE {
-                                // The contact ended: forget its history.
-                                store.close(contact[kl]);
-                                contact[kl] = NONE;
-                            }
-                        }
-                    }
-                    let (base, owned) = (owners.start, owners.end);
-                    // The load of a particle of this slab or of the next one.
-                    fn load<'l>(
-                        idx: usize,
-                        (base, owned): (usize, usize),
-                        loads: &'l mut [Load],
-                        next: &'l mut Option<(usize, &mut [Load])>,
-                    ) -> &'l mut Load {
-                        if idx < owned {
-                            &mut loads[idx - base]
-                        } else {
-                            let (start, next) =
-                                next.as_mut().expect("partners reach the next slab only");
-                            &mut next[idx - *start]
-                        }
-                    }
-                    for group in touching.chunks(WIDTH) {
-                        // A short last group repeats its last pair in the spare lanes.
-                        let (mut i, mut j, mut c) = ([0; WIDTH], [0; WIDTH], [0; WIDTH]);
-                        for l in 0..WIDTH {
-                            let [a, b, e] = group[l.min(group.len() - 1)];
-                            (i[l], j[l], c[l]) = (a as usize, b as usize, e);
-                        }
-                        let body = |idx: [usize; WIDTH]| Body::<Group> {
-                            x: Group::gather_vec_at(&p.x, &idx),
-                            radius: Group::gather_at(&p.radius, &idx),
-                            v: Group::gather_vec_at(&p.v, &idx),
-                            w: Group::gather_vec_at(&p.w, &idx),
-                        };
-                        let (body_i, body_j) = (body(i), body(j));
-                        let d = body_i.x - body_j.x; // Eq. (8)
-                        let kin = Kinematics::of_touching_particles(
-                            &body_i,
-                            &body_j,
-                            d,
-                            Group::dot(d, d),
-                        );
-                        let mut lanes = gather_springs(store, c);
-                        let other = Other::Particle {
-                            r: body_j.radius,
-                            m: Inertia::mass_with(body_j.radius, mass_per_r3(&j)),
-                        };
-                        let m_i = Inertia::mass_with(body_i.radius, mass_per_r3(&i));
-                        let coef = if uniform {
-                            one_pair
-                        } else {
-                            Coefficients::gather(std::array::from_fn(|l| {
-                                law.pair(p.material[i[l]], p.material[j[l]])
-                            }))
-                        };
-                        let force =
-                            law.evaluate(&coef, body_i.radius, m_i, other, &kin, &mut lanes);
-                        scatter_springs(lanes, store, &c[..group.len()]);
-                        let (f, tau_i, tau_j) = (
-                            Group::scatter_vec(force.f),
-                            Group::scatter_vec(force.tau_i),
-                            Group::scatter_vec(force.tau_j),
-                        );
-                        let (at, lanes, mut fine) = ((base, owned), &scales.lanes, true);
-                        for l in 0..group.len() {
-                            let load_i = load(i[l], at, loads, &mut next_loads);
-                            fine &= load_i.add(pack(f[l], tau_i[l]), lanes);
-                            let load_j = load(j[l], at, loads, &mut next_loads);
-                            fine &= load_j.add(pack(-f[l], tau_j[l]), lanes); // Eqs. (56)-(60)
-                        }
-                        if !fine {
-                            beyond.store(true, Ordering::Relaxed);
-                        }
-                        if kin.delta.simd_gt(body_i.radius.min(body_j.radius)).any() {
-                            let delta = kin.delta.scatter();
-                            for l in 0..group.len() {
-                                let limit = p.radius[i[l]].min(p.radius[j[l]]);
-                                if delta[l] > limit {
-                                    deep.lock().expect("not poisoned").push(Deep {
-                                        i: i[l],
-                                        other: Partner::Particle(j[l]),
-                                        delta: delta[l],
-                                        limit,
-                                    });
-                                }
-                            }
-                        }
-                    }
-                });
+                TOUCHING.with_borrow_mut(|touching| stage.slab(slab, next, touching, &found));
             });
         }
-        let mut deep = deep.into_inner().expect("not poisoned");
-        self.beyond_range |= beyond.into_inner();
+        let (mut deep, beyond) = found.into_inner();
+        self.beyond_range |= beyond;
         self.wrapped_contacts(&mut deep);
         deep
     }
@@ -267,5 +170,164 @@ impl Simulation {
                 }
             }
         }
+    }
+}
+
+impl PairStage<'_> {
+    /// The density quotient of the particles `idx` in lanes.
+    #[inline(always)]
+    fn mass_per_r3(&self, idx: &[usize; WIDTH]) -> Group {
+        if self.uniform {
+            Group::splat(self.densities[0].mass_per_r3)
+        } else {
+            Group::gather(idx.map(|k| self.densities[self.p.material[k] as usize].mass_per_r3))
+        }
+    }
+
+    /// One slab of the pair list: its touching pairs, then the law for `WIDTH` of them at a
+    /// time, added to the loads of the slab's particles and of the `next` slab's.
+    #[inline]
+    fn slab(&self, slab: Piece, next: Option<Piece>, touching: &mut Vec<[u32; 3]>, found: &Found) {
+        let Piece {
+            owners,
+            first,
+            loads,
+            contact,
+            store,
+        } = slab;
+        let mut next_loads = next.map(|n| (n.owners.start, n.loads));
+        self.touching(owners.clone(), first, contact, store, touching);
+        let at = (owners.start, owners.end);
+        for group in touching.chunks(WIDTH) {
+            self.group(group, store, (at, &mut *loads, &mut next_loads), found);
+        }
+    }
+
+    /// The touching pairs of owners `owners` (their slots from `first`): the particle of the
+    /// lower id (body i of the law, whatever the storage order), the other, and the
+    /// contact's entry in the slab's store (opened at first touch, closed when the pair
+    /// parts).
+    #[inline]
+    fn touching(
+        &self,
+        owners: std::ops::Range<usize>,
+        first: usize,
+        contact: &mut [u32],
+        store: &mut Store,
+        touching: &mut Vec<[u32; 3]>,
+    ) {
+        touching.clear();
+        for i in owners {
+            let (xi, ri) = (self.p.x[i], self.p.radius[i]);
+            let run = self.start[i] as usize - first..self.start[i + 1] as usize - first;
+            for kl in run {
+                let j = self.partner[first + kl] as usize;
+                let reach = ri + self.p.radius[j];
+                if (xi - self.p.x[j]).length_squared() < reach * reach {
+                    let (a, b) = if self.p.id[i] < self.p.id[j] {
+                        (i, j)
+                    } else {
+                        (j, i)
+                    };
+                    if contact[kl] == NONE {
+                        contact[kl] = store.open();
+                    }
+                    touching.push([a as u32, b as u32, contact[kl]]);
+                } else if contact[kl] != NONE {
+                    // The contact ended: forget its history.
+                    store.close(contact[kl]);
+                    contact[kl] = NONE;
+                }
+            }
+        }
+    }
+
+    /// The law for one group of touching pairs, added to both particles' loads; deep
+    /// overlaps and loads out of range to `found`.
+    #[inline]
+    fn group(
+        &self,
+        group: &[[u32; 3]],
+        store: &mut Store,
+        (at, loads, next_loads): SlabLoads,
+        found: &Found,
+    ) {
+        // A short last group repeats its last pair in the spare lanes.
+        let (mut i, mut j, mut c) = ([0; WIDTH], [0; WIDTH], [0; WIDTH]);
+        for l in 0..WIDTH {
+            let [a, b, e] = group[l.min(group.len() - 1)];
+            (i[l], j[l], c[l]) = (a as usize, b as usize, e);
+        }
+        let body = |idx: [usize; WIDTH]| Body::<Group> {
+            x: Group::gather_vec_at(&self.p.x, &idx),
+            radius: Group::gather_at(&self.p.radius, &idx),
+            v: Group::gather_vec_at(&self.p.v, &idx),
+            w: Group::gather_vec_at(&self.p.w, &idx),
+        };
+        let (body_i, body_j) = (body(i), body(j));
+        let d = body_i.x - body_j.x; // Eq. (8)
+        let kin = Kinematics::of_touching_particles(&body_i, &body_j, d, Group::dot(d, d));
+        let mut lanes = gather_springs(store, c);
+        let other = Other::Particle {
+            r: body_j.radius,
+            m: Inertia::mass_with(body_j.radius, self.mass_per_r3(&j)),
+        };
+        let m_i = Inertia::mass_with(body_i.radius, self.mass_per_r3(&i));
+        let coef = if self.uniform {
+            self.one_pair
+        } else {
+            Coefficients::gather(std::array::from_fn(|l| {
+                self.law.pair(self.p.material[i[l]], self.p.material[j[l]])
+            }))
+        };
+        let force = self
+            .law
+            .evaluate(&coef, body_i.radius, m_i, other, &kin, &mut lanes);
+        scatter_springs(lanes, store, &c[..group.len()]);
+        let (f, tau_i, tau_j) = (
+            Group::scatter_vec(force.f),
+            Group::scatter_vec(force.tau_i),
+            Group::scatter_vec(force.tau_j),
+        );
+        let (lanes, mut fine) = (&self.scales.lanes, true);
+        for l in 0..group.len() {
+            let load_i = load(i[l], at, loads, next_loads);
+            fine &= load_i.add(pack(f[l], tau_i[l]), lanes);
+            let load_j = load(j[l], at, loads, next_loads);
+            fine &= load_j.add(pack(-f[l], tau_j[l]), lanes); // Eqs. (56)-(60)
+        }
+        if !fine {
+            found.beyond.store(true, Ordering::Relaxed);
+        }
+        if kin.delta.simd_gt(body_i.radius.min(body_j.radius)).any() {
+            let delta = kin.delta.scatter();
+            for l in 0..group.len() {
+                let limit = self.p.radius[i[l]].min(self.p.radius[j[l]]);
+                if delta[l] > limit {
+                    found.deep.lock().expect("not poisoned").push(Deep {
+                        i: i[l],
+                        other: Partner::Particle(j[l]),
+                        delta: delta[l],
+                        limit,
+                    });
+                }
+            }
+        }
+    }
+}
+
+/// The load of a particle of this slab (from owner `base` to `owned`) or of the next one.
+#[inline(always)]
+fn load<'l>(
+    idx: usize,
+    (base, owned): (usize, usize),
+    loads: &'l mut [Load],
+    next: &'l mut Option<(usize, &mut [Load])>,
+) -> &'l mut Load {
+    if idx < owned {
+        &mut loads[idx - base]
+    } else {
+        let (start, next) = next.as_mut().expect("partners reach the next slab only");
+        &mut next[idx - *start]
     }
 }

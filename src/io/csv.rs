@@ -126,82 +126,74 @@ pub fn write_contacts(dir: &Path, name: &str, contacts: &[ContactRecord]) -> Res
     Ok(path)
 }
 
-/// Reads particles from CSV text. The header names the 14 columns (in any order); every
-/// value must be a finite number, every radius positive, every quaternion non-zero (it
-/// is normalised).
-pub fn read_particles(input: impl Read, file: &str) -> Result<Particles> {
-    let mut lines = BufReader::with_capacity(1 << 16, input);
-    let mut header = String::new();
-    if lines
-        .read_line(&mut header)
-        .map_err(|_| anyhow::anyhow!("{file}:1: cannot read line (not UTF-8 text?)"))?
-        == 0
-    {
-        bail!(
-            "{file}: empty file, expected the header line '{}'",
-            COLUMNS.join(",")
-        );
-    }
-    let names: Vec<&str> = header.trim().split(',').map(str::trim).collect();
-    let mut slot = [usize::MAX; 14];
-    // The optional whole-number columns: tag, id, material.
-    let mut int_column = [None; 3];
-    for (col, name) in names.iter().enumerate() {
-        if let Some(k) = INT_COLUMNS.iter().position(|c| c == name) {
-            if int_column[k].is_some() {
+/// The columns of a particle CSV file, from its header.
+struct Header {
+    columns: usize,
+    /// The column of each optional whole-number quantity: tag, id, material.
+    int_column: [Option<usize>; 3],
+    /// The quantity (of the 14) each column holds.
+    quantity_of_column: Vec<usize>,
+}
+
+impl Header {
+    /// The header line `header` of `file`: the 14 columns in any order, and the optional
+    /// ones.
+    fn parse(header: &str, file: &str) -> Result<Header> {
+        let names: Vec<&str> = header.trim().split(',').map(str::trim).collect();
+        let mut slot = [usize::MAX; 14];
+        // The optional whole-number columns: tag, id, material.
+        let mut int_column = [None; 3];
+        for (col, name) in names.iter().enumerate() {
+            if let Some(k) = INT_COLUMNS.iter().position(|c| c == name) {
+                if int_column[k].is_some() {
+                    bail!("{file}:1: column '{name}' appears twice");
+                }
+                int_column[k] = Some(col);
+                continue;
+            }
+            let Some(k) = COLUMNS.iter().position(|c| c == name) else {
+                bail!(
+                    "{file}:1: unknown column '{name}': expected the header '{}' (and optionally {})",
+                    COLUMNS.join(","),
+                    INT_COLUMNS.join(", ")
+                );
+            };
+            if slot[k] != usize::MAX {
                 bail!("{file}:1: column '{name}' appears twice");
             }
-            int_column[k] = Some(col);
-            continue;
+            slot[k] = col;
         }
-        let Some(k) = COLUMNS.iter().position(|c| c == name) else {
+        if let Some(k) = slot.iter().position(|&s| s == usize::MAX) {
             bail!(
-                "{file}:1: unknown column '{name}': expected the header '{}' (and optionally {})",
-                COLUMNS.join(","),
-                INT_COLUMNS.join(", ")
+                "{file}:1: column '{}' is missing: expected the header '{}'",
+                COLUMNS[k],
+                COLUMNS.join(",")
             );
-        };
-        if slot[k] != usize::MAX {
-            bail!("{file}:1: column '{name}' appears twice");
         }
-        slot[k] = col;
-    }
-    if let Some(k) = slot.iter().position(|&s| s == usize::MAX) {
-        bail!(
-            "{file}:1: column '{}' is missing: expected the header '{}'",
-            COLUMNS[k],
-            COLUMNS.join(",")
-        );
+
+        // Column of each of the 14 quantities, and which quantity each column holds.
+        let mut quantity_of_column = vec![usize::MAX; names.len()];
+        for (k, &col) in slot.iter().enumerate() {
+            quantity_of_column[col] = k;
+        }
+        Ok(Header {
+            columns: names.len(),
+            int_column,
+            quantity_of_column,
+        })
     }
 
-    // Column of each of the 14 quantities, and which quantity each column holds.
-    let mut quantity_of_column = vec![usize::MAX; names.len()];
-    for (k, &col) in slot.iter().enumerate() {
-        quantity_of_column[col] = k;
-    }
-    let mut particles = Particles::default();
-    let mut ids = Vec::new();
-    let mut values = [0.0f64; 14];
-    let mut reader = lines;
-    let mut buf = String::new();
-    let mut n = 1;
-    loop {
-        buf.clear();
-        n += 1;
-        match reader.read_line(&mut buf) {
-            Ok(0) => break,
-            Ok(_) => {}
-            Err(_) => bail!("{file}:{n}: cannot read line (not UTF-8 text?)"),
-        }
-        let line = buf.trim();
-        if line.is_empty() {
-            continue;
-        }
+    /// The values of row `line` (line `n` of `file`): the 14 quantities and the whole
+    /// numbers.
+    fn row(&self, line: &str, n: usize, file: &str) -> Result<([f64; 14], [u32; 3])> {
+        let (names, int_column, quantity_of_column) =
+            (self.columns, &self.int_column, &self.quantity_of_column);
+        let mut values = [0.0f64; 14];
         let mut count = 0;
         let mut ints = [0u32; 3];
         for (col, text) in line.split(',').enumerate() {
             count += 1;
-            if col >= names.len() {
+            if col >= names {
                 continue;
             }
             let text = text.trim();
@@ -232,50 +224,96 @@ pub fn read_particles(input: impl Read, file: &str) -> Result<Particles> {
             }
             values[k] = x;
         }
-        if count != names.len() {
-            bail!("{file}:{n}: expected {} values, found {count}", names.len());
+        if count != names {
+            bail!("{file}:{n}: expected {names} values, found {count}");
         }
-        let v = values;
-        if v[3] <= 0.0 {
-            bail!("{file}:{n}: radius R = {} must be > 0", v[3]);
+        Ok((values, ints))
+    }
+}
+
+/// The particle of a row's values `v` and whole numbers `ints` (line `n` of `file`).
+fn particle(v: [f64; 14], ints: [u32; 3], n: usize, file: &str) -> Result<Particle> {
+    if v[3] <= 0.0 {
+        bail!("{file}:{n}: radius R = {} must be > 0", v[3]);
+    }
+    let q = DQuat::from_xyzw(v[8], v[9], v[10], v[7]);
+    let norm = q.length();
+    if norm == 0.0 {
+        bail!("{file}:{n}: the quaternion (q0, q1, q2, q3) is zero; use 1,0,0,0 for no rotation");
+    }
+    Ok(Particle {
+        x: DVec3::new(v[0], v[1], v[2]),
+        radius: v[3],
+        v: DVec3::new(v[4], v[5], v[6]),
+        q: if (norm - 1.0).abs() < 1e-12 {
+            q
+        } else {
+            q / norm
+        },
+        w: DVec3::new(v[11], v[12], v[13]),
+        tag: ints[0],
+        material: u16::try_from(ints[2])
+            .map_err(|_| anyhow::anyhow!("{file}:{n}: material {} is out of range", ints[2]))?,
+    })
+}
+
+/// The ids of a file's particles, which they keep (a frame of a run that removed some).
+fn keep_ids(particles: &mut Particles, ids: Vec<u32>, file: &str) -> Result<()> {
+    let mut sorted = ids.clone();
+    sorted.sort_unstable();
+    if let Some(w) = sorted.windows(2).find(|w| w[0] == w[1]) {
+        bail!("{file}: particle id {} appears twice", w[0]);
+    }
+    if sorted.last().is_some_and(|&m| m >= u32::MAX / 2) {
+        bail!("{file}: particle ids must be below {}", u32::MAX / 2);
+    }
+    particles.next_id = sorted.last().map_or(0, |&m| m + 1);
+    particles.id = ids;
+    Ok(())
+}
+
+/// Reads particles from CSV text. The header names the 14 columns (in any order); every
+/// value must be a finite number, every radius positive, every quaternion non-zero (it
+/// is normalised).
+pub fn read_particles(input: impl Read, file: &str) -> Result<Particles> {
+    let mut lines = BufReader::with_capacity(1 << 16, input);
+    let mut header = String::new();
+    if lines
+        .read_line(&mut header)
+        .map_err(|_| anyhow::anyhow!("{file}:1: cannot read line (not UTF-8 text?)"))?
+        == 0
+    {
+        bail!(
+            "{file}: empty file, expected the header line '{}'",
+            COLUMNS.join(",")
+        );
+    }
+    let columns = Header::parse(&header, file)?;
+    let mut particles = Particles::default();
+    let mut ids = Vec::new();
+    let mut reader = lines;
+    let mut buf = String::new();
+    let mut n = 1;
+    loop {
+        buf.clear();
+        n += 1;
+        match reader.read_line(&mut buf) {
+            Ok(0) => break,
+            Ok(_) => {}
+            Err(_) => bail!("{file}:{n}: cannot read line (not UTF-8 text?)"),
         }
-        let q = DQuat::from_xyzw(v[8], v[9], v[10], v[7]);
-        let norm = q.length();
-        if norm == 0.0 {
-            bail!(
-                "{file}:{n}: the quaternion (q0, q1, q2, q3) is zero; use 1,0,0,0 for no rotation"
-            );
+        let line = buf.trim();
+        if line.is_empty() {
+            continue;
         }
-        particles.push(Particle {
-            x: DVec3::new(v[0], v[1], v[2]),
-            radius: v[3],
-            v: DVec3::new(v[4], v[5], v[6]),
-            q: if (norm - 1.0).abs() < 1e-12 {
-                q
-            } else {
-                q / norm
-            },
-            w: DVec3::new(v[11], v[12], v[13]),
-            tag: ints[0],
-            material: u16::try_from(ints[2])
-                .map_err(|_| anyhow::anyhow!("{file}:{n}: material {} is out of range", ints[2]))?,
-        });
-        if int_column[1].is_some() {
+        let (values, ints) = columns.row(line, n, file)?;
+        particles.push(particle(values, ints, n, file)?);
+        if columns.int_column[1].is_some() {
             ids.push(ints[1]);
         }
     }
-    if int_column[1].is_some() {
-        // The particles keep the ids of the file (a frame of a run that removed some).
-        let mut sorted = ids.clone();
-        sorted.sort_unstable();
-        if let Some(w) = sorted.windows(2).find(|w| w[0] == w[1]) {
-            bail!("{file}: particle id {} appears twice", w[0]);
-        }
-        if sorted.last().is_some_and(|&m| m >= u32::MAX / 2) {
-            bail!("{file}: particle ids must be below {}", u32::MAX / 2);
-        }
-        particles.next_id = sorted.last().map_or(0, |&m| m + 1);
-        particles.id = ids;
+    if columns.int_column[1].is_some() {
+        keep_ids(&mut particles, ids, file)?;
     }
     Ok(particles)
 }

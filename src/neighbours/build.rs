@@ -189,166 +189,217 @@ impl Neighbours {
                 .all(|w| key(cell_of(w[0], inv_h)) <= key(cell_of(w[1], inv_h)))
         };
         let (start, partner) = if in_cell_order {
-            // Storage in cell order: per cell, each particle's partners are the later ones
-            // of its cell and those of the 13 cells after it in key order, whose indices
-            // all come after its own; so each run comes out sorted.
-            let cells = grid.occupied();
-            let runs: Vec<Vec<u32>> = cells
-                .par_iter()
-                .with_min_len(MIN_PARALLEL_LEN / 4)
-                .fold(Vec::new, |mut out: Vec<u32>, &(c, a, b)| {
-                    let forward = FORWARD.map(|d| grid.range(c + d));
-                    for i in a..b {
-                        let at = out.len();
-                        out.push(0); // the run's length, filled below
-                        for j in (i + 1..b).chain(forward.iter().flat_map(|r| r.clone())) {
-                            if close(i, j) {
-                                out.push(j);
-                            }
-                        }
-                        out[at] = (out.len() - at - 1) as u32;
-                    }
-                    out
-                })
-                .collect();
-            runs_to_csr(n, runs)
+            pairs_forward(&grid, n, &close)
         } else if layout.uniform {
-            // Any storage order (a restored checkpoint may hold a re-anchored particle out
-            // of its cell): per owner, its partners of higher index from the 27 cells
-            // around its cell, sorted.
-            let runs: Vec<Vec<u32>> = (0..n as u32)
-                .into_par_iter()
-                .with_min_len(4 * MIN_PARALLEL_LEN)
-                .fold(Vec::new, |mut out: Vec<u32>, i| {
-                    let at = out.len();
-                    out.push(0); // the run's length, filled below
-                    grid.for_each_near(x[i as usize], |j| {
-                        if j > i && close(i, j) {
-                            out.push(j);
-                        }
-                    });
-                    out[at + 1..].sort_unstable();
-                    out[at] = (out.len() - at - 1) as u32;
-                    out
-                })
-                .collect();
-            runs_to_csr(n, runs)
+            pairs_around(&grid, x, &close)
         } else {
-            let finds = |i: u32, j: u32| {
-                let (ri, rj) = (radius[i as usize], radius[j as usize]);
-                rj < ri || (rj == ri && j > i)
-            };
-            let cells_needed = |i: u32| {
-                ((2.0 * radius[i as usize] + skin) / layout.h)
-                    .ceil()
-                    .max(1.0) as i32
-            };
-            let mut pairs: Vec<u64> = (0..n as u32)
-                .into_par_iter()
-                .with_min_len(4 * MIN_PARALLEL_LEN)
-                .fold(Vec::new, |mut out: Vec<u64>, i| {
-                    let c = cell_of(x[i as usize], 1.0 / layout.h);
-                    let m = cells_needed(i);
-                    for dz in -m..=m {
-                        for dy in -m..=m {
-                            for dx in -m..=m {
-                                for &j in grid.in_cell(c + IVec3::new(dx, dy, dz)) {
-                                    if finds(i, j) && close(i, j) {
-                                        out.push(((i.min(j) as u64) << 32) | i.max(j) as u64);
-                                    }
-                                }
-                            }
-                        }
-                    }
-                    out
-                })
-                .flatten()
-                .collect();
-            pairs.par_sort_unstable();
-            compress(n, pairs.iter().map(|&k| ((k >> 32) as u32, k as u32)))
+            pairs_by_larger(&grid, x, radius, (skin, layout), &close)
         };
         let slabs = slabs_of(&start, &partner);
         self.pairs = ContactList::with_springs(start, partner, slabs, &history.pairs);
         if let Some(periodic) = self.periodic {
-            // Pairs across periodic sides: each image x_j + s of a particle near a side
-            // against the particles i < j near it; one shift per pair, since a period is
-            // longer than twice any reach (checked by the scenario).
-            let max_radius = radius.iter().copied().fold(0.0, f64::max);
-            let reach_max = 2.0 * max_radius + skin;
-            let m = (reach_max / layout.h).ceil().max(1.0) as i32;
-            type Found = (u32, u32, DVec3, i8);
-            let mut found: Vec<Found> = (0..n as u32)
-                .into_par_iter()
-                .with_min_len(4 * MIN_PARALLEL_LEN)
-                .fold(
-                    || (Vec::new(), Vec::new()),
-                    |(mut out, mut shifts): (Vec<Found>, Vec<(DVec3, i8)>), j| {
-                        periodic.image_shifts(x[j as usize], reach_max, &mut shifts);
-                        for &(s, crossing) in &shifts {
-                            let image = x[j as usize] + s;
-                            let c = cell_of(image, 1.0 / layout.h);
-                            for dz in -m..=m {
-                                for dy in -m..=m {
-                                    for dx in -m..=m {
-                                        for &i in grid.in_cell(c + IVec3::new(dx, dy, dz)) {
-                                            let reach =
-                                                radius[i as usize] + radius[j as usize] + skin;
-                                            if i < j
-                                                && (x[i as usize] - image).length_squared()
-                                                    < reach * reach
-                                            {
-                                                out.push((i, j, s, crossing));
-                                            }
+            self.build_wrapped(periodic, x, particles, (&grid, layout), history);
+        }
+        drop(grid);
+        let (start, partner) = face_pairs(x, radius, skin, faces, face_grid);
+        let pieces = pieces_of(&start, FACE_PIECE);
+        self.faces = ContactList::with_springs(start, partner, pieces, &history.faces);
+    }
+
+    /// The pairs across periodic sides: each image x_j + s of a particle near a side
+    /// against the particles i < j near it; one shift per pair, since a period is longer
+    /// than twice any reach (checked by the scenario).
+    fn build_wrapped(
+        &mut self,
+        periodic: Periodic,
+        x: &[DVec3],
+        particles: &Particles,
+        (grid, layout): (&CellGrid, Layout),
+        history: &Histories,
+    ) {
+        let (radius, n, skin) = (&particles.radius, x.len(), self.skin);
+        let max_radius = radius.iter().copied().fold(0.0, f64::max);
+        let reach_max = 2.0 * max_radius + skin;
+        let m = (reach_max / layout.h).ceil().max(1.0) as i32;
+        type Found = (u32, u32, DVec3, i8);
+        let mut found: Vec<Found> = (0..n as u32)
+            .into_par_iter()
+            .with_min_len(4 * MIN_PARALLEL_LEN)
+            .fold(
+                || (Vec::new(), Vec::new()),
+                |(mut out, mut shifts): (Vec<Found>, Vec<(DVec3, i8)>), j| {
+                    periodic.image_shifts(x[j as usize], reach_max, &mut shifts);
+                    for &(s, crossing) in &shifts {
+                        let image = x[j as usize] + s;
+                        let c = cell_of(image, 1.0 / layout.h);
+                        for dz in -m..=m {
+                            for dy in -m..=m {
+                                for dx in -m..=m {
+                                    for &i in grid.in_cell(c + IVec3::new(dx, dy, dz)) {
+                                        let reach = radius[i as usize] + radius[j as usize] + skin;
+                                        if i < j
+                                            && (x[i as usize] - image).length_squared()
+                                                < reach * reach
+                                        {
+                                            out.push((i, j, s, crossing));
                                         }
                                     }
                                 }
                             }
                         }
-                        (out, shifts)
-                    },
-                )
-                .map(|(out, _)| out)
-                .flatten()
-                .collect();
-            found.sort_unstable_by_key(|&(i, j, _, _)| (i, j));
-            // Each pair as the law sees it: the particle of the higher id at its image
-            // nearest the other.
-            let ids = &particles.id;
-            for f in &mut found {
-                let (lo, hi) = if ids[f.0 as usize] < ids[f.1 as usize] {
-                    (f.0, f.1)
-                } else {
-                    (f.1, f.0)
-                };
-                (f.2, f.3) = periodic.image_towards(x[hi as usize], x[lo as usize]);
-            }
-            let (start, partner) = compress(n, found.iter().map(|&(i, j, _, _)| (i, j)));
-            self.shift = found.iter().map(|f| f.2).collect();
-            self.crossings = found.iter().map(|f| f.3).collect();
-            self.offset_at_build = periodic.shear.map_or(0.0, |sh| sh.offset);
-            let pieces = pieces_of(&start, FACE_PIECE);
-            self.wrapped = ContactList::with_springs(start, partner, pieces, &history.pairs);
-        }
-        drop(grid);
-
-        // The items of a grid cell come in ascending order, so each particle's run of faces
-        // is sorted.
-        let face_pairs: Vec<(u32, u32)> = (0..n)
-            .into_par_iter()
-            .with_min_len(MIN_PARALLEL_LEN / 8)
-            .flat_map_iter(|i| {
-                let (xi, ri) = (x[i], radius[i]);
-                face_grid.at(xi).iter().copied().filter_map(move |f| {
-                    let face = &faces[f as usize];
-                    let reach = ri + face.radius + skin;
-                    let near = face.separation(xi).length_squared() < reach * reach;
-                    near.then_some((i as u32, f))
-                })
-            })
+                    }
+                    (out, shifts)
+                },
+            )
+            .map(|(out, _)| out)
+            .flatten()
             .collect();
-        let (start, partner) = compress(n, face_pairs.iter().copied());
-        drop(face_pairs);
+        found.sort_unstable_by_key(|&(i, j, _, _)| (i, j));
+        // Each pair as the law sees it: the particle of the higher id at its image
+        // nearest the other.
+        let ids = &particles.id;
+        for f in &mut found {
+            let (lo, hi) = if ids[f.0 as usize] < ids[f.1 as usize] {
+                (f.0, f.1)
+            } else {
+                (f.1, f.0)
+            };
+            (f.2, f.3) = periodic.image_towards(x[hi as usize], x[lo as usize]);
+        }
+        let (start, partner) = compress(n, found.iter().map(|&(i, j, _, _)| (i, j)));
+        self.shift = found.iter().map(|f| f.2).collect();
+        self.crossings = found.iter().map(|f| f.3).collect();
+        self.offset_at_build = periodic.shear.map_or(0.0, |sh| sh.offset);
         let pieces = pieces_of(&start, FACE_PIECE);
-        self.faces = ContactList::with_springs(start, partner, pieces, &history.faces);
+        self.wrapped = ContactList::with_springs(start, partner, pieces, &history.pairs);
     }
+}
+
+/// The pair list of particles stored in cell order: per cell, each particle's partners are
+/// the later ones of its cell and those of the 13 cells after it in key order, whose
+/// indices all come after its own; so each run comes out sorted.
+fn pairs_forward(
+    grid: &CellGrid,
+    n: usize,
+    close: &(impl Fn(u32, u32) -> bool + Sync),
+) -> (Vec<u32>, Vec<u32>) {
+    let cells = grid.occupied();
+    let runs: Vec<Vec<u32>> = cells
+        .par_iter()
+        .with_min_len(MIN_PARALLEL_LEN / 4)
+        .fold(Vec::new, |mut out: Vec<u32>, &(c, a, b)| {
+            let forward = FORWARD.map(|d| grid.range(c + d));
+            for i in a..b {
+                let at = out.len();
+                out.push(0); // the run's length, filled below
+                for j in (i + 1..b).chain(forward.iter().flat_map(|r| r.clone())) {
+                    if close(i, j) {
+                        out.push(j);
+                    }
+                }
+                out[at] = (out.len() - at - 1) as u32;
+            }
+            out
+        })
+        .collect();
+    runs_to_csr(n, runs)
+}
+
+/// The pair list of particles in any storage order (a restored checkpoint may hold a
+/// re-anchored particle out of its cell): per owner, its partners of higher index from the
+/// 27 cells around its cell, sorted.
+fn pairs_around(
+    grid: &CellGrid,
+    x: &[DVec3],
+    close: &(impl Fn(u32, u32) -> bool + Sync),
+) -> (Vec<u32>, Vec<u32>) {
+    let n = x.len();
+    let runs: Vec<Vec<u32>> = (0..n as u32)
+        .into_par_iter()
+        .with_min_len(4 * MIN_PARALLEL_LEN)
+        .fold(Vec::new, |mut out: Vec<u32>, i| {
+            let at = out.len();
+            out.push(0); // the run's length, filled below
+            grid.for_each_near(x[i as usize], |j| {
+                if j > i && close(i, j) {
+                    out.push(j);
+                }
+            });
+            out[at + 1..].sort_unstable();
+            out[at] = (out.len() - at - 1) as u32;
+            out
+        })
+        .collect();
+    runs_to_csr(n, runs)
+}
+
+/// The pair list with cells smaller than the largest reach: each pair found by its larger
+/// particle (ties: the lower index), which searches as many cells as its own reach needs,
+/// and the pairs sorted afterwards.
+fn pairs_by_larger(
+    grid: &CellGrid,
+    x: &[DVec3],
+    radius: &[f64],
+    (skin, layout): (f64, Layout),
+    close: &(impl Fn(u32, u32) -> bool + Sync),
+) -> (Vec<u32>, Vec<u32>) {
+    let n = x.len();
+    let finds = |i: u32, j: u32| {
+        let (ri, rj) = (radius[i as usize], radius[j as usize]);
+        rj < ri || (rj == ri && j > i)
+    };
+    let cells_needed = |i: u32| {
+        ((2.0 * radius[i as usize] + skin) / layout.h)
+            .ceil()
+            .max(1.0) as i32
+    };
+    let mut pairs: Vec<u64> = (0..n as u32)
+        .into_par_iter()
+        .with_min_len(4 * MIN_PARALLEL_LEN)
+        .fold(Vec::new, |mut out: Vec<u64>, i| {
+            let c = cell_of(x[i as usize], 1.0 / layout.h);
+            let m = cells_needed(i);
+            for dz in -m..=m {
+                for dy in -m..=m {
+                    for dx in -m..=m {
+                        for &j in grid.in_cell(c + IVec3::new(dx, dy, dz)) {
+                            if finds(i, j) && close(i, j) {
+                                out.push(((i.min(j) as u64) << 32) | i.max(j) as u64);
+                            }
+                        }
+                    }
+                }
+            }
+            out
+        })
+        .flatten()
+        .collect();
+    pairs.par_sort_unstable();
+    compress(n, pairs.iter().map(|&k| ((k >> 32) as u32, k as u32)))
+}
+
+/// The particle-face list: each particle's faces within reach, from the face grid. The
+/// items of a grid cell come in ascending order, so each particle's run of faces is sorted.
+fn face_pairs(
+    x: &[DVec3],
+    radius: &[f64],
+    skin: f64,
+    faces: &[Face],
+    face_grid: &CellGrid,
+) -> (Vec<u32>, Vec<u32>) {
+    let n = x.len();
+    let face_pairs: Vec<(u32, u32)> = (0..n)
+        .into_par_iter()
+        .with_min_len(MIN_PARALLEL_LEN / 8)
+        .flat_map_iter(|i| {
+            let (xi, ri) = (x[i], radius[i]);
+            face_grid.at(xi).iter().copied().filter_map(move |f| {
+                let face = &faces[f as usize];
+                let reach = ri + face.radius + skin;
+                let near = face.separation(xi).length_squared() < reach * reach;
+                near.then_some((i as u32, f))
+            })
+        })
+        .collect();
+    compress(n, face_pairs.iter().copied())
 }
