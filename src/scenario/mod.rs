@@ -37,6 +37,7 @@ use crate::model::motion::Motion;
 
 mod raw;
 mod resolved;
+mod spawn;
 mod validate;
 pub use resolved::changes;
 

@@ -7,11 +7,12 @@ use anyhow::{Context, Result, bail};
 use glam::DVec3;
 
 use super::raw::*;
+use super::spawn::spawn;
 use super::*;
 
 /// A range check of Table 2's "Requirements" column.
 #[derive(Clone, Copy)]
-enum Range {
+pub(super) enum Range {
     Positive,
     NonNegative,
     /// Any finite value.
@@ -45,7 +46,7 @@ impl Range {
     }
 }
 
-fn check(key: &str, x: f64, range: Range) -> Result<f64> {
+pub(super) fn check(key: &str, x: f64, range: Range) -> Result<f64> {
     if !range.contains(x) {
         bail!(
             "{key} = {x} is not allowed: it must be {}",
@@ -55,7 +56,7 @@ fn check(key: &str, x: f64, range: Range) -> Result<f64> {
     Ok(x)
 }
 
-fn check_vec(key: &str, v: [f64; 3]) -> Result<DVec3> {
+pub(super) fn check_vec(key: &str, v: [f64; 3]) -> Result<DVec3> {
     for (c, x) in ["x", "y", "z"].iter().zip(v) {
         check(&format!("{key}.{c}"), x, Range::Finite)?;
     }
@@ -64,7 +65,7 @@ fn check_vec(key: &str, v: [f64; 3]) -> Result<DVec3> {
 
 /// A box from `min` and `max` under `key`: `max >= min` in every component, or `max > min`
 /// if `strict` (a box of space that must hold particles).
-fn region(key: &str, b: RawBox, strict: bool) -> Result<Region> {
+pub(super) fn region(key: &str, b: RawBox, strict: bool) -> Result<Region> {
     let (min, max) = (
         check_vec(&format!("{key} min"), b.min)?,
         check_vec(&format!("{key} max"), b.max)?,
@@ -76,153 +77,6 @@ fn region(key: &str, b: RawBox, strict: bool) -> Result<Region> {
         bail!("{key} max = {max} must be >= min = {min} in every component");
     }
     Ok(Region { min, max })
-}
-
-/// Validates one `[[spawn]]` region: `index` finds a material by name, `velocity` is the
-/// default initial velocity, radii must lie in [R_min, R_max] (`radii`).
-fn spawn_region(
-    key: &str,
-    r: RawSpawn,
-    index: &dyn Fn(&str, &str) -> Result<u16>,
-    velocity: DVec3,
-    radii: (f64, f64),
-) -> Result<SpawnRegion> {
-    let k = |name: &str| format!("{key} {name}");
-    let region = region(
-        key,
-        RawBox {
-            min: r.min,
-            max: r.max,
-        },
-        false,
-    )?;
-    let material = match &r.material {
-        Some(name) => index(&k("material"), name)?,
-        None => 0,
-    };
-    let velocity = match r.velocity {
-        Some(v) => check_vec(&k("velocity"), v)?,
-        None => velocity,
-    };
-    let rate = r
-        .rate
-        .map(|x| check(&k("rate"), x, Range::Positive))
-        .transpose()?;
-    if r.count.is_none() && rate.is_none() {
-        bail!("{key} needs a count (particles in all) or a rate (particles per second), or both");
-    }
-    let start = check(&k("start"), r.start.unwrap_or(0.0), Range::NonNegative)?;
-    let stop = match r.stop {
-        Some(t) => check(&k("stop"), t, Range::NonNegative)?,
-        None => f64::INFINITY,
-    };
-    if stop <= start {
-        bail!("{} = {stop} must be after start = {start}", k("stop"));
-    }
-    let (lo, hi) = radii;
-    let within = |name: &str, x: f64| -> Result<f64> {
-        let x = check(&k(&format!("radius.{name}")), x, Range::Positive)?;
-        if x < lo || x > hi {
-            bail!(
-                "{} = {x} must lie within [geometry] radius_min = {lo} and radius_max = {hi}",
-                k(&format!("radius.{name}"))
-            );
-        }
-        Ok(x)
-    };
-    let bounds = |min: Option<f64>, max: Option<f64>| -> Result<(f64, f64)> {
-        let (min, max) = (
-            within("min", min.unwrap_or(lo))?,
-            within("max", max.unwrap_or(hi))?,
-        );
-        if max < min {
-            bail!("{} = {max} must be >= min = {min}", k("radius.max"));
-        }
-        Ok((min, max))
-    };
-    let spread = |mean: f64, std: f64, min: f64, max: f64| -> Result<(f64, f64)> {
-        let mean = check(&k("radius.mean"), mean, Range::Positive)?;
-        let std = check(&k("radius.std"), std, Range::NonNegative)?;
-        if std == 0.0 && (mean < min || mean > max) {
-            bail!(
-                "{} = {mean} must lie within [{min}, {max}]",
-                k("radius.mean")
-            );
-        }
-        Ok((mean, std))
-    };
-    let radius = match r.radius {
-        None => RadiusDistribution::Uniform { min: lo, max: hi },
-        Some(RawRadius::Uniform { min, max }) => {
-            let (min, max) = bounds(min, max)?;
-            RadiusDistribution::Uniform { min, max }
-        }
-        Some(RawRadius::Normal {
-            mean,
-            std,
-            min,
-            max,
-        }) => {
-            let (min, max) = bounds(min, max)?;
-            let (mean, std) = spread(mean, std, min, max)?;
-            RadiusDistribution::Normal {
-                mean,
-                std,
-                min,
-                max,
-            }
-        }
-        Some(RawRadius::Lognormal {
-            mean,
-            std,
-            min,
-            max,
-        }) => {
-            let (min, max) = bounds(min, max)?;
-            let (mean, std) = spread(mean, std, min, max)?;
-            RadiusDistribution::LogNormal {
-                mean,
-                std,
-                min,
-                max,
-            }
-        }
-        Some(RawRadius::Table { radii, weights }) => {
-            if radii.is_empty() {
-                bail!("{} must hold at least one radius", k("radius.radii"));
-            }
-            for (i, &x) in radii.iter().enumerate() {
-                within(&format!("radii[{i}]"), x)?;
-            }
-            let weights = weights.unwrap_or_else(|| vec![1.0; radii.len()]);
-            if weights.len() != radii.len() {
-                bail!(
-                    "{} has {} entries, radii {}: one weight per radius",
-                    k("radius.weights"),
-                    weights.len(),
-                    radii.len()
-                );
-            }
-            for (i, &w) in weights.iter().enumerate() {
-                check(&k(&format!("radius.weights[{i}]")), w, Range::NonNegative)?;
-            }
-            let total: f64 = weights.iter().sum();
-            if total <= 0.0 {
-                bail!("{} must not all be zero", k("radius.weights"));
-            }
-            RadiusDistribution::Table { radii, weights }
-        }
-    };
-    Ok(SpawnRegion {
-        region,
-        material,
-        velocity,
-        count: r.count,
-        rate,
-        start,
-        stop,
-        radius,
-    })
 }
 
 /// Validates the properties of one material (`key` names it in messages).
@@ -740,59 +594,4 @@ fn domain(
         }
     }
     Ok(domain)
-}
-
-/// `[[spawn]]`, each inside the domain, or the `[geometry]` spawn box inside it when
-/// there are none.
-fn spawn(
-    raw: Vec<RawSpawn>,
-    index: &dyn Fn(&str, &str) -> Result<u16>,
-    kinetics: &Kinetics,
-    geometry: &Geometry,
-    simulation: &Simulation,
-    domain: Option<Region>,
-) -> Result<Vec<SpawnRegion>> {
-    let (radius_min, radius_max) = (geometry.radius_min, geometry.radius_max);
-    let (spawn_min, spawn_max) = (geometry.spawn_min, geometry.spawn_max);
-    let spawn = raw
-        .into_iter()
-        .enumerate()
-        .map(|(k, r)| {
-            spawn_region(
-                &format!("[[spawn]] #{}", k + 1),
-                r,
-                &index,
-                kinetics.initial_velocity,
-                (radius_min, radius_max),
-            )
-        })
-        .collect::<Result<Vec<_>>>()?;
-    for (k, r) in spawn.iter().enumerate() {
-        if let Some(d) = domain
-            && !(d.contains(r.region.min) && d.contains(r.region.max))
-        {
-            bail!(
-                "[[spawn]] #{} box {} .. {} must lie inside [domain] {} .. {}",
-                k + 1,
-                r.region.min,
-                r.region.max,
-                d.min,
-                d.max
-            );
-        }
-    }
-    if let Some(d) = domain
-        && spawn.is_empty()
-        && simulation.max_particles > 0
-        && simulation.spawn_attempts > 0
-        && !(d.contains(spawn_min) && d.contains(spawn_max))
-    {
-        bail!(
-            "[geometry] spawn box {spawn_min} .. {spawn_max} must lie inside [domain] {} .. {} \
-             (particles spawned outside it would be removed at once)",
-            d.min,
-            d.max
-        );
-    }
-    Ok(spawn)
 }

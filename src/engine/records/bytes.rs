@@ -248,6 +248,52 @@ fn check_states(ids: &[u32], p: &Particles) -> Result<()> {
 /// Decodes a checkpoint, checking magic, version, checksum and, if given, the fingerprint
 /// (a resume needs the scenario it was written with; a staged run does not).
 pub fn decode(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<Snapshot> {
+    let (version, mut r) = checked_body(bytes, expected_fingerprint)?;
+    let steps = r.u64()?;
+    let built_at = r.u64()?;
+    if built_at > steps {
+        bail!("corrupt checkpoint: last rebuild at step {built_at}, after step {steps}");
+    }
+    let word_pos = r.u128()?;
+    let has_pending = r.u8()? != 0;
+    let pending = r.f64()?;
+    let next_id = r.u32()?;
+    let v3 = version >= 3;
+    let (particles, anchors) = r.particles(v3, next_id)?;
+    let lonely = r.lonely(particles.len())?;
+    let pair_history = r.history()?;
+    let face_history = r.history()?;
+    let rest = if v3 { r.rest()? } else { Rest::default() };
+    if r.at != r.bytes.len() {
+        bail!(
+            "corrupt checkpoint: {} unexpected bytes at the end",
+            r.bytes.len() - r.at
+        );
+    }
+    Ok(Snapshot {
+        steps,
+        built_at,
+        particles,
+        spawner: SpawnerState {
+            word_pos,
+            pending_radius: has_pending.then_some(pending),
+            regions: rest.regions,
+        },
+        anchors,
+        lonely,
+        pair_history,
+        face_history,
+        removed: rest.removed,
+        wall_sums: rest.wall_sums,
+        scenario: rest.scenario,
+        mesh_files: rest.mesh_files,
+    })
+}
+
+/// The format version of a checkpoint and a reader of its body after the fingerprint,
+/// once its magic, version, checksum and fingerprint (if `expected_fingerprint`) are
+/// checked.
+fn checked_body(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<(u32, Reader<'_>)> {
     if bytes.len() < MAGIC.len() + 4 || &bytes[..MAGIC.len()] != MAGIC {
         bail!("not a tinydem checkpoint (no 'TINYDEM CKPT' header)");
     }
@@ -272,77 +318,89 @@ pub fn decode(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<Snapsho
              spawning, geometry): resume it with the scenario it was written with"
         );
     }
-    let steps = r.u64()?;
-    let built_at = r.u64()?;
-    if built_at > steps {
-        bail!("corrupt checkpoint: last rebuild at step {built_at}, after step {steps}");
+    Ok((version, r))
+}
+
+/// What format 3 added after the histories.
+#[derive(Default)]
+struct Rest {
+    removed: Removed,
+    wall_sums: Vec<Wrench>,
+    scenario: String,
+    mesh_files: Vec<(u64, u64)>,
+    regions: Vec<RegionState>,
+}
+
+impl Reader<'_> {
+    /// The particles (material indices from format 3 on), checked, with their ids below
+    /// `next_id`; and their anchors, if the lists were built.
+    fn particles(&mut self, v3: bool, next_id: u32) -> Result<(Particles, Vec<DVec3>)> {
+        let r = self;
+        let n = r.count(4 + 14 * 8 + 4 + if v3 { 2 } else { 0 })?;
+        let mut particles = Particles::default();
+        let mut ids = Vec::with_capacity(n);
+        for _ in 0..n {
+            ids.push(r.u32()?);
+            let x = r.vec3()?;
+            let radius = r.f64()?;
+            let v = r.vec3()?;
+            let (w0, q1, q2, q3) = (r.f64()?, r.f64()?, r.f64()?, r.f64()?);
+            let w = r.vec3()?;
+            let tag = r.u32()?;
+            let material = if v3 { r.u16()? } else { 0 };
+            particles.push(Particle {
+                x,
+                radius,
+                v,
+                q: DQuat::from_xyzw(q1, q2, q3, w0),
+                w,
+                tag,
+                material,
+            });
+        }
+        let anchors = match r.u8()? {
+            0 => Vec::new(),
+            _ => (0..n).map(|_| r.vec3()).collect::<Result<_>>()?,
+        };
+        check_states(&ids, &particles)?;
+        let mut sorted = ids.clone();
+        sorted.sort_unstable();
+        if sorted.windows(2).any(|w| w[0] == w[1]) || sorted.last().is_some_and(|&m| m >= next_id) {
+            bail!("corrupt checkpoint: particle ids repeat or reach the next id {next_id}");
+        }
+        (particles.id, particles.next_id) = (ids, next_id);
+        Ok((particles, anchors))
     }
-    let word_pos = r.u128()?;
-    let has_pending = r.u8()? != 0;
-    let pending = r.f64()?;
-    let next_id = r.u32()?;
-    let v3 = version >= 3;
-    let n = r.count(4 + 14 * 8 + 4 + if v3 { 2 } else { 0 })?;
-    let mut particles = Particles::default();
-    let mut ids = Vec::with_capacity(n);
-    for _ in 0..n {
-        ids.push(r.u32()?);
-        let x = r.vec3()?;
-        let radius = r.f64()?;
-        let v = r.vec3()?;
-        let (w0, q1, q2, q3) = (r.f64()?, r.f64()?, r.f64()?, r.f64()?);
-        let w = r.vec3()?;
-        let tag = r.u32()?;
-        let material = if v3 { r.u16()? } else { 0 };
-        particles.push(Particle {
-            x,
-            radius,
-            v,
-            q: DQuat::from_xyzw(q1, q2, q3, w0),
-            w,
-            tag,
-            material,
-        });
+
+    /// The lonely particles of the last rebuild (storage indices below `n`, ascending) with
+    /// their allowances.
+    fn lonely(&mut self, n: usize) -> Result<Vec<(u32, f64)>> {
+        let r = self;
+        let lonely_count = r.count(4 + 8)?;
+        let lonely = (0..lonely_count)
+            .map(|_| Ok((r.u32()?, r.f64()?)))
+            .collect::<Result<Vec<(u32, f64)>>>()?;
+        if lonely.iter().any(|&(i, _)| i as usize >= n) || !lonely.is_sorted_by_key(|l| l.0) {
+            bail!("corrupt checkpoint: lonely particles out of order or range");
+        }
+        Ok(lonely)
     }
-    let anchors = match r.u8()? {
-        0 => Vec::new(),
-        _ => (0..n).map(|_| r.vec3()).collect::<Result<_>>()?,
-    };
-    check_states(&ids, &particles)?;
-    let mut sorted = ids.clone();
-    sorted.sort_unstable();
-    if sorted.windows(2).any(|w| w[0] == w[1]) || sorted.last().is_some_and(|&m| m >= next_id) {
-        bail!("corrupt checkpoint: particle ids repeat or reach the next id {next_id}");
-    }
-    (particles.id, particles.next_id) = (ids, next_id);
-    let lonely_count = r.count(4 + 8)?;
-    let lonely = (0..lonely_count)
-        .map(|_| Ok((r.u32()?, r.f64()?)))
-        .collect::<Result<Vec<(u32, f64)>>>()?;
-    if lonely.iter().any(|&(i, _)| i as usize >= n) || !lonely.is_sorted_by_key(|l| l.0) {
-        bail!("corrupt checkpoint: lonely particles out of order or range");
-    }
-    let pair_history = r.history()?;
-    let face_history = r.history()?;
-    let mut removed = Removed::default();
-    let mut wall_sums = Vec::new();
-    let mut scenario = String::new();
-    let mut mesh_files = Vec::new();
-    let mut regions = Vec::new();
-    if v3 {
+
+    /// The removed particles, wall sums, scenario, mesh files and spawn regions (format 3).
+    fn rest(&mut self) -> Result<Rest> {
+        let r = self;
+        let mut rest = Rest::default();
         let outflow = |r: &mut Reader| -> Result<Outflow> {
             Ok(Outflow {
                 count: r.u64()?,
                 mass: r.f64()?,
             })
         };
-        removed.domain = outflow(&mut r)?;
+        rest.removed.domain = outflow(r)?;
         let outlets = r.count(16)?;
-        removed.outlets = (0..outlets)
-            .map(|_| outflow(&mut r))
-            .collect::<Result<_>>()?;
+        rest.removed.outlets = (0..outlets).map(|_| outflow(r)).collect::<Result<_>>()?;
         let files = r.count(48)?;
-        wall_sums = (0..files)
+        rest.wall_sums = (0..files)
             .map(|_| {
                 Ok(Wrench {
                     f: r.vec3()?,
@@ -351,14 +409,14 @@ pub fn decode(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<Snapsho
             })
             .collect::<Result<_>>()?;
         let len = r.count(1)?;
-        scenario = String::from_utf8(r.take(len)?.to_vec())
+        rest.scenario = String::from_utf8(r.take(len)?.to_vec())
             .map_err(|_| anyhow::anyhow!("corrupt checkpoint: its scenario is not UTF-8"))?;
         let files = r.count(16)?;
-        mesh_files = (0..files)
+        rest.mesh_files = (0..files)
             .map(|_| Ok((r.u64()?, r.u64()?)))
             .collect::<Result<_>>()?;
         let count = r.count(17)?;
-        regions = (0..count)
+        rest.regions = (0..count)
             .map(|_| {
                 let inserted = r.u64()?;
                 let has = r.u8()? != 0;
@@ -369,29 +427,6 @@ pub fn decode(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<Snapsho
                 })
             })
             .collect::<Result<_>>()?;
+        Ok(rest)
     }
-    if r.at != body.len() {
-        bail!(
-            "corrupt checkpoint: {} unexpected bytes at the end",
-            body.len() - r.at
-        );
-    }
-    Ok(Snapshot {
-        steps,
-        built_at,
-        particles,
-        spawner: SpawnerState {
-            word_pos,
-            pending_radius: has_pending.then_some(pending),
-            regions,
-        },
-        anchors,
-        lonely,
-        pair_history,
-        face_history,
-        removed,
-        wall_sums,
-        scenario,
-        mesh_files,
-    })
 }

@@ -1,0 +1,251 @@
+//! Validation of `[[spawn]]` regions: their boxes (inside the domain), materials, rates and
+//! windows, and radius distributions within [R_min, R_max].
+
+use anyhow::{Result, bail};
+use glam::DVec3;
+
+use super::raw::*;
+use super::validate::{Range, check, check_vec, region};
+use super::*;
+
+/// `[[spawn]]`, each inside the domain, or the `[geometry]` spawn box inside it when
+/// there are none.
+pub(super) fn spawn(
+    raw: Vec<RawSpawn>,
+    index: &dyn Fn(&str, &str) -> Result<u16>,
+    kinetics: &Kinetics,
+    geometry: &Geometry,
+    simulation: &Simulation,
+    domain: Option<Region>,
+) -> Result<Vec<SpawnRegion>> {
+    let (radius_min, radius_max) = (geometry.radius_min, geometry.radius_max);
+    let (spawn_min, spawn_max) = (geometry.spawn_min, geometry.spawn_max);
+    let spawn = raw
+        .into_iter()
+        .enumerate()
+        .map(|(k, r)| {
+            spawn_region(
+                &format!("[[spawn]] #{}", k + 1),
+                r,
+                &index,
+                kinetics.initial_velocity,
+                (radius_min, radius_max),
+            )
+        })
+        .collect::<Result<Vec<_>>>()?;
+    for (k, r) in spawn.iter().enumerate() {
+        if let Some(d) = domain
+            && !(d.contains(r.region.min) && d.contains(r.region.max))
+        {
+            bail!(
+                "[[spawn]] #{} box {} .. {} must lie inside [domain] {} .. {}",
+                k + 1,
+                r.region.min,
+                r.region.max,
+                d.min,
+                d.max
+            );
+        }
+    }
+    if let Some(d) = domain
+        && spawn.is_empty()
+        && simulation.max_particles > 0
+        && simulation.spawn_attempts > 0
+        && !(d.contains(spawn_min) && d.contains(spawn_max))
+    {
+        bail!(
+            "[geometry] spawn box {spawn_min} .. {spawn_max} must lie inside [domain] {} .. {} \
+             (particles spawned outside it would be removed at once)",
+            d.min,
+            d.max
+        );
+    }
+    Ok(spawn)
+}
+
+/// Validates one `[[spawn]]` region: `index` finds a material by name, `velocity` is the
+/// default initial velocity, radii must lie in [R_min, R_max] (`radii`).
+fn spawn_region(
+    key: &str,
+    r: RawSpawn,
+    index: &dyn Fn(&str, &str) -> Result<u16>,
+    velocity: DVec3,
+    radii: (f64, f64),
+) -> Result<SpawnRegion> {
+    let k = |name: &str| format!("{key} {name}");
+    let region = region(
+        key,
+        RawBox {
+            min: r.min,
+            max: r.max,
+        },
+        false,
+    )?;
+    let material = match &r.material {
+        Some(name) => index(&k("material"), name)?,
+        None => 0,
+    };
+    let velocity = match r.velocity {
+        Some(v) => check_vec(&k("velocity"), v)?,
+        None => velocity,
+    };
+    let rate = r
+        .rate
+        .map(|x| check(&k("rate"), x, Range::Positive))
+        .transpose()?;
+    if r.count.is_none() && rate.is_none() {
+        bail!("{key} needs a count (particles in all) or a rate (particles per second), or both");
+    }
+    let start = check(&k("start"), r.start.unwrap_or(0.0), Range::NonNegative)?;
+    let stop = match r.stop {
+        Some(t) => check(&k("stop"), t, Range::NonNegative)?,
+        None => f64::INFINITY,
+    };
+    if stop <= start {
+        bail!("{} = {stop} must be after start = {start}", k("stop"));
+    }
+    let radius = Radii {
+        key,
+        lo: radii.0,
+        hi: radii.1,
+    }
+    .distribution(r.radius)?;
+    Ok(SpawnRegion {
+        region,
+        material,
+        velocity,
+        count: r.count,
+        rate,
+        start,
+        stop,
+        radius,
+    })
+}
+
+/// The radius distribution of a `[[spawn]]` region (`key`), its radii within
+/// [R_min, R_max] = [`lo`, `hi`].
+struct Radii<'a> {
+    key: &'a str,
+    lo: f64,
+    hi: f64,
+}
+
+impl Radii<'_> {
+    fn k(&self, name: &str) -> String {
+        format!("{} {name}", self.key)
+    }
+
+    /// A radius `radius.name` within [R_min, R_max].
+    fn within(&self, name: &str, x: f64) -> Result<f64> {
+        let (lo, hi) = (self.lo, self.hi);
+        let x = check(&self.k(&format!("radius.{name}")), x, Range::Positive)?;
+        if x < lo || x > hi {
+            bail!(
+                "{} = {x} must lie within [geometry] radius_min = {lo} and radius_max = {hi}",
+                self.k(&format!("radius.{name}"))
+            );
+        }
+        Ok(x)
+    }
+
+    /// The truncation `min`, `max` (default R_min, R_max).
+    fn bounds(&self, min: Option<f64>, max: Option<f64>) -> Result<(f64, f64)> {
+        let (min, max) = (
+            self.within("min", min.unwrap_or(self.lo))?,
+            self.within("max", max.unwrap_or(self.hi))?,
+        );
+        if max < min {
+            bail!("{} = {max} must be >= min = {min}", self.k("radius.max"));
+        }
+        Ok((min, max))
+    }
+
+    /// The `mean` and `std` of a distribution truncated to [`min`, `max`].
+    fn spread(&self, mean: f64, std: f64, (min, max): (f64, f64)) -> Result<(f64, f64)> {
+        let mean = check(&self.k("radius.mean"), mean, Range::Positive)?;
+        let std = check(&self.k("radius.std"), std, Range::NonNegative)?;
+        if std == 0.0 && (mean < min || mean > max) {
+            bail!(
+                "{} = {mean} must lie within [{min}, {max}]",
+                self.k("radius.mean")
+            );
+        }
+        Ok((mean, std))
+    }
+
+    /// A table of radii with weights by number (default all 1).
+    fn table(&self, radii: Vec<f64>, weights: Option<Vec<f64>>) -> Result<RadiusDistribution> {
+        if radii.is_empty() {
+            bail!("{} must hold at least one radius", self.k("radius.radii"));
+        }
+        for (i, &x) in radii.iter().enumerate() {
+            self.within(&format!("radii[{i}]"), x)?;
+        }
+        let weights = weights.unwrap_or_else(|| vec![1.0; radii.len()]);
+        if weights.len() != radii.len() {
+            bail!(
+                "{} has {} entries, radii {}: one weight per radius",
+                self.k("radius.weights"),
+                weights.len(),
+                radii.len()
+            );
+        }
+        for (i, &w) in weights.iter().enumerate() {
+            check(
+                &self.k(&format!("radius.weights[{i}]")),
+                w,
+                Range::NonNegative,
+            )?;
+        }
+        let total: f64 = weights.iter().sum();
+        if total <= 0.0 {
+            bail!("{} must not all be zero", self.k("radius.weights"));
+        }
+        Ok(RadiusDistribution::Table { radii, weights })
+    }
+
+    /// The distribution `raw` gives (default uniform in [R_min, R_max]).
+    fn distribution(&self, raw: Option<RawRadius>) -> Result<RadiusDistribution> {
+        Ok(match raw {
+            None => RadiusDistribution::Uniform {
+                min: self.lo,
+                max: self.hi,
+            },
+            Some(RawRadius::Uniform { min, max }) => {
+                let (min, max) = self.bounds(min, max)?;
+                RadiusDistribution::Uniform { min, max }
+            }
+            Some(RawRadius::Normal {
+                mean,
+                std,
+                min,
+                max,
+            }) => {
+                let (min, max) = self.bounds(min, max)?;
+                let (mean, std) = self.spread(mean, std, (min, max))?;
+                RadiusDistribution::Normal {
+                    mean,
+                    std,
+                    min,
+                    max,
+                }
+            }
+            Some(RawRadius::Lognormal {
+                mean,
+                std,
+                min,
+                max,
+            }) => {
+                let (min, max) = self.bounds(min, max)?;
+                let (mean, std) = self.spread(mean, std, (min, max))?;
+                RadiusDistribution::LogNormal {
+                    mean,
+                    std,
+                    min,
+                    max,
+                }
+            }
+            Some(RawRadius::Table { radii, weights }) => self.table(radii, weights)?,
+        })
+    }
+}
