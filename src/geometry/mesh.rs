@@ -218,120 +218,23 @@ impl Mesh {
             .enumerate()
             .map(|(k, l)| (k + 1, strip_comment(l)))
             .filter(|(_, l)| !l.is_empty());
-        let Some((n0, header)) = lines.next() else {
-            bail!("{file}: empty file, expected an OFF mesh starting with the line 'OFF'");
-        };
-        // The counts may follow the keyword on the same line.
-        let rest = match header.strip_prefix("OFF") {
-            Some(rest) => rest.trim(),
-            None => bail!("{file}:{n0}: expected the keyword 'OFF', found '{header}'"),
-        };
-        let (n1, counts_line) = if rest.is_empty() {
-            match lines.next() {
-                Some(l) => l,
-                None => bail!("{file}: ends after 'OFF', expected the line 'vertices faces edges'"),
-            }
-        } else {
-            (n0, rest)
-        };
-        let counts: Vec<u64> = parse_numbers(
-            file,
-            n1,
-            counts_line,
-            "the counts 'vertices faces edges' (whole numbers)",
-        )?;
-        if counts.len() < 2 || counts.len() > 3 {
-            bail!("{file}:{n1}: expected the counts 'vertices faces edges', found '{counts_line}'");
-        }
-        let (nv, nf) = (counts[0] as usize, counts[1] as usize);
-        let remaining = text.len();
-        if nv > remaining || nf > remaining {
-            bail!(
-                "{file}:{n1}: the header announces {nv} vertices and {nf} faces, more than the file can hold"
-            );
-        }
-
+        let (nv, nf) = off_counts(&mut lines, text.len(), file)?;
         let mut vertices = Vec::with_capacity(nv);
         for k in 0..nv {
             let Some((n, line)) = lines.next() else {
                 bail!("{file}: ends after {k} of {nv} vertices");
             };
-            let xyz: Vec<f64> = parse_numbers(file, n, line, "a vertex 'x y z'")?;
-            if xyz.len() != 3 || xyz.iter().any(|x| !x.is_finite()) {
-                bail!(
-                    "{file}:{n}: expected a vertex as three finite numbers 'x y z', found '{line}'"
-                );
-            }
-            vertices.push(DVec3::new(xyz[0], xyz[1], xyz[2]));
+            vertices.push(off_vertex(line, file, n)?);
         }
-
         let mut faces = Vec::with_capacity(nf);
         let mut corners = Vec::with_capacity(nf);
         for k in 0..nf {
             let Some((n, line)) = lines.next() else {
                 bail!("{file}: ends after {k} of {nf} faces");
             };
-            let ints: Vec<i64> = parse_numbers(
-                file,
-                n,
-                line,
-                "a face 'k v_1 ... v_k [radius index]' (whole numbers)",
-            )?;
-            let count = ints[0];
-            if !(1..=4).contains(&count) {
-                bail!(
-                    "{file}:{n}: a face has 1 to 4 vertices (point, edge, triangle, rectangle), found {count}"
-                );
-            }
-            let count = count as usize;
-            let extra = ints.len() - 1;
-            if extra < count || extra > count + 1 {
-                bail!(
-                    "{file}:{n}: expected {count} vertex indices and an optional radius index, found {extra} numbers after the vertex count"
-                );
-            }
-            let mut v = [DVec3::ZERO; 4];
-            for (slot, &idx) in v.iter_mut().zip(&ints[1..=count]) {
-                if idx < 0 || idx as usize >= nv {
-                    bail!("{file}:{n}: vertex index {idx} is out of range 0..{nv}");
-                }
-                *slot = vertices[idx as usize];
-            }
-            let ri = if extra == count + 1 {
-                ints[count + 1]
-            } else {
-                0
-            };
-            if ri < 0 || ri as usize >= radii.len() {
-                bail!(
-                    "{file}:{n}: radius index {ri} is out of range: mesh_radii has {} entries",
-                    radii.len()
-                );
-            }
-            let shape = match count {
-                1 => Primitive::Point(v[0]),
-                2 => Primitive::Segment(v[0], v[1]),
-                3 => {
-                    let normal = (v[1] - v[0]).cross(v[2] - v[0]);
-                    if normal.length_squared() == 0.0 {
-                        bail!("{file}:{n}: degenerate triangle (its vertices are collinear)");
-                    }
-                    Primitive::Triangle {
-                        a: v[0],
-                        b: v[1],
-                        c: v[2],
-                        n: normal.normalize(),
-                    }
-                }
-                _ => rectangle(v, file, n)?,
-            };
-            faces.push(Face {
-                shape,
-                radius: radii[ri as usize],
-                surface: 0,
-                contacts: Contacts::Merged,
-            });
-            corners.push(v[..count].to_vec());
+            let (face, v) = off_face(line, (file, n), &vertices, radii)?;
+            faces.push(face);
+            corners.push(v);
         }
         if let Some((n, line)) = lines.next() {
             bail!("{file}:{n}: unexpected line '{line}' after the {nf} faces the header announced");
@@ -514,6 +417,129 @@ fn rectangle(v: [DVec3; 4], file: &str, n: usize) -> Result<Primitive> {
         e2,
         n: e1.cross(e2).normalize(),
     })
+}
+
+/// The numbers of vertices and faces of an OFF file of `size` bytes, from its header lines.
+fn off_counts<'a>(
+    lines: &mut impl Iterator<Item = (usize, &'a str)>,
+    size: usize,
+    file: &str,
+) -> Result<(usize, usize)> {
+    let Some((n0, header)) = lines.next() else {
+        bail!("{file}: empty file, expected an OFF mesh starting with the line 'OFF'");
+    };
+    // The counts may follow the keyword on the same line.
+    let rest = match header.strip_prefix("OFF") {
+        Some(rest) => rest.trim(),
+        None => bail!("{file}:{n0}: expected the keyword 'OFF', found '{header}'"),
+    };
+    let (n1, counts_line) = if rest.is_empty() {
+        match lines.next() {
+            Some(l) => l,
+            None => bail!("{file}: ends after 'OFF', expected the line 'vertices faces edges'"),
+        }
+    } else {
+        (n0, rest)
+    };
+    let counts: Vec<u64> = parse_numbers(
+        file,
+        n1,
+        counts_line,
+        "the counts 'vertices faces edges' (whole numbers)",
+    )?;
+    if counts.len() < 2 || counts.len() > 3 {
+        bail!("{file}:{n1}: expected the counts 'vertices faces edges', found '{counts_line}'");
+    }
+    let (nv, nf) = (counts[0] as usize, counts[1] as usize);
+    let remaining = size;
+    if nv > remaining || nf > remaining {
+        bail!(
+            "{file}:{n1}: the header announces {nv} vertices and {nf} faces, more than the file can hold"
+        );
+    }
+
+    Ok((nv, nf))
+}
+
+/// A vertex line `x y z` (line `n` of `file`).
+fn off_vertex(line: &str, file: &str, n: usize) -> Result<DVec3> {
+    let xyz: Vec<f64> = parse_numbers(file, n, line, "a vertex 'x y z'")?;
+    if xyz.len() != 3 || xyz.iter().any(|x| !x.is_finite()) {
+        bail!("{file}:{n}: expected a vertex as three finite numbers 'x y z', found '{line}'");
+    }
+    Ok(DVec3::new(xyz[0], xyz[1], xyz[2]))
+}
+
+/// A face line `k v_1 ... v_k [i]` (line `n` of `file`): the face, with the radius of
+/// index `i` of `radii`, and its corners.
+fn off_face(
+    line: &str,
+    (file, n): (&str, usize),
+    vertices: &[DVec3],
+    radii: &[f64],
+) -> Result<(Face, Vec<DVec3>)> {
+    let nv = vertices.len();
+    let ints: Vec<i64> = parse_numbers(
+        file,
+        n,
+        line,
+        "a face 'k v_1 ... v_k [radius index]' (whole numbers)",
+    )?;
+    let count = ints[0];
+    if !(1..=4).contains(&count) {
+        bail!(
+            "{file}:{n}: a face has 1 to 4 vertices (point, edge, triangle, rectangle), found {count}"
+        );
+    }
+    let count = count as usize;
+    let extra = ints.len() - 1;
+    if extra < count || extra > count + 1 {
+        bail!(
+            "{file}:{n}: expected {count} vertex indices and an optional radius index, found {extra} numbers after the vertex count"
+        );
+    }
+    let mut v = [DVec3::ZERO; 4];
+    for (slot, &idx) in v.iter_mut().zip(&ints[1..=count]) {
+        if idx < 0 || idx as usize >= nv {
+            bail!("{file}:{n}: vertex index {idx} is out of range 0..{nv}");
+        }
+        *slot = vertices[idx as usize];
+    }
+    let ri = if extra == count + 1 {
+        ints[count + 1]
+    } else {
+        0
+    };
+    if ri < 0 || ri as usize >= radii.len() {
+        bail!(
+            "{file}:{n}: radius index {ri} is out of range: mesh_radii has {} entries",
+            radii.len()
+        );
+    }
+    let shape = match count {
+        1 => Primitive::Point(v[0]),
+        2 => Primitive::Segment(v[0], v[1]),
+        3 => {
+            let normal = (v[1] - v[0]).cross(v[2] - v[0]);
+            if normal.length_squared() == 0.0 {
+                bail!("{file}:{n}: degenerate triangle (its vertices are collinear)");
+            }
+            Primitive::Triangle {
+                a: v[0],
+                b: v[1],
+                c: v[2],
+                n: normal.normalize(),
+            }
+        }
+        _ => rectangle(v, file, n)?,
+    };
+    let face = Face {
+        shape,
+        radius: radii[ri as usize],
+        surface: 0,
+        contacts: Contacts::Merged,
+    };
+    Ok((face, v[..count].to_vec()))
 }
 
 #[cfg(test)]

@@ -347,6 +347,82 @@ fn frame_times(dir: &Path) -> std::collections::HashMap<u64, f64> {
         .collect()
 }
 
+/// What the pictures of a run's frames are drawn with: the run's simulation (for its
+/// meshes at each frame's time and its materials), further mesh files, the frames' times.
+struct Source {
+    sim: Option<Simulation>,
+    extra: Mesh,
+    times: std::collections::HashMap<u64, f64>,
+}
+
+impl Source {
+    /// The source of the frames in `dir`: `scenario` (default: the run's `run.toml`) and
+    /// the mesh files `meshes`.
+    fn open(dir: &Path, scenario: Option<&Path>, meshes: &[PathBuf]) -> Result<Source> {
+        let scenario = scenario
+            .map(Path::to_path_buf)
+            .or_else(|| crate::io::output::run_toml(dir));
+        let sim = match &scenario {
+            Some(s) => Some(Simulation::new(Scenario {
+                particles: None,
+                ..Scenario::load(s)?
+            })?),
+            None => None,
+        };
+        let mut extra = Mesh::default();
+        for m in meshes {
+            // Radii do not show in pictures; accept any radius index of an OFF file.
+            let part = Mesh::load(m, &[0.0; 1024])?;
+            extra.faces.extend(part.faces);
+        }
+        Ok(Source {
+            sim,
+            extra,
+            times: frame_times(dir),
+        })
+    }
+
+    /// The time of a frame: from `frames.csv`, else from its number and the scenario.
+    fn time_of(&self, frame: &Path) -> Option<f64> {
+        let k = frame_number(frame)?;
+        self.times.get(&k).copied().or_else(|| {
+            self.sim.as_ref().map(|sim| {
+                let s = &sim.scenario.simulation;
+                k as f64 * s.steps_per_frame as f64 * s.timestep
+            })
+        })
+    }
+
+    /// The meshes at time `t`.
+    fn mesh_of(&mut self, t: Option<f64>) -> Mesh {
+        let mut mesh = self.extra.clone();
+        if let Some(sim) = self.sim.as_mut() {
+            mesh.faces
+                .extend(sim.mesh_at(t.unwrap_or(0.0)).faces.iter().copied());
+        }
+        mesh
+    }
+}
+
+/// The frames of `path`: itself, or every `particlesNNNNNN.csv` of a directory, in order.
+fn frames_of(path: &Path) -> Result<Vec<PathBuf>> {
+    if !path.is_dir() {
+        return Ok(vec![path.to_path_buf()]);
+    }
+    let mut f: Vec<PathBuf> = std::fs::read_dir(path)
+        .with_context(|| format!("cannot read directory {}", path.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| frame_number(p).is_some() && p.extension().is_some_and(|e| e == "csv"))
+        .collect();
+    f.sort();
+    anyhow::ensure!(
+        !f.is_empty(),
+        "{}: no frames particlesNNNNNN.csv",
+        path.display()
+    );
+    Ok(f)
+}
+
 /// Renders a frame `particlesNNNNNN.csv` to `output` (default: beside it, as .png), or every
 /// frame of an output directory into `output` (default: the directory), all in one layout
 /// (view and colour range fitted to all frames, or as `fixed`), with an animation if asked.
@@ -366,65 +442,17 @@ pub fn render_path(
     } else {
         path.parent().unwrap_or(Path::new(".")).to_path_buf()
     };
-    let scenario = scenario
-        .map(Path::to_path_buf)
-        .or_else(|| crate::io::output::run_toml(&dir));
-    let mut sim = match &scenario {
-        Some(s) => Some(Simulation::new(Scenario {
-            particles: None,
-            ..Scenario::load(s)?
-        })?),
-        None => None,
-    };
-    let mut extra = Mesh::default();
-    for m in meshes {
-        // Radii do not show in pictures; accept any radius index of an OFF file.
-        let part = Mesh::load(m, &[0.0; 1024])?;
-        extra.faces.extend(part.faces);
-    }
-    let frames: Vec<PathBuf> = if path.is_dir() {
-        let mut f: Vec<PathBuf> = std::fs::read_dir(path)
-            .with_context(|| format!("cannot read directory {}", path.display()))?
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| frame_number(p).is_some() && p.extension().is_some_and(|e| e == "csv"))
-            .collect();
-        f.sort();
-        anyhow::ensure!(
-            !f.is_empty(),
-            "{}: no frames particlesNNNNNN.csv",
-            path.display()
-        );
-        f
-    } else {
-        vec![path.to_path_buf()]
-    };
-    let times = frame_times(&dir);
-    let time_of = |frame: &Path, sim: &Option<Simulation>| -> Option<f64> {
-        let k = frame_number(frame)?;
-        times.get(&k).copied().or_else(|| {
-            sim.as_ref().map(|sim| {
-                let s = &sim.scenario.simulation;
-                k as f64 * s.steps_per_frame as f64 * s.timestep
-            })
-        })
-    };
-    let mesh_of = |t: Option<f64>, sim: &mut Option<Simulation>| -> Mesh {
-        let mut mesh = extra.clone();
-        if let Some(sim) = sim.as_mut() {
-            mesh.faces
-                .extend(sim.mesh_at(t.unwrap_or(0.0)).faces.iter().copied());
-        }
-        mesh
-    };
+    let mut source = Source::open(&dir, scenario, meshes)?;
+    let frames = frames_of(path)?;
     // The layout of all frames, then the pictures in it.
     let mut layout = Layout::empty();
     for f in &frames {
         let p = crate::io::csv::load_particles(f)?;
-        let t = time_of(f, &sim);
-        layout.include(&p, &mesh_of(t, &mut sim), style);
+        let t = source.time_of(f);
+        layout.include(&p, &source.mesh_of(t), style);
     }
     layout.fix(fixed, style);
-    if let Some(sim) = &sim {
+    if let Some(sim) = &source.sim {
         layout.material_names = sim
             .scenario
             .materials
@@ -449,8 +477,8 @@ pub fn render_path(
     let mut images = Vec::new();
     for f in &frames {
         let p = crate::io::csv::load_particles(f)?;
-        let t = time_of(f, &sim);
-        let img = render_in(&p, &mesh_of(t, &mut sim), style, &layout, t)?;
+        let t = source.time_of(f);
+        let img = render_in(&p, &source.mesh_of(t), style, &layout, t)?;
         let png = if path.is_dir() {
             out_dir.join(f.with_extension("png").file_name().expect("a file name"))
         } else {
@@ -463,6 +491,18 @@ pub fn render_path(
             images.push(img);
         }
     }
+    animate(&out_dir, images, animation, &mut rendered)?;
+    Ok(rendered)
+}
+
+/// The animation of `images` into `out_dir` that `animation` asks for: an MP4 (a GIF where
+/// there is no ffmpeg, with a note) or a GIF.
+fn animate(
+    out_dir: &Path,
+    images: Vec<RgbImage>,
+    animation: Animation,
+    rendered: &mut Rendered,
+) -> Result<()> {
     if animation == Animation::Movie {
         let movie = out_dir.join("animation.mp4");
         match write_movie(&movie, &images) {
@@ -479,7 +519,7 @@ pub fn render_path(
         write_gif(&gif, images)?;
         rendered.animation = Some(gif);
     }
-    Ok(rendered)
+    Ok(())
 }
 
 /// Frames per second of animations.
