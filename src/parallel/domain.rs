@@ -108,11 +108,6 @@ impl Tree {
     /// found by bisection with the counts summed over all processes. Every process gets
     /// the same tree.
     pub fn bisect(comm: &dyn Comm, x: &[DVec3]) -> Tree {
-        struct Group {
-            cell: usize,
-            ranks: std::ops::Range<usize>,
-            members: Vec<u32>,
-        }
         let mut cells = vec![Cell::Leaf(0)];
         let mut groups = vec![Group {
             cell: 0,
@@ -128,39 +123,9 @@ impl Tree {
             if split.is_empty() {
                 break;
             }
-            // The extent and count of each group's points over all processes.
-            let mut w = Writer::default();
-            for g in &split {
-                let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-                for &i in &g.members {
-                    (lo, hi) = (lo.min(x[i as usize]), hi.max(x[i as usize]));
-                }
-                w.vec3(lo);
-                w.vec3(hi);
-                w.u64(g.members.len() as u64);
-            }
-            let mut lo = vec![DVec3::INFINITY; split.len()];
-            let mut hi = vec![DVec3::NEG_INFINITY; split.len()];
-            let mut count = vec![0u64; split.len()];
-            for d in comm.all_gather(w.0) {
-                let mut r = Reader::new(&d);
-                for g in 0..split.len() {
-                    lo[g] = lo[g].min(r.vec3());
-                    hi[g] = hi[g].max(r.vec3());
-                    count[g] += r.u64();
-                }
-            }
+            let (lo, hi, count) = extents(comm, x, &split);
             let axis: Vec<usize> = (0..split.len())
-                .map(|g| {
-                    let e = hi[g] - lo[g];
-                    if !e.is_finite() || (e.x >= e.y && e.x >= e.z) {
-                        0
-                    } else if e.y >= e.z {
-                        1
-                    } else {
-                        2
-                    }
-                })
+                .map(|g| longest_axis(hi[g] - lo[g]))
                 .collect();
             let target: Vec<i64> = (0..split.len())
                 .map(|g| {
@@ -168,65 +133,132 @@ impl Tree {
                     ((count[g] * left + n / 2) / n) as i64
                 })
                 .collect();
-            let mut a: Vec<f64> = (0..split.len()).map(|g| lo[g][axis[g]]).collect();
-            let mut b: Vec<f64> = (0..split.len()).map(|g| hi[g][axis[g]]).collect();
-            for g in 0..split.len() {
-                if !(a[g].is_finite() && b[g].is_finite()) {
-                    (a[g], b[g]) = (0.0, 0.0);
-                }
-            }
-            for _ in 0..BISECTIONS {
-                let mid: Vec<f64> = (0..split.len())
-                    .map(|g| a[g] + 0.5 * (b[g] - a[g]))
-                    .collect();
-                let below: Vec<i64> = split
-                    .iter()
-                    .enumerate()
-                    .map(|(g, grp)| {
-                        grp.members
-                            .iter()
-                            .filter(|&&i| x[i as usize][axis[g]] < mid[g])
-                            .count() as i64
-                    })
-                    .collect();
-                let below = comm.sum_i64(&below);
-                for g in 0..split.len() {
-                    if below[g] < target[g] {
-                        a[g] = mid[g];
-                    } else {
-                        b[g] = mid[g];
-                    }
-                }
-            }
+            let at = cut_places(comm, x, &split, &axis, &target, (&lo, &hi));
             groups = Vec::new();
             for (g, grp) in split.into_iter().enumerate() {
-                let (at, axis) = (b[g], axis[g]);
-                let (below, above) = (cells.len(), cells.len() + 1);
-                cells.push(Cell::Leaf(0));
-                cells.push(Cell::Leaf(0));
-                cells[grp.cell] = Cell::Cut {
-                    axis,
-                    at,
-                    below: below as u32,
-                    above: above as u32,
-                };
-                let middle = grp.ranks.start + grp.ranks.len() / 2;
-                let (under, over): (Vec<u32>, Vec<u32>) =
-                    grp.members.iter().partition(|&&i| x[i as usize][axis] < at);
-                groups.push(Group {
-                    cell: below,
-                    ranks: grp.ranks.start..middle,
-                    members: under,
-                });
-                groups.push(Group {
-                    cell: above,
-                    ranks: middle..grp.ranks.end,
-                    members: over,
-                });
+                groups.extend(halve(&mut cells, grp, x, (axis[g], at[g])));
             }
         }
         Tree { cells }
     }
+}
+
+/// Processes that share a box of the bisection: its cell of the tree, their ranks, and
+/// this process's points in it.
+struct Group {
+    cell: usize,
+    ranks: std::ops::Range<usize>,
+    members: Vec<u32>,
+}
+
+/// The extent and count of each group's points over all processes (collective).
+fn extents(comm: &dyn Comm, x: &[DVec3], split: &[Group]) -> (Vec<DVec3>, Vec<DVec3>, Vec<u64>) {
+    let mut w = Writer::default();
+    for g in split {
+        let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+        for &i in &g.members {
+            (lo, hi) = (lo.min(x[i as usize]), hi.max(x[i as usize]));
+        }
+        w.vec3(lo);
+        w.vec3(hi);
+        w.u64(g.members.len() as u64);
+    }
+    let mut lo = vec![DVec3::INFINITY; split.len()];
+    let mut hi = vec![DVec3::NEG_INFINITY; split.len()];
+    let mut count = vec![0u64; split.len()];
+    for d in comm.all_gather(w.0) {
+        let mut r = Reader::new(&d);
+        for g in 0..split.len() {
+            lo[g] = lo[g].min(r.vec3());
+            hi[g] = hi[g].max(r.vec3());
+            count[g] += r.u64();
+        }
+    }
+    (lo, hi, count)
+}
+
+/// The axis of the longest extent `e` (x if it is not finite).
+fn longest_axis(e: DVec3) -> usize {
+    if !e.is_finite() || (e.x >= e.y && e.x >= e.z) {
+        0
+    } else if e.y >= e.z {
+        1
+    } else {
+        2
+    }
+}
+
+/// The place of each group's cut across its `axis` that leaves `target` points below it
+/// (collective): `BISECTIONS` bisections of the extent `lo`..`hi` with the counts summed
+/// over all processes.
+fn cut_places(
+    comm: &dyn Comm,
+    x: &[DVec3],
+    split: &[Group],
+    axis: &[usize],
+    target: &[i64],
+    (lo, hi): (&[DVec3], &[DVec3]),
+) -> Vec<f64> {
+    let mut a: Vec<f64> = (0..split.len()).map(|g| lo[g][axis[g]]).collect();
+    let mut b: Vec<f64> = (0..split.len()).map(|g| hi[g][axis[g]]).collect();
+    for g in 0..split.len() {
+        if !(a[g].is_finite() && b[g].is_finite()) {
+            (a[g], b[g]) = (0.0, 0.0);
+        }
+    }
+    for _ in 0..BISECTIONS {
+        let mid: Vec<f64> = (0..split.len())
+            .map(|g| a[g] + 0.5 * (b[g] - a[g]))
+            .collect();
+        let below: Vec<i64> = split
+            .iter()
+            .enumerate()
+            .map(|(g, grp)| {
+                grp.members
+                    .iter()
+                    .filter(|&&i| x[i as usize][axis[g]] < mid[g])
+                    .count() as i64
+            })
+            .collect();
+        let below = comm.sum_i64(&below);
+        for g in 0..split.len() {
+            if below[g] < target[g] {
+                a[g] = mid[g];
+            } else {
+                b[g] = mid[g];
+            }
+        }
+    }
+    b
+}
+
+/// Cuts group `grp`'s box across `axis` at `at`: its cell becomes the cut, and the two
+/// halves, each with half its processes, are the groups returned.
+fn halve(cells: &mut Vec<Cell>, grp: Group, x: &[DVec3], (axis, at): (usize, f64)) -> [Group; 2] {
+    let (below, above) = (cells.len(), cells.len() + 1);
+    cells.push(Cell::Leaf(0));
+    cells.push(Cell::Leaf(0));
+    cells[grp.cell] = Cell::Cut {
+        axis,
+        at,
+        below: below as u32,
+        above: above as u32,
+    };
+    let middle = grp.ranks.start + grp.ranks.len() / 2;
+    let (under, over): (Vec<u32>, Vec<u32>) =
+        grp.members.iter().partition(|&&i| x[i as usize][axis] < at);
+    [
+        Group {
+            cell: below,
+            ranks: grp.ranks.start..middle,
+            members: under,
+        },
+        Group {
+            cell: above,
+            ranks: middle..grp.ranks.end,
+            members: over,
+        },
+    ]
 }
 
 /// The bytes of a ghost's new state each step: position, velocity, orientation, angular
