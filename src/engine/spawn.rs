@@ -9,7 +9,7 @@ use rustc_hash::FxHashMap;
 
 use crate::geometry::mesh::Face;
 use crate::model::particles::{Particle, Particles};
-use crate::neighbours::{CellGrid, cell_of, key};
+use crate::neighbours::{CellGrid, Periodic, cell_of, key};
 use crate::scenario::{RadiusDistribution, Region, Scenario, SpawnRegion};
 
 /// Draws spawn attempts from a seeded random stream, so the same seed gives the same run.
@@ -23,7 +23,7 @@ pub struct Spawner {
     regions: Vec<RegionState>,
     /// The periodic axes of the domain, as they are now (its shear offset), to test
     /// candidates against the images of particles across the sides.
-    pub periodic: Option<crate::neighbours::Periodic>,
+    pub periodic: Option<Periodic>,
 }
 
 /// How far a `[[spawn]]` region has got: particles inserted, and its pending radius.
@@ -297,25 +297,7 @@ impl Spawner {
                 .radius_max
                 .max(particles.max_radius())
                 .max(present);
-        let inv_h = 1.0 / h;
-        let near = Region {
-            min: source.region.min - DVec3::splat(h),
-            max: source.region.max + DVec3::splat(h),
-        };
-        // In a periodic domain a sphere may touch the images of particles near the far side.
-        let periodic = self.periodic;
-        let wrap = |x: DVec3| periodic.map_or(x, |p| p.wrap(x));
-        let mut shifts = Vec::new();
-        let mut cells: FxHashMap<u64, Vec<u32>> = FxHashMap::default();
-        for (i, &x) in particles.x.iter().enumerate() {
-            let x = wrap(x);
-            if periodic.is_some() || near.contains(x) {
-                cells
-                    .entry(key(cell_of(x, inv_h)))
-                    .or_default()
-                    .push(i as u32);
-            }
-        }
+        let mut crowd = Crowd::of(particles, &source.region, h, self.periodic);
         let (lo, hi) = (source.region.min, source.region.max);
         let mut inserted = 0;
         for _ in 0..attempts {
@@ -331,33 +313,7 @@ impl Spawner {
                 uniform(&mut self.rng, lo.y, hi.y),
                 uniform(&mut self.rng, lo.z, hi.z),
             );
-            let overlaps = |at: DVec3| {
-                let c = cell_of(at, inv_h);
-                for dz in -1..=1 {
-                    for dy in -1..=1 {
-                        for dx in -1..=1 {
-                            let Some(list) = cells.get(&key(c + glam::IVec3::new(dx, dy, dz)))
-                            else {
-                                continue;
-                            };
-                            for &j in list {
-                                let j = j as usize;
-                                let reach = radius + particles.radius[j];
-                                if (at - wrap(particles.x[j])).length_squared() < reach * reach {
-                                    return true;
-                                }
-                            }
-                        }
-                    }
-                }
-                false
-            };
-            let mut free = !overlaps(x);
-            if free && let Some(p) = periodic {
-                p.image_shifts(wrap(x), h, &mut shifts);
-                free = shifts.iter().all(|&(s, _)| !overlaps(wrap(x) + s));
-            }
-            free = free
+            let free = crowd.free(particles, x, radius)
                 && face_grid.at(x).iter().all(|&f| {
                     let face = &faces[f as usize];
                     let reach = radius + face.radius;
@@ -368,10 +324,7 @@ impl Spawner {
                 continue;
             }
             *pending = None;
-            cells
-                .entry(key(cell_of(wrap(x), inv_h)))
-                .or_default()
-                .push(particles.len() as u32);
+            crowd.add(x, particles.len());
             particles.push(Particle {
                 x,
                 radius,
@@ -384,5 +337,95 @@ impl Spawner {
             inserted += 1;
         }
         inserted
+    }
+}
+
+/// The particles a sphere spawned in a region could touch, binned in cells of edge `h`
+/// (twice the largest radius), with their images in a periodic domain.
+struct Crowd {
+    cells: FxHashMap<u64, Vec<u32>>,
+    h: f64,
+    inv_h: f64,
+    periodic: Option<Periodic>,
+    shifts: Vec<(DVec3, i8)>,
+}
+
+impl Crowd {
+    /// The particles within `h` of `region` (all of them in a periodic domain, where a
+    /// sphere may touch the images of particles near the far side).
+    fn of(particles: &Particles, region: &Region, h: f64, periodic: Option<Periodic>) -> Crowd {
+        let near = Region {
+            min: region.min - DVec3::splat(h),
+            max: region.max + DVec3::splat(h),
+        };
+        let mut crowd = Crowd {
+            cells: FxHashMap::default(),
+            h,
+            inv_h: 1.0 / h,
+            periodic,
+            shifts: Vec::new(),
+        };
+        for (i, &x) in particles.x.iter().enumerate() {
+            let x = crowd.wrap(x);
+            if periodic.is_some() || near.contains(x) {
+                crowd.add_wrapped(x, i);
+            }
+        }
+        crowd
+    }
+
+    fn wrap(&self, x: DVec3) -> DVec3 {
+        self.periodic.map_or(x, |p| p.wrap(x))
+    }
+
+    fn add_wrapped(&mut self, x: DVec3, i: usize) {
+        self.cells
+            .entry(key(cell_of(x, self.inv_h)))
+            .or_default()
+            .push(i as u32);
+    }
+
+    /// Adds particle `i`, placed at `x`.
+    fn add(&mut self, x: DVec3, i: usize) {
+        self.add_wrapped(self.wrap(x), i);
+    }
+
+    /// Whether a sphere at `at` of `radius` overlaps one of the particles (at their
+    /// wrapped places).
+    fn overlaps(&self, particles: &Particles, at: DVec3, radius: f64) -> bool {
+        let c = cell_of(at, self.inv_h);
+        for dz in -1..=1 {
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    let Some(list) = self.cells.get(&key(c + glam::IVec3::new(dx, dy, dz))) else {
+                        continue;
+                    };
+                    for &j in list {
+                        let j = j as usize;
+                        let reach = radius + particles.radius[j];
+                        if (at - self.wrap(particles.x[j])).length_squared() < reach * reach {
+                            return true;
+                        }
+                    }
+                }
+            }
+        }
+        false
+    }
+
+    /// Whether a sphere at `x` of `radius` is clear of every particle and, in a periodic
+    /// domain, of their images.
+    fn free(&mut self, particles: &Particles, x: DVec3, radius: f64) -> bool {
+        let mut free = !self.overlaps(particles, x, radius);
+        if free && let Some(p) = self.periodic {
+            let at = self.wrap(x);
+            let mut shifts = std::mem::take(&mut self.shifts);
+            p.image_shifts(at, self.h, &mut shifts);
+            free = shifts
+                .iter()
+                .all(|&(s, _)| !self.overlaps(particles, at + s, radius));
+            self.shifts = shifts;
+        }
+        free
     }
 }
