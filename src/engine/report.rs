@@ -25,110 +25,113 @@ impl Simulation {
 
     /// The contact network of the particles this process holds (own and ghosts).
     pub(super) fn held_contact_network(&self) -> Vec<ContactRecord> {
-        let p = &self.particles;
-        let law = &self.law;
-        let mass = |k: usize| {
-            Inertia::mass_with(
-                p.radius[k],
-                self.densities[p.material[k] as usize].mass_per_r3,
-            )
-        };
-        let body = |k: usize| Body {
-            x: p.x[k],
-            radius: p.radius[k],
-            v: p.v[k],
-            w: p.w[k],
-        };
-        let record = |i: usize, other: Other, kin: &Kinematics, coef, springs: Springs, with| {
-            let mut springs = springs;
-            let force = law.evaluate(coef, p.radius[i], mass(i), other, kin, &mut springs);
-            let f_n = kin.n * kin.n.dot(force.f);
-            ContactRecord {
-                id: p.id[i],
-                with,
-                point: p.x[i] - kin.n * kin.r_i,
-                f_n,
-                f_t: force.f - f_n,
-                overlap: kin.delta,
-            }
-        };
-        let mut out = Vec::new();
-        // Each open contact of `list`: owner, partner, springs and slot.
-        let open = |list: &ContactList| {
-            let mut v = Vec::new();
-            for piece in 0..list.pieces.len().saturating_sub(1) {
-                let store = &list.stores[piece];
-                for i in list.pieces[piece] as usize..list.pieces[piece + 1] as usize {
-                    for k in list.run(i) {
-                        if list.contact[k] != NONE {
-                            let springs = store.springs[list.contact[k] as usize];
-                            v.push((i, list.partner[k] as usize, springs, k));
-                        }
-                    }
-                }
-            }
-            v
-        };
-        // Pairs within the box, and across periodic sides with the partner at its image.
-        let nb = &self.neighbours;
-        let within = open(&nb.pairs).into_iter().map(|(a, b, s, _)| {
-            let (i, j) = if p.id[a] < p.id[b] { (a, b) } else { (b, a) };
-            (i, j, s, DVec3::ZERO, DVec3::ZERO)
-        });
-        let across = open(&nb.wrapped).into_iter().map(|(a, b, s, k)| {
-            let (i, j, shift, dv) = nb.across(&p.id, a, b, k);
-            (i, j, s, shift, dv)
-        });
-        for (i, j, springs, shift, dv) in within.chain(across) {
-            let bj = Body {
-                x: p.x[j] + shift,
-                v: p.v[j] + dv,
-                ..body(j)
-            };
-            let Some(kin) = Kinematics::between_particles(&body(i), &bj) else {
-                continue;
-            };
-            let other = Other::Particle {
-                r: p.radius[j],
-                m: mass(j),
-            };
-            let coef = law.pair(p.material[i], p.material[j]);
-            out.push(record(
-                i,
-                other,
-                &kin,
-                coef,
-                springs,
-                Partner::Particle(p.id[j] as usize),
-            ));
-        }
-        for (i, f, springs, _) in open(&self.neighbours.faces) {
-            let face = &self.mesh.faces[f];
-            let wall = match self.face_part[f] {
-                STATIC => RigidVelocity::default(),
-                part => self.moving[part as usize].velocity,
-            };
-            let b = body(i);
-            let (d, feature) = face.separation_and_feature(b.x);
-            let (d, _) = surface::snap(face, b.x, b.radius, d, feature);
-            let Some(kin) = Kinematics::with_wall(&b, d, face.radius, &wall) else {
-                continue;
-            };
-            let coef = law.with_wall(p.material[i], self.face_material[f]);
-            out.push(record(
-                i,
-                Other::Wall,
-                &kin,
-                coef,
-                springs,
-                Partner::Face(f),
-            ));
-        }
+        let mut out = self.held_pair_records();
+        out.extend(self.held_face_records());
         out.sort_by_key(|r| match r.with {
             Partner::Particle(j) => (0, r.id, j),
             Partner::Face(f) => (1, r.id, f),
         });
         out
+    }
+
+    /// The open pair contacts: within the box, and across periodic sides with the partner
+    /// at its image, each as (lower id, higher id).
+    fn held_pair_records(&self) -> Vec<ContactRecord> {
+        let p = &self.particles;
+        let nb = &self.neighbours;
+        let within = open_contacts(&nb.pairs).into_iter().map(|(a, b, s, _)| {
+            let (i, j) = if p.id[a] < p.id[b] { (a, b) } else { (b, a) };
+            (i, j, s, DVec3::ZERO, DVec3::ZERO)
+        });
+        let across = open_contacts(&nb.wrapped).into_iter().map(|(a, b, s, k)| {
+            let (i, j, shift, dv) = nb.across(&p.id, a, b, k);
+            (i, j, s, shift, dv)
+        });
+        let mut out = Vec::new();
+        for (i, j, springs, shift, dv) in within.chain(across) {
+            let bj = Body {
+                x: p.x[j] + shift,
+                v: p.v[j] + dv,
+                ..self.body_of(j)
+            };
+            let Some(kin) = Kinematics::between_particles(&self.body_of(i), &bj) else {
+                continue;
+            };
+            let other = Other::Particle {
+                r: p.radius[j],
+                m: self.mass_of(j),
+            };
+            let coef = self.law.pair(p.material[i], p.material[j]);
+            let with = Partner::Particle(p.id[j] as usize);
+            out.push(self.record(i, other, &kin, coef, springs, with));
+        }
+        out
+    }
+
+    /// The open contacts of particles with mesh faces, the face moving as its part does.
+    fn held_face_records(&self) -> Vec<ContactRecord> {
+        let p = &self.particles;
+        let mut out = Vec::new();
+        for (i, f, springs, _) in open_contacts(&self.neighbours.faces) {
+            let face = &self.mesh.faces[f];
+            let wall = match self.face_part[f] {
+                STATIC => RigidVelocity::default(),
+                part => self.moving[part as usize].velocity,
+            };
+            let b = self.body_of(i);
+            let (d, feature) = face.separation_and_feature(b.x);
+            let (d, _) = surface::snap(face, b.x, b.radius, d, feature);
+            let Some(kin) = Kinematics::with_wall(&b, d, face.radius, &wall) else {
+                continue;
+            };
+            let coef = self.law.with_wall(p.material[i], self.face_material[f]);
+            out.push(self.record(i, Other::Wall, &kin, coef, springs, Partner::Face(f)));
+        }
+        out
+    }
+
+    fn mass_of(&self, k: usize) -> f64 {
+        let p = &self.particles;
+        Inertia::mass_with(
+            p.radius[k],
+            self.densities[p.material[k] as usize].mass_per_r3,
+        )
+    }
+
+    fn body_of(&self, k: usize) -> Body {
+        let p = &self.particles;
+        Body {
+            x: p.x[k],
+            radius: p.radius[k],
+            v: p.v[k],
+            w: p.w[k],
+        }
+    }
+
+    /// The record of particle `i`'s contact with `other`: the force the law gives it now,
+    /// from a copy of its springs (the springs themselves left unchanged).
+    fn record(
+        &self,
+        i: usize,
+        other: Other,
+        kin: &Kinematics,
+        coef: &Coefficients,
+        mut springs: Springs,
+        with: Partner,
+    ) -> ContactRecord {
+        let p = &self.particles;
+        let force = self
+            .law
+            .evaluate(coef, p.radius[i], self.mass_of(i), other, kin, &mut springs);
+        let f_n = kin.n * kin.n.dot(force.f);
+        ContactRecord {
+            id: p.id[i],
+            with,
+            point: p.x[i] - kin.n * kin.r_i,
+            f_n,
+            f_t: force.f - f_n,
+            overlap: kin.delta,
+        }
     }
 
     /// What the status line and `log.csv` report of the current state, as LAMMPS's thermo
@@ -213,4 +216,21 @@ impl Simulation {
         }
         thermo
     }
+}
+
+/// Each open contact of `list`: owner, partner, springs and slot.
+fn open_contacts(list: &ContactList) -> Vec<(usize, usize, Springs, usize)> {
+    let mut v = Vec::new();
+    for piece in 0..list.pieces.len().saturating_sub(1) {
+        let store = &list.stores[piece];
+        for i in list.pieces[piece] as usize..list.pieces[piece + 1] as usize {
+            for k in list.run(i) {
+                if list.contact[k] != NONE {
+                    let springs = store.springs[list.contact[k] as usize];
+                    v.push((i, list.partner[k] as usize, springs, k));
+                }
+            }
+        }
+    }
+    v
 }
