@@ -91,57 +91,23 @@ impl Simulation {
         // The particles come from the snapshot; the scenario keeps its input file, so that
         // its `run.toml` reruns the run.
         sim.scenario.particles = input;
-        let misfit = |what: String| anyhow::anyhow!("the checkpoint does not fit: {what}");
-        let built = !snapshot.anchors.is_empty();
-        if built && snapshot.anchors.len() != snapshot.particles.len() {
-            return Err(misfit("one anchor per particle".into()));
-        }
-        check_materials(&snapshot.particles, &sim.scenario)
-            .map_err(|e| misfit(format!("{e:#}")))?;
+        sim.check_same_run(&snapshot).map_err(misfit)?;
+        let history = Histories {
+            pairs: History::in_storage(&snapshot.particles, &snapshot.pair_history, true)
+                .map_err(misfit)?,
+            faces: History::in_storage(&snapshot.particles, &snapshot.face_history, false)
+                .map_err(misfit)?,
+        };
         sim.particles = snapshot.particles;
-        let (regions, spawn) = (snapshot.spawner.regions.len(), sim.scenario.spawn.len());
-        if regions > spawn {
-            return Err(misfit(format!(
-                "it counts the insertions of {regions} [[spawn]] regions, the scenario has {spawn}"
-            )));
-        }
-        let (sums, files) = (snapshot.wall_sums.len(), sim.mesh_files.len());
-        if sums != 0 && sums != files {
-            return Err(misfit(format!(
-                "it sums the loads on {sums} mesh files, the scenario has {files}"
-            )));
-        }
         sim.spawner = Spawner::resume(sim.scenario.simulation.seed, snapshot.spawner);
-        if snapshot.removed.outlets.len() > sim.removed.outlets.len() {
-            return Err(misfit(format!(
-                "it counts {} outlets, the scenario has {}",
-                snapshot.removed.outlets.len(),
-                sim.removed.outlets.len()
-            )));
-        }
         sim.removed.domain = snapshot.removed.domain;
         sim.removed.outlets[..snapshot.removed.outlets.len()]
             .copy_from_slice(&snapshot.removed.outlets);
         if !sim.wall_sums.is_empty() && snapshot.wall_sums.len() == sim.wall_sums.len() {
             sim.wall_sums = snapshot.wall_sums;
         }
-        let history = Histories {
-            pairs: History::in_storage(&sim.particles, &snapshot.pair_history, true)
-                .map_err(misfit)?,
-            faces: History::in_storage(&sim.particles, &snapshot.face_history, false)
-                .map_err(misfit)?,
-        };
-        if let Some(&(_, f, _)) = snapshot
-            .face_history
-            .iter()
-            .find(|e| e.1 as usize >= sim.mesh.faces.len())
-        {
-            return Err(misfit(format!(
-                "contact with face {f}, which the mesh lacks"
-            )));
-        }
         let dt = sim.scenario.simulation.timestep;
-        if !built {
+        if snapshot.anchors.is_empty() {
             // Taken before the first step: the lists are made as that step would make them.
             sim.steps = snapshot.steps;
             sim.time = sim.steps as f64 * dt;
@@ -156,20 +122,65 @@ impl Simulation {
         sim.time = sim.steps as f64 * dt;
         sim.slide_images();
         sim.move_meshes();
-        sim.regrid_faces();
-        sim.neighbours.restore(
-            &sim.particles,
-            snapshot.anchors,
-            snapshot.lonely,
-            &sim.mesh.faces,
-            &sim.face_grid,
-            &history,
-        );
-        sim.built();
+        sim.rebuild_as_built(snapshot.anchors, snapshot.lonely, &history);
         sim.steps = snapshot.steps;
         sim.time = sim.steps as f64 * dt;
         sim.move_meshes();
         Ok(sim)
+    }
+
+    /// Why `snapshot` cannot continue this run, if it cannot: its counts of particles and
+    /// anchors, materials, [[spawn]] regions, mesh files, outlets and faces must fit.
+    fn check_same_run(&self, snapshot: &Snapshot) -> std::result::Result<(), String> {
+        let n = snapshot.particles.len();
+        if !snapshot.anchors.is_empty() && snapshot.anchors.len() != n {
+            return Err("one anchor per particle".into());
+        }
+        check_materials(&snapshot.particles, &self.scenario).map_err(|e| format!("{e:#}"))?;
+        let (regions, spawn) = (snapshot.spawner.regions.len(), self.scenario.spawn.len());
+        if regions > spawn {
+            return Err(format!(
+                "it counts the insertions of {regions} [[spawn]] regions, the scenario has {spawn}"
+            ));
+        }
+        let (sums, files) = (snapshot.wall_sums.len(), self.mesh_files.len());
+        if sums != 0 && sums != files {
+            return Err(format!(
+                "it sums the loads on {sums} mesh files, the scenario has {files}"
+            ));
+        }
+        let (outlets, have) = (snapshot.removed.outlets.len(), self.removed.outlets.len());
+        if outlets > have {
+            return Err(format!(
+                "it counts {outlets} outlets, the scenario has {have}"
+            ));
+        }
+        let faces = self.mesh.faces.len();
+        if let Some(&(_, f, _)) = snapshot.face_history.iter().find(|e| e.1 as usize >= faces) {
+            return Err(format!("contact with face {f}, which the mesh lacks"));
+        }
+        Ok(())
+    }
+
+    /// Builds the lists again as a run had them at its last rebuild: from the particles'
+    /// `anchors` (their positions then), with its `lonely` particles' allowances and the
+    /// contact `history` it held.
+    fn rebuild_as_built(
+        &mut self,
+        anchors: Vec<DVec3>,
+        lonely: Vec<(u32, f64)>,
+        history: &Histories,
+    ) {
+        self.regrid_faces();
+        self.neighbours.restore(
+            &self.particles,
+            anchors,
+            lonely,
+            &self.mesh.faces,
+            &self.face_grid,
+            history,
+        );
+        self.built();
     }
 
     /// Starts a new stage of a study from the snapshot of another run (`tinydem run NEXT
@@ -188,62 +199,12 @@ impl Simulation {
         snapshot: Snapshot,
     ) -> Result<(Simulation, Vec<String>)> {
         let mut sim = Simulation::from_inputs(scenario, inputs)?;
-        let misfit = |what: String| anyhow::anyhow!("the checkpoint does not fit: {what}");
-        let mut notes = Vec::new();
         let p = snapshot.particles;
         check_materials(&p, &sim.scenario).map_err(|e| misfit(format!("{e:#}")))?;
-        let old_seed = if snapshot.scenario.is_empty() {
-            None
-        } else {
-            let old = Scenario::parse(&snapshot.scenario, std::path::Path::new("checkpoint"))
-                .map_err(|e| misfit(format!("its scenario does not parse: {e:#}")))?;
-            if old.lees_edwards.is_some() {
-                bail!(
-                    "a run with Lees-Edwards boundaries cannot start a stage yet (its images would jump back to offset 0): continue it with --resume"
-                );
-            }
-            Some(old.simulation.seed)
-        };
-        if old_seed == Some(sim.scenario.simulation.seed) {
-            // The stage's [[spawn]] regions are its own: their counts start at 0 with its
-            // clock.
-            let state = SpawnerState {
-                regions: Vec::new(),
-                ..snapshot.spawner
-            };
-            sim.spawner = Spawner::resume(sim.scenario.simulation.seed, state);
-            notes.push("spawning continues the random stream of the checkpoint".into());
-        } else {
-            notes.push(format!(
-                "spawning draws from a new random stream (seed {})",
-                sim.scenario.simulation.seed
-            ));
-        }
-        // Each mesh file of the checkpoint's run, found among this scenario's by its faces.
+        let mut notes = vec![sim.continue_spawner(&snapshot.scenario, snapshot.spawner)?];
         let new_files = sim.mesh_signatures();
-        let mut taken = vec![false; new_files.len()];
-        let mut face_map: Vec<Option<u32>> = Vec::new();
-        for old in &snapshot.mesh_files {
-            let found = (0..new_files.len()).find(|&j| !taken[j] && new_files[j] == *old);
-            if let Some(j) = found {
-                taken[j] = true;
-            }
-            let start = found.map(|j| sim.mesh_files[j].faces.start as u32);
-            face_map.extend((0..old.0 as u32).map(|f| start.map(|s| s + f)));
-        }
-        let face_history: Vec<_> = snapshot
-            .face_history
-            .iter()
-            .filter_map(|&(id, f, springs)| {
-                face_map
-                    .get(f as usize)
-                    .copied()
-                    .flatten()
-                    .map(|f| (id, f, springs))
-            })
-            .collect();
+        let face_history = sim.carried_face_contacts(&snapshot.mesh_files, &snapshot.face_history);
         let dropped = snapshot.face_history.len() - face_history.len();
-        let same_mesh = snapshot.mesh_files == new_files;
         notes.push(format!(
             "carried {} particles, {} particle contacts and {} contacts with meshes{}",
             p.len(),
@@ -267,23 +228,72 @@ impl Simulation {
         if built {
             // The lists at the positions of the run's last rebuild; the allowances of its
             // lonely particles hold only for the same mesh.
-            let lonely = if same_mesh {
+            let lonely = if snapshot.mesh_files == new_files {
                 snapshot.lonely
             } else {
                 Vec::new()
             };
-            sim.regrid_faces();
-            sim.neighbours.restore(
-                &sim.particles,
-                snapshot.anchors,
-                lonely,
-                &sim.mesh.faces,
-                &sim.face_grid,
-                &history,
-            );
-            sim.built();
+            sim.rebuild_as_built(snapshot.anchors, lonely, &history);
         }
         Ok((sim, notes))
+    }
+
+    /// Lets the spawner of a stage continue the random stream of the run before it (whose
+    /// resolved scenario is `old`, empty if unknown) when the seed is the same; its
+    /// [[spawn]] regions are its own, their counts start at 0 with its clock. Says which.
+    fn continue_spawner(&mut self, old: &str, state: SpawnerState) -> Result<String> {
+        let old_seed = if old.is_empty() {
+            None
+        } else {
+            let old = Scenario::parse(old, std::path::Path::new("checkpoint"))
+                .map_err(|e| misfit(format!("its scenario does not parse: {e:#}")))?;
+            if old.lees_edwards.is_some() {
+                bail!(
+                    "a run with Lees-Edwards boundaries cannot start a stage yet (its images would jump back to offset 0): continue it with --resume"
+                );
+            }
+            Some(old.simulation.seed)
+        };
+        let seed = self.scenario.simulation.seed;
+        if old_seed != Some(seed) {
+            return Ok(format!(
+                "spawning draws from a new random stream (seed {seed})"
+            ));
+        }
+        let state = SpawnerState {
+            regions: Vec::new(),
+            ..state
+        };
+        self.spawner = Spawner::resume(seed, state);
+        Ok("spawning continues the random stream of the checkpoint".into())
+    }
+
+    /// The contacts with meshes of a run whose mesh files were `old_files` (face count and
+    /// hash) that this simulation's mesh also has, each file found among its own by its
+    /// faces wherever it stands, with the faces renumbered.
+    fn carried_face_contacts(
+        &self,
+        old_files: &[(u64, u64)],
+        face_history: &[(u32, u32, Springs)],
+    ) -> Vec<(u32, u32, Springs)> {
+        let new_files = self.mesh_signatures();
+        let mut taken = vec![false; new_files.len()];
+        let mut face_map: Vec<Option<u32>> = Vec::new();
+        for old in old_files {
+            let found = (0..new_files.len()).find(|&j| !taken[j] && new_files[j] == *old);
+            if let Some(j) = found {
+                taken[j] = true;
+            }
+            let start = found.map(|j| self.mesh_files[j].faces.start as u32);
+            face_map.extend((0..old.0 as u32).map(|f| start.map(|s| s + f)));
+        }
+        face_history
+            .iter()
+            .filter_map(|&(id, f, springs)| {
+                let f = face_map.get(f as usize).copied().flatten()?;
+                Some((id, f, springs))
+            })
+            .collect()
     }
 
     /// Sets up a simulation from a mesh and particles already in memory.
@@ -364,4 +374,9 @@ fn contact_law(s: &Scenario) -> ContactLaw {
     let materials: Vec<_> = s.materials.iter().map(|m| m.properties.clone()).collect();
     let (dt, springs) = (s.simulation.timestep, s.simulation.friction_springs);
     ContactLaw::of(&materials, |a, b| s.pair(a, b), dt, springs)
+}
+
+/// The error of a checkpoint that does not fit the run it is to continue.
+fn misfit(what: String) -> anyhow::Error {
+    anyhow::anyhow!("the checkpoint does not fit: {what}")
 }
