@@ -484,7 +484,7 @@ fn migrate(
     p: Particles,
     anchors: Option<Vec<DVec3>>,
     gone: &FxHashSet<u32>,
-    (pairs, faces): Entries,
+    entries: Entries,
 ) -> (Particles, Option<Vec<DVec3>>, Entries) {
     let carry = anchors.is_some();
     // Where each particle is placed: at its anchor, or where it is now.
@@ -492,105 +492,151 @@ fn migrate(
         Some(a) => a.into(),
         None => p.x.as_slice().into(),
     };
-    let index: FxHashMap<u32, u32> =
-        p.id.iter()
-            .enumerate()
-            .map(|(i, &id)| (id, i as u32))
-            .collect();
-    let kept = |i: usize| d.owned[i] && !gone.contains(&p.id[i]);
     let own: Vec<DVec3> = (0..p.len())
-        .filter(|&i| kept(i))
+        .filter(|&i| d.owned[i] && !gone.contains(&p.id[i]))
         .map(|i| place[i])
         .collect();
     recut(d, &own);
     drop(own);
     let d = &*d;
-    let kept = |i: usize| d.owned[i] && !gone.contains(&p.id[i]);
-    let (me, k) = (d.comm.rank(), d.comm.size());
-    let tree = d.tree.as_ref().expect("cut");
-    let owner = |id: u32| tree.owner(place[index[&id] as usize]);
-    let mine = |id: u32| d.owned[index[&id] as usize];
-    let mut particles_to: Vec<Vec<u32>> = vec![Vec::new(); k];
-    for i in (0..p.len()).filter(|&i| kept(i)) {
-        particles_to[tree.owner(place[i])].push(i as u32);
-    }
-    let mut pairs_to: Vec<Vec<usize>> = vec![Vec::new(); k];
-    for (e, &(a, b, _)) in pairs.iter().enumerate() {
-        if gone.contains(&a) || gone.contains(&b) || !mine(a) {
-            continue;
-        }
-        let (qa, qb) = (owner(a), owner(b));
-        pairs_to[qa].push(e);
-        if qb != qa {
-            pairs_to[qb].push(e);
-        }
-    }
-    let mut faces_to: Vec<Vec<usize>> = vec![Vec::new(); k];
-    for (e, &(a, _, _)) in faces.iter().enumerate() {
-        if !gone.contains(&a) && mine(a) {
-            faces_to[owner(a)].push(e);
-        }
-    }
-    let messages: Vec<Vec<u8>> = (0..k)
-        .map(|q| {
-            let mut w = Writer::default();
-            if q == me {
-                return w.0; // what stays, stays
-            }
-            w.u64(particles_to[q].len() as u64);
-            for &i in &particles_to[q] {
-                put_particle(&mut w, p.id[i as usize], &p.get(i as usize));
-                if carry {
-                    w.vec3(place[i as usize]);
-                }
-            }
-            w.u64(pairs_to[q].len() as u64);
-            pairs_to[q]
-                .iter()
-                .for_each(|&e| put_entry(&mut w, &pairs[e]));
-            w.u64(faces_to[q].len() as u64);
-            faces_to[q]
-                .iter()
-                .for_each(|&e| put_entry(&mut w, &faces[e]));
-            w.0
+    let to = Destinations::of(d, &p, &place, gone, &entries);
+    let me = d.comm.rank();
+    let messages: Vec<Vec<u8>> = (0..d.comm.size())
+        .map(|q| match q == me {
+            true => Vec::new(), // what stays, stays
+            false => to.message(q, &p, carry.then_some(&*place), &entries),
         })
         .collect();
-    drop(index);
     let mut held = Particles {
         next_id: p.next_id,
         ..Particles::default()
     };
     let mut held_at = carry.then(Vec::new);
-    for &i in &particles_to[me] {
+    for &i in &to.particles[me] {
         held.insert(p.id[i as usize], p.get(i as usize));
         if let Some(at) = &mut held_at {
             at.push(place[i as usize]);
         }
     }
-    let mut kept_pairs: Vec<_> = pairs_to[me].iter().map(|&e| pairs[e]).collect();
-    let mut kept_faces: Vec<_> = faces_to[me].iter().map(|&e| faces[e]).collect();
-    drop(place);
-    drop((particles_to, pairs_to, faces_to, pairs, faces, p));
+    let (pairs, faces) = &entries;
+    let mut kept = (
+        to.pairs[me].iter().map(|&e| pairs[e]).collect(),
+        to.faces[me].iter().map(|&e| faces[e]).collect(),
+    );
+    drop((place, to, entries));
+    drop(p);
     for (q, m) in d.comm.all_to_all(messages).iter().enumerate() {
-        if q == me {
-            continue;
-        }
-        let mut r = Reader::new(m);
-        for _ in 0..r.u64() {
-            let (id, particle) = get_particle(&mut r);
-            held.insert(id, particle);
-            if let Some(at) = &mut held_at {
-                at.push(r.vec3());
-            }
-        }
-        for _ in 0..r.u64() {
-            kept_pairs.push(get_entry(&mut r));
-        }
-        for _ in 0..r.u64() {
-            kept_faces.push(get_entry(&mut r));
+        if q != me {
+            receive(&mut Reader::new(m), &mut held, held_at.as_mut(), &mut kept);
         }
     }
-    (held, held_at, (kept_pairs, kept_faces))
+    (held, held_at, kept)
+}
+
+/// Where [`migrate`] sends each own particle (by index) and the springs of each contact
+/// (by entry), per process.
+struct Destinations {
+    particles: Vec<Vec<u32>>,
+    pairs: Vec<Vec<usize>>,
+    faces: Vec<Vec<usize>>,
+}
+
+impl Destinations {
+    /// To the owner of the box each kept own particle of `p` is placed in (at `place`):
+    /// the particle, its contacts with faces, and its contacts with particles of higher id
+    /// (to the owners of both partners).
+    fn of(
+        d: &Domain,
+        p: &Particles,
+        place: &[DVec3],
+        gone: &FxHashSet<u32>,
+        (pairs, faces): &Entries,
+    ) -> Destinations {
+        let k = d.comm.size();
+        let index: FxHashMap<u32, u32> =
+            p.id.iter()
+                .enumerate()
+                .map(|(i, &id)| (id, i as u32))
+                .collect();
+        let tree = d.tree.as_ref().expect("cut");
+        let owner = |id: u32| tree.owner(place[index[&id] as usize]);
+        let mine = |id: u32| d.owned[index[&id] as usize];
+        let mut to = Destinations {
+            particles: vec![Vec::new(); k],
+            pairs: vec![Vec::new(); k],
+            faces: vec![Vec::new(); k],
+        };
+        for i in (0..p.len()).filter(|&i| d.owned[i] && !gone.contains(&p.id[i])) {
+            to.particles[tree.owner(place[i])].push(i as u32);
+        }
+        for (e, &(a, b, _)) in pairs.iter().enumerate() {
+            if gone.contains(&a) || gone.contains(&b) || !mine(a) {
+                continue;
+            }
+            let (qa, qb) = (owner(a), owner(b));
+            to.pairs[qa].push(e);
+            if qb != qa {
+                to.pairs[qb].push(e);
+            }
+        }
+        for (e, &(a, _, _)) in faces.iter().enumerate() {
+            if !gone.contains(&a) && mine(a) {
+                to.faces[owner(a)].push(e);
+            }
+        }
+        to
+    }
+
+    /// What goes to process `q`: its particles (with their places if `place`), then its
+    /// springs of pairs and of contacts with faces, each list after its length.
+    fn message(
+        &self,
+        q: usize,
+        p: &Particles,
+        place: Option<&[DVec3]>,
+        (pairs, faces): &Entries,
+    ) -> Vec<u8> {
+        let mut w = Writer::default();
+        w.u64(self.particles[q].len() as u64);
+        for &i in &self.particles[q] {
+            put_particle(&mut w, p.id[i as usize], &p.get(i as usize));
+            if let Some(place) = place {
+                w.vec3(place[i as usize]);
+            }
+        }
+        w.u64(self.pairs[q].len() as u64);
+        self.pairs[q]
+            .iter()
+            .for_each(|&e| put_entry(&mut w, &pairs[e]));
+        w.u64(self.faces[q].len() as u64);
+        self.faces[q]
+            .iter()
+            .for_each(|&e| put_entry(&mut w, &faces[e]));
+        w.0
+    }
+}
+
+/// Adds what a [`Destinations::message`] holds to the particles `held` (and their places to
+/// `held_at`, if carried) and the springs `kept`.
+fn receive(
+    r: &mut Reader,
+    held: &mut Particles,
+    mut held_at: Option<&mut Vec<DVec3>>,
+    (pairs, faces): &mut Entries,
+) {
+    for _ in 0..r.u64() {
+        let (id, particle) = get_particle(r);
+        held.insert(id, particle);
+        if let Some(at) = held_at.as_mut() {
+            at.push(r.vec3());
+        }
+    }
+    for _ in 0..r.u64() {
+        pairs.push(get_entry(r));
+    }
+    for _ in 0..r.u64() {
+        faces.push(get_entry(r));
+    }
 }
 
 /// Ghosts: copies of own particles (all `held` holds) for the processes whose boxes are
