@@ -47,7 +47,7 @@ for root, _, names in os.walk(src):
                 not l.strip() or l.lstrip().startswith("//") or re.match(r"pub mod \w+;$", l.strip())
                 for l in code.splitlines()
             )
-            if parts[0] not in ("main", "lib") and not only_mods:
+            if parts[0] not in ("main", "lib", "bin") and not only_mods:
                 files[rel] = module_of(parts)
 modules = set(files.values())
 

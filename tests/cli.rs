@@ -338,6 +338,24 @@ fn render_draws_frames_and_directories() {
     let t = tempfile::tempdir().unwrap();
     let frames = hourglass_frames("2", t.path());
     assert!(frames.len() == 5);
+    renders_a_frame(t.path());
+    renders_a_directory_in_one_view(t.path());
+    renders_a_movie_in_a_fixed_box(t.path());
+    fails_with(
+        &tinydem(&["render", "nope.csv"], t.path()),
+        &["cannot read particle file nope.csv"],
+    );
+    fails_with(
+        &tinydem(
+            &["render", "out/particles000004.csv", "--width", "0"],
+            t.path(),
+        ),
+        &["picture size 0x600"],
+    );
+}
+
+/// A frame of the run in `dir`, with the hourglass mesh.
+fn renders_a_frame(dir: &Path) {
     let mesh = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/hourglass.off");
     let o = tinydem(
         &[
@@ -352,14 +370,17 @@ fn render_draws_frames_and_directories() {
             "--height",
             "200",
         ],
-        t.path(),
+        dir,
     );
     assert!(o.status.success(), "{}", stderr(&o));
-    let img = image::open(t.path().join("f.png")).unwrap().to_rgb8();
+    let img = image::open(dir.join("f.png")).unwrap().to_rgb8();
     assert_eq!(img.dimensions(), (320, 200));
     let drawn = img.pixels().filter(|p| p.0 != [255, 255, 255]).count();
     assert!(drawn > 320 * 200 / 50, "only {drawn} pixels drawn");
-    // A directory: one PNG per frame and an animation; the scenario supplies the mesh.
+}
+
+/// A directory: one PNG per frame and an animation; the scenario supplies the mesh.
+fn renders_a_directory_in_one_view(dir: &Path) {
     let o = tinydem(
         &[
             "render",
@@ -372,19 +393,19 @@ fn render_draws_frames_and_directories() {
             "--height",
             "120",
         ],
-        t.path(),
+        dir,
     );
     assert!(o.status.success(), "{}", stderr(&o));
     for k in 0..=4 {
-        assert!(t.path().join(format!("out/particles{k:06}.png")).exists());
+        assert!(dir.join(format!("out/particles{k:06}.png")).exists());
     }
-    let gif = std::fs::read(t.path().join("out/animation.gif")).unwrap();
+    let gif = std::fs::read(dir.join("out/animation.gif")).unwrap();
     assert!(gif.starts_with(b"GIF89a"));
     // One view for all frames: the static mesh's edges are the same pixels in each picture
     // (the run.toml of the directory supplies the mesh), and so is the colour bar.
     let pictures: Vec<image::RgbImage> = (0..=4)
         .map(|k| {
-            image::open(t.path().join(format!("out/particles{k:06}.png")))
+            image::open(dir.join(format!("out/particles{k:06}.png")))
                 .unwrap()
                 .to_rgb8()
         })
@@ -399,7 +420,10 @@ fn render_draws_frames_and_directories() {
     assert!(first.len() > 100, "{}", first.len());
     let last = edge(&pictures[4]);
     assert!(last.is_subset(&first), "the view moved");
-    // --range and --bounds, and a movie (an animated GIF where ffmpeg is missing).
+}
+
+/// --range and --bounds, and a movie (an animated GIF where ffmpeg is missing).
+fn renders_a_movie_in_a_fixed_box(dir: &Path) {
     let o = common::tinydem_with_env(
         &[
             "render",
@@ -417,7 +441,7 @@ fn render_draws_frames_and_directories() {
             "--height",
             "150",
         ],
-        t.path(),
+        dir,
         &[("PATH", "/nonexistent")],
     );
     assert!(o.status.success(), "{}", stderr(&o));
@@ -426,9 +450,9 @@ fn render_draws_frames_and_directories() {
         "{}",
         stderr(&o)
     );
-    assert!(t.path().join("pics/animation.gif").exists());
+    assert!(dir.join("pics/animation.gif").exists());
     fails_with(
-        &tinydem(&["render", "out", "--range", "5,1"], t.path()),
+        &tinydem(&["render", "out", "--range", "5,1"], dir),
         &["--range 5,1"],
     );
     // With the system's ffmpeg (CI installs it), an MP4.
@@ -437,24 +461,13 @@ fn render_draws_frames_and_directories() {
         .output()
         .is_ok_and(|o| o.status.success());
     if ffmpeg {
-        let o = tinydem(&["render", "out", "-o", "movie", "--movie"], t.path());
+        let o = tinydem(&["render", "out", "-o", "movie", "--movie"], dir);
         assert!(o.status.success(), "{}", stderr(&o));
-        let mp4 = std::fs::read(t.path().join("movie/animation.mp4")).unwrap();
+        let mp4 = std::fs::read(dir.join("movie/animation.mp4")).unwrap();
         assert_eq!(&mp4[4..8], b"ftyp", "an MP4 file");
     } else {
         eprintln!("no ffmpeg: the MP4 path is not tested here");
     }
-    fails_with(
-        &tinydem(&["render", "nope.csv"], t.path()),
-        &["cannot read particle file nope.csv"],
-    );
-    fails_with(
-        &tinydem(
-            &["render", "out/particles000004.csv", "--width", "0"],
-            t.path(),
-        ),
-        &["picture size 0x600"],
-    );
 }
 
 #[test]

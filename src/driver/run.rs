@@ -135,15 +135,7 @@ pub fn run_on(
     let total_steps = scenario.simulation.frames * steps_per_frame;
     let mut checkpoints = Checkpoints::of(&scenario);
     let (mut sim, notes) = open_on(scenario, &options, comm)?;
-    let writer = sim.is_writer();
-    let options = Options {
-        verbosity: if writer {
-            options.verbosity
-        } else {
-            Verbosity::Quiet
-        },
-        ..options
-    };
+    let options = quiet_unless_writer(options, &sim);
     if options.verbosity == Verbosity::Normal
         && let Some(path) = options.from
     {
@@ -152,8 +144,55 @@ pub fn run_on(
     if !options.force {
         refuse(&sim, output_dir)?;
     }
-    let _lock = sim.agree(
-        writer
+    let _lock = lock_output(&sim, output_dir, &options)?;
+    let start = Instant::now();
+    let mut record = Record::open(output_dir, &sim, &options, total_steps)?;
+    if options.resume.is_none() {
+        record.frame(&mut sim, 0)?;
+    }
+    while sim.steps < total_steps {
+        if let Err(unstable) = sim.step() {
+            return Err(unstable_error(
+                &unstable,
+                output_dir,
+                &sim,
+                record.out.extra,
+            ));
+        }
+        if sim.steps.is_multiple_of(steps_per_frame) {
+            let t = Instant::now();
+            let frame = sim.steps / steps_per_frame;
+            record.frame(&mut sim, frame)?;
+            checkpoints.after_frame(output_dir, &sim, frame)?;
+            record.output_seconds += t.elapsed().as_secs_f64();
+        }
+        checkpoints.timed(output_dir, &sim)?;
+        record.status.progress(sim.steps);
+        if let Some(keep) = checkpoints.asked(output_dir, &sim, options.requests)? {
+            record.status.abandon();
+            return Err(stop(output_dir, &sim, record.out.extra, keep)?.into());
+        }
+    }
+    record.finish(output_dir, &sim, start)
+}
+
+/// `options`, silenced on the processes that do not write.
+fn quiet_unless_writer<'a>(options: Options<'a>, sim: &Simulation) -> Options<'a> {
+    Options {
+        verbosity: if sim.is_writer() {
+            options.verbosity
+        } else {
+            Verbosity::Quiet
+        },
+        ..options
+    }
+}
+
+/// The lock on the output directory, held by the writer for the run (collective), with
+/// the output of an earlier run cleared or refused first unless resuming.
+fn lock_output(sim: &Simulation, output_dir: &Path, options: &Options) -> Result<Option<Lock>> {
+    sim.agree(
+        sim.is_writer()
             .then(|| -> Result<Lock> {
                 let lock = take_output(output_dir)?;
                 if options.resume.is_none() {
@@ -162,70 +201,80 @@ pub fn run_on(
                 Ok(lock)
             })
             .transpose(),
-    )?;
-    let start = Instant::now();
-    let out = Frames::of(output_dir, &sim);
-    sim.agree(out.start(&sim))?;
-    let mut output_seconds = 0.0;
-    // The logs, continued after the checkpoint's last complete frame when resuming.
-    let resumed_at = options.resume.map(|_| sim.steps / steps_per_frame);
-    let logs = writer
-        .then(|| Logs::open(output_dir, &sim.scenario, resumed_at))
-        .transpose();
-    let mut logs = sim.agree(logs)?;
-    let mut status = Status::new(options.verbosity, total_steps, sim.steps);
-    let mut frames_written = 0;
-    if options.resume.is_none() {
-        let written = out.write(0, &sim);
+    )
+}
+
+/// What a run writes as it goes (frames, logs, status) and how much of it.
+struct Record<'a> {
+    out: Frames<'a>,
+    logs: Option<Logs>,
+    status: Status,
+    frames_written: u64,
+    /// Wall time spent writing frames and checkpoints.
+    output_seconds: f64,
+}
+
+impl<'a> Record<'a> {
+    /// The record of `sim`'s run into `output_dir` (collective), with the logs continued
+    /// after the checkpoint's last complete frame when resuming.
+    fn open(
+        output_dir: &'a Path,
+        sim: &Simulation,
+        options: &Options,
+        total_steps: u64,
+    ) -> Result<Record<'a>> {
+        let out = Frames::of(output_dir, sim);
+        sim.agree(out.start(sim))?;
+        let steps_per_frame = sim.scenario.simulation.steps_per_frame;
+        let resumed_at = options.resume.map(|_| sim.steps / steps_per_frame);
+        let logs = sim
+            .is_writer()
+            .then(|| Logs::open(output_dir, &sim.scenario, resumed_at))
+            .transpose();
+        let logs = sim.agree(logs)?;
+        Ok(Record {
+            out,
+            logs,
+            status: Status::new(options.verbosity, total_steps, sim.steps),
+            frames_written: 0,
+            output_seconds: 0.0,
+        })
+    }
+
+    /// Frame `frame`: its files, its lines in the logs and its status line (collective).
+    fn frame(&mut self, sim: &mut Simulation, frame: u64) -> Result<()> {
+        let written = self.out.write(frame, sim);
         sim.agree(written)?;
-        frames_written += 1;
-        let logged = Logs::frame(logs.as_mut(), &mut sim, 0);
+        self.frames_written += 1;
+        let logged = Logs::frame(self.logs.as_mut(), sim, frame);
         let th = sim.agree(logged)?;
-        status.frame(&mut sim, 0, &th);
+        self.status.frame(sim, frame, &th);
+        Ok(())
     }
-    while sim.steps < total_steps {
-        if let Err(unstable) = sim.step() {
-            return Err(unstable_error(&unstable, output_dir, &sim, out.extra));
+
+    /// The end of a complete run: its last checkpoint, so that it can be extended or
+    /// staged, and its summary.
+    fn finish(mut self, output_dir: &Path, sim: &Simulation, start: Instant) -> Result<Summary> {
+        self.status.finish();
+        let t = Instant::now();
+        save_checkpoint(output_dir, sim)?;
+        self.output_seconds += t.elapsed().as_secs_f64();
+        if sim.is_writer() {
+            let _ = std::fs::remove_file(output_dir.join(INTERRUPTED));
         }
-        if sim.steps.is_multiple_of(steps_per_frame) {
-            let t = Instant::now();
-            let frame = sim.steps / steps_per_frame;
-            let written = out.write(frame, &sim);
-            sim.agree(written)?;
-            let logged = Logs::frame(logs.as_mut(), &mut sim, frame);
-            let th = sim.agree(logged)?;
-            frames_written += 1;
-            status.frame(&mut sim, frame, &th);
-            checkpoints.after_frame(output_dir, &sim, frame)?;
-            output_seconds += t.elapsed().as_secs_f64();
-        }
-        checkpoints.timed(output_dir, &sim)?;
-        status.progress(sim.steps);
-        if let Some(keep) = checkpoints.asked(output_dir, &sim, options.requests)? {
-            status.abandon();
-            return Err(stop(output_dir, &sim, out.extra, keep)?.into());
-        }
+        Ok(Summary {
+            frames_written: self.frames_written,
+            particles: sim.particle_count(),
+            steps: sim.steps,
+            rebuilds: sim.rebuilds(),
+            wall_seconds: start.elapsed().as_secs_f64(),
+            stage_times: sim.stage_times.clone(),
+            output_seconds: self.output_seconds,
+            warnings: sim.warnings().count(),
+            advice: sim.advice(),
+            removed: sim.removed.clone(),
+        })
     }
-    status.finish();
-    // Every run ends with a checkpoint, so that it can be extended or staged.
-    let t = Instant::now();
-    save_checkpoint(output_dir, &sim)?;
-    output_seconds += t.elapsed().as_secs_f64();
-    if writer {
-        let _ = std::fs::remove_file(output_dir.join(INTERRUPTED));
-    }
-    Ok(Summary {
-        frames_written,
-        particles: sim.particle_count(),
-        steps: sim.steps,
-        rebuilds: sim.rebuilds(),
-        wall_seconds: start.elapsed().as_secs_f64(),
-        stage_times: sim.stage_times.clone(),
-        output_seconds,
-        warnings: sim.warnings().count(),
-        advice: sim.advice(),
-        removed: sim.removed.clone(),
-    })
 }
 
 /// The simulation of `scenario` as [`open`] makes it, split over `comm`'s processes when

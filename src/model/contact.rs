@@ -358,6 +358,9 @@ impl ContactLaw {
     /// Evaluates the contact of particle `i` (radius `radius_i`, mass `m_i`) with body
     /// `other` with the pair's coefficients `coef`, updating the friction springs for the
     /// next time step. One contact, or several in lanes.
+    // Kept whole: it reads top to bottom as Section 2.2, Eq. 11 to Eq. 45, and a split
+    // would scatter the law over helpers that each carry most of its inputs.
+    #[allow(clippy::too_many_lines)]
     #[inline(always)]
     pub fn evaluate<T>(
         &self,

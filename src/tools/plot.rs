@@ -28,99 +28,183 @@ pub fn line_plot(points: &[(f64, f64)], width: u32, height: u32, axes: &Axes) ->
     if pts.is_empty() {
         bail!("nothing to plot: the column has no finite values");
     }
-    let range = |f: fn(&(f64, f64)) -> f64| {
-        let (lo, hi) = pts
-            .iter()
-            .map(f)
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-                (a.min(v), b.max(v))
-            });
-        if hi > lo {
-            (lo, hi)
-        } else {
-            let pad = if lo == 0.0 { 1.0 } else { 0.1 * lo.abs() };
-            (lo - pad, hi + pad)
-        }
-    };
-    let (t0, t1) = range(|p| p.0);
-    let (y0, y1) = range(|p| p.1);
-    // A little room above and below the line.
-    let (y0, y1) = (y0 - 0.04 * (y1 - y0), y1 + 0.04 * (y1 - y0));
-    let scale = (height / 300).clamp(1, 4);
-    let s = scale as i64;
-    let y_ticks = text::ticks(y0, y1, 5);
-    let label_width = y_ticks
-        .iter()
-        .map(|v| text::width(&text::number(*v), scale))
-        .max()
-        .unwrap_or(0);
-    let (l, r) = (label_width + 16 * s, width as i64 - 16 * s);
-    let (top, bottom) = (28 * s, height as i64 - 38 * s);
-    if r <= l + 20 || bottom <= top + 20 {
-        bail!("plot size {width}x{height} is too small");
-    }
+    let plot = Area::of(&pts, width, height)?;
     let mut img = RgbImage::from_pixel(width, height, Rgb([255, 255, 255]));
-    let px = |t: f64| l as f64 + (t - t0) / (t1 - t0) * (r - l) as f64;
-    let py = |y: f64| bottom as f64 - (y - y0) / (y1 - y0) * (bottom - top) as f64;
-    // Grid and ticks with their values.
-    for v in &y_ticks {
-        let y = py(*v).round() as i64;
-        for x in l..=r {
-            put(&mut img, x, y, GRID);
-        }
-        for x in l - 4 * s..l {
-            put(&mut img, x, y, BLACK);
-        }
-        let label = text::number(*v);
-        let w = text::width(&label, scale);
-        text::draw(&mut img, l - 6 * s - w, y - 4 * s, &label, scale, BLACK);
+    plot.y_grid(&mut img);
+    plot.t_grid(&mut img);
+    plot.frame(&mut img);
+    plot.line(&mut img, &pts);
+    plot.titles(&mut img, axes);
+    Ok(img)
+}
+
+/// The range of `f` over `pts`, widened when it is a single value.
+fn range(pts: &[(f64, f64)], f: fn(&(f64, f64)) -> f64) -> (f64, f64) {
+    let (lo, hi) = pts
+        .iter()
+        .map(f)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
+    if hi > lo {
+        (lo, hi)
+    } else {
+        let pad = if lo == 0.0 { 1.0 } else { 0.1 * lo.abs() };
+        (lo - pad, hi + pad)
     }
-    for v in text::ticks(t0, t1, 6) {
-        let x = px(v).round() as i64;
-        for y in top..=bottom {
-            put(&mut img, x, y, GRID);
+}
+
+/// The plot area of a picture: where it lies in pixels, and the data ranges it shows.
+struct Area {
+    /// The left, right, top and bottom edges [px].
+    l: i64,
+    r: i64,
+    top: i64,
+    bottom: i64,
+    t: (f64, f64),
+    y: (f64, f64),
+    /// The y values with a tick.
+    y_ticks: Vec<f64>,
+    /// The size of text and lines: one per 300 pixels of height.
+    scale: u32,
+}
+
+impl Area {
+    /// The area for `pts` on a `width` x `height` picture, with room for the tick values
+    /// and titles around it.
+    fn of(pts: &[(f64, f64)], width: u32, height: u32) -> Result<Area> {
+        let t = range(pts, |p| p.0);
+        let (y0, y1) = range(pts, |p| p.1);
+        // A little room above and below the line.
+        let y = (y0 - 0.04 * (y1 - y0), y1 + 0.04 * (y1 - y0));
+        let scale = (height / 300).clamp(1, 4);
+        let s = scale as i64;
+        let y_ticks = text::ticks(y.0, y.1, 5);
+        let label_width = y_ticks
+            .iter()
+            .map(|v| text::width(&text::number(*v), scale))
+            .max()
+            .unwrap_or(0);
+        let (l, r) = (label_width + 16 * s, width as i64 - 16 * s);
+        let (top, bottom) = (28 * s, height as i64 - 38 * s);
+        if r <= l + 20 || bottom <= top + 20 {
+            bail!("plot size {width}x{height} is too small");
         }
-        for y in bottom..bottom + 4 * s {
-            put(&mut img, x, y, BLACK);
+        Ok(Area {
+            l,
+            r,
+            top,
+            bottom,
+            t,
+            y,
+            y_ticks,
+            scale,
+        })
+    }
+
+    fn s(&self) -> i64 {
+        self.scale as i64
+    }
+
+    /// The pixel column of time `t`.
+    fn px(&self, t: f64) -> f64 {
+        let (t0, t1) = self.t;
+        self.l as f64 + (t - t0) / (t1 - t0) * (self.r - self.l) as f64
+    }
+
+    /// The pixel row of value `y`.
+    fn py(&self, y: f64) -> f64 {
+        let (y0, y1) = self.y;
+        self.bottom as f64 - (y - y0) / (y1 - y0) * (self.bottom - self.top) as f64
+    }
+
+    /// The grid lines across at the y ticks, with their ticks and values on the left.
+    fn y_grid(&self, img: &mut RgbImage) {
+        let s = self.s();
+        for v in &self.y_ticks {
+            let y = self.py(*v).round() as i64;
+            for x in self.l..=self.r {
+                put(img, x, y, GRID);
+            }
+            for x in self.l - 4 * s..self.l {
+                put(img, x, y, BLACK);
+            }
+            let label = text::number(*v);
+            let w = text::width(&label, self.scale);
+            text::draw(
+                img,
+                self.l - 6 * s - w,
+                y - 4 * s,
+                &label,
+                self.scale,
+                BLACK,
+            );
         }
-        let label = text::number(v);
-        let w = text::width(&label, scale);
-        text::draw(&mut img, x - w / 2, bottom + 7 * s, &label, scale, BLACK);
     }
-    // The frame of the plot area.
-    for x in l..=r {
-        put(&mut img, x, top, BLACK);
-        put(&mut img, x, bottom, BLACK);
+
+    /// The grid lines up at the time ticks, with their ticks and values below.
+    fn t_grid(&self, img: &mut RgbImage) {
+        let s = self.s();
+        for v in text::ticks(self.t.0, self.t.1, 6) {
+            let x = self.px(v).round() as i64;
+            for y in self.top..=self.bottom {
+                put(img, x, y, GRID);
+            }
+            for y in self.bottom..self.bottom + 4 * s {
+                put(img, x, y, BLACK);
+            }
+            let label = text::number(v);
+            let w = text::width(&label, self.scale);
+            text::draw(
+                img,
+                x - w / 2,
+                self.bottom + 7 * s,
+                &label,
+                self.scale,
+                BLACK,
+            );
+        }
     }
-    for y in top..=bottom {
-        put(&mut img, l, y, BLACK);
-        put(&mut img, r, y, BLACK);
+
+    /// The frame around the area.
+    fn frame(&self, img: &mut RgbImage) {
+        for x in self.l..=self.r {
+            put(img, x, self.top, BLACK);
+            put(img, x, self.bottom, BLACK);
+        }
+        for y in self.top..=self.bottom {
+            put(img, self.l, y, BLACK);
+            put(img, self.r, y, BLACK);
+        }
     }
-    for w in pts.windows(2) {
-        let (ax, ay, bx, by) = (px(w[0].0), py(w[0].1), px(w[1].0), py(w[1].1));
-        let n = ((bx - ax).abs().max((by - ay).abs()).ceil() as usize).max(1);
-        for k in 0..=n {
-            let f = k as f64 / n as f64;
-            let (x, y) = (ax + f * (bx - ax), ay + f * (by - ay));
-            for dy in 0..s.max(2) {
-                for dx in 0..s.max(2) {
-                    put(&mut img, x as i64 + dx, y as i64 + dy, LINE);
+
+    /// The line through `pts`, at least two pixels thick.
+    fn line(&self, img: &mut RgbImage, pts: &[(f64, f64)]) {
+        let thick = self.s().max(2);
+        for w in pts.windows(2) {
+            let (ax, ay) = (self.px(w[0].0), self.py(w[0].1));
+            let (bx, by) = (self.px(w[1].0), self.py(w[1].1));
+            let n = ((bx - ax).abs().max((by - ay).abs()).ceil() as usize).max(1);
+            for k in 0..=n {
+                let f = k as f64 / n as f64;
+                let (x, y) = (ax + f * (bx - ax), ay + f * (by - ay));
+                for dy in 0..thick {
+                    for dx in 0..thick {
+                        put(img, x as i64 + dx, y as i64 + dy, LINE);
+                    }
                 }
             }
         }
     }
-    // Axis titles: y above the axis, x centred below the tick values.
-    text::draw(&mut img, l, top - 14 * s, axes.y, scale, BLACK);
-    let w = text::width(axes.x, scale);
-    text::draw(
-        &mut img,
-        (l + r) / 2 - w / 2,
-        bottom + 22 * s,
-        axes.x,
-        scale,
-        BLACK,
-    );
-    Ok(img)
+
+    /// The axis titles: y above the axis, x centred below the tick values.
+    fn titles(&self, img: &mut RgbImage, axes: &Axes) {
+        let s = self.s();
+        text::draw(img, self.l, self.top - 14 * s, axes.y, self.scale, BLACK);
+        let w = text::width(axes.x, self.scale);
+        let x = (self.l + self.r) / 2 - w / 2;
+        text::draw(img, x, self.bottom + 22 * s, axes.x, self.scale, BLACK);
+    }
 }
 
 #[cfg(test)]

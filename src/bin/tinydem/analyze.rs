@@ -1,0 +1,261 @@
+//! `tinydem analyze`: a table of measurements of every frame of an output directory, on
+//! stdout and optionally as CSV, and one of its columns plotted against time.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use clap::Args;
+
+use tinydem::analyze::{
+    NoPile, ReposeWindow, angle_of_repose, coordination_number, kinetic_energy,
+    mean_height_of_large, packing_fraction,
+};
+use tinydem::particles::Particles;
+use tinydem::scenario::Scenario;
+
+#[derive(Args)]
+pub struct AnalyzeArgs {
+    /// Output directory with frames particlesNNNNNN.csv.
+    dir: PathBuf,
+    /// The run's scenario, for frame times and the density.
+    #[arg(long)]
+    scenario: Option<PathBuf>,
+    /// Fit the angle of repose of a pile in the x-z plane (both flanks, with errors): the
+    /// resting grains' surface, from 3 to 30 diameters below the apex (see --window).
+    #[arg(long)]
+    repose: bool,
+    /// With --repose: grains slower than this rest [m/s]; only they make the pile.
+    #[arg(long, default_value_t = 0.01, requires = "repose")]
+    rest_speed: f64,
+    /// With --repose: the fitted part of each flank, FROM,TO grain diameters below the apex
+    /// (leaving out the rounded apex and the curved foot).
+    #[arg(
+        long,
+        value_name = "FROM,TO",
+        value_delimiter = ',',
+        requires = "repose"
+    )]
+    window: Option<Vec<f64>>,
+    /// Report the mean height of the particles with at least this radius.
+    #[arg(long)]
+    large: Option<f64>,
+    /// Report the number and mean height of the particles with this tag.
+    #[arg(long)]
+    tag: Option<u32>,
+    /// Also write the table as CSV to this file.
+    #[arg(long)]
+    csv: Option<PathBuf>,
+    /// Also plot one column against time as a PNG (see --column).
+    #[arg(long)]
+    plot: Option<PathBuf>,
+    /// The column to plot (a name from the table's header).
+    #[arg(long, default_value = "kinetic_energy")]
+    column: String,
+}
+
+impl AnalyzeArgs {
+    /// Measures every frame, printing a row each, then writes the CSV and the plot.
+    pub fn execute(self) -> Result<()> {
+        let repose = self
+            .repose
+            .then(|| ReposeWindow::of(self.rest_speed, self.window.as_deref()))
+            .transpose()?;
+        let s = match self
+            .scenario
+            .or_else(|| tinydem::output::run_toml(&self.dir))
+        {
+            Some(p) => Scenario::load(&p)?,
+            None => Scenario::parse("", Path::new("defaults"))?,
+        };
+        let frames = frames_in(&self.dir)?;
+        let table = Table {
+            frame_time: s.simulation.steps_per_frame as f64 * s.simulation.timestep,
+            densities: s.materials.iter().map(|m| m.properties.density).collect(),
+            repose,
+            large: self.large,
+            tag: self.tag,
+        };
+        let header = table.header();
+        println!("{}", aligned(&header));
+        let mut rows = Vec::new();
+        let mut no_pile = Vec::new();
+        let count = frames.len();
+        for (k, path) in frames {
+            let p = tinydem::csv::load_particles(&path)?;
+            let row = table.row(k, &p, &mut no_pile);
+            println!("{}", aligned(&row));
+            rows.push(row.join(","));
+        }
+        if let (Some(w), Some((k, why))) = (repose, no_pile.last()) {
+            eprintln!(
+                "note: --repose found no pile in {} of {count} frames (nan), e.g. frame {k}: \
+                 {why}. It fits the surface of the grains slower than {} m/s, {} to {} \
+                 diameters below the highest, on both sides (--rest-speed, --window)",
+                no_pile.len(),
+                w.rest_speed,
+                w.from,
+                w.to
+            );
+        }
+        if let Some(path) = self.csv {
+            std::fs::write(
+                &path,
+                format!("{}\n{}\n", header.join(","), rows.join("\n")),
+            )
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        }
+        if let Some(path) = self.plot {
+            plot(&header, &rows, &path, &self.column)?;
+        }
+        Ok(())
+    }
+}
+
+/// The frames `particlesNNNNNN.csv` in `dir`, by number.
+fn frames_in(dir: &Path) -> Result<Vec<(u64, PathBuf)>> {
+    let mut frames: Vec<(u64, PathBuf)> = std::fs::read_dir(dir)
+        .with_context(|| format!("cannot read directory {}", dir.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter_map(|p| {
+            let k = p
+                .file_name()?
+                .to_str()?
+                .strip_prefix("particles")?
+                .strip_suffix(".csv")?
+                .parse()
+                .ok()?;
+            Some((k, p))
+        })
+        .collect();
+    frames.sort();
+    anyhow::ensure!(
+        !frames.is_empty(),
+        "{}: no frames particlesNNNNNN.csv",
+        dir.display()
+    );
+    Ok(frames)
+}
+
+/// The values of a row, right-aligned in columns 17 wide.
+fn aligned<T: std::fmt::Display>(row: &[T]) -> String {
+    row.iter().map(|v| format!("{v:>17}")).collect()
+}
+
+/// What the table measures of each frame.
+struct Table {
+    /// Simulated time between frames.
+    frame_time: f64,
+    /// The density of each material.
+    densities: Vec<f64>,
+    repose: Option<ReposeWindow>,
+    large: Option<f64>,
+    tag: Option<u32>,
+}
+
+impl Table {
+    /// The names of the columns.
+    fn header(&self) -> Vec<&'static str> {
+        let mut header = vec![
+            "frame",
+            "time",
+            "particles",
+            "kinetic_energy",
+            "coordination",
+            "packing_fraction",
+        ];
+        if self.repose.is_some() {
+            header.extend([
+                "repose_left_deg",
+                "repose_left_err_deg",
+                "repose_right_deg",
+                "repose_right_err_deg",
+            ]);
+        }
+        if self.large.is_some() {
+            header.push("large_mean_height");
+        }
+        if self.tag.is_some() {
+            header.extend(["tagged", "tagged_mean_height"]);
+        }
+        header
+    }
+
+    /// The row of frame `k` with particles `p`; a frame with no pile to fit is added to
+    /// `no_pile` with the reason.
+    fn row(&self, k: u64, p: &Particles, no_pile: &mut Vec<(u64, NoPile)>) -> Vec<String> {
+        let mut row = vec![
+            k.to_string(),
+            format!("{:.6e}", k as f64 * self.frame_time),
+            p.len().to_string(),
+            format!("{:.6e}", kinetic_energy(p, &self.densities)),
+            format!("{:.4}", coordination_number(p)),
+            format!("{:.4}", packing_fraction(p)),
+        ];
+        if let Some(w) = self.repose {
+            match angle_of_repose(p, w) {
+                Ok(a) => row.extend(
+                    [a.left.angle, a.left.error, a.right.angle, a.right.error]
+                        .map(|v| format!("{v:.2}")),
+                ),
+                Err(why) => {
+                    no_pile.push((k, why));
+                    row.extend(["nan"; 4].map(String::from))
+                }
+            }
+        }
+        if let Some(r) = self.large {
+            row.push(mean_height_of_large(p, r).map_or("nan".into(), |z| format!("{z:.6e}")));
+        }
+        if let Some(t) = self.tag {
+            let z: Vec<f64> = (0..p.len())
+                .filter(|&k| p.tag[k] == t)
+                .map(|k| p.x[k].z)
+                .collect();
+            row.push(z.len().to_string());
+            row.push(if z.is_empty() {
+                "nan".into()
+            } else {
+                format!("{:.6e}", z.iter().sum::<f64>() / z.len() as f64)
+            });
+        }
+        row
+    }
+}
+
+/// Plots `column` of the table (`header`, CSV `rows`) against time into the PNG `path`.
+fn plot(header: &[&str], rows: &[String], path: &Path, column: &str) -> Result<()> {
+    let Some(c) = header.iter().position(|h| *h == column) else {
+        anyhow::bail!(
+            "--column {column}: not a column of this table ({})",
+            header.join(", ")
+        );
+    };
+    let points: Vec<(f64, f64)> = rows
+        .iter()
+        .map(|r| {
+            let v: Vec<&str> = r.split(',').collect();
+            (
+                v[1].parse().unwrap_or(f64::NAN),
+                v[c].parse().unwrap_or(f64::NAN),
+            )
+        })
+        .collect();
+    let unit = match column {
+        "time" => " [s]",
+        "kinetic_energy" => " [J]",
+        "large_mean_height" | "tagged_mean_height" => " [m]",
+        c if c.starts_with("repose_") => " [°]",
+        "coordination" => " [contacts per particle]",
+        _ => "",
+    };
+    let y = format!("{column}{unit}");
+    let axes = tinydem::plot::Axes {
+        x: "time [s]",
+        y: &y,
+    };
+    tinydem::plot::line_plot(&points, 800, 500, &axes)?
+        .save(path)
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    eprintln!("plot of {column} against time in {}", path.display());
+    Ok(())
+}

@@ -1,0 +1,202 @@
+//! The `tinydem` command line: its arguments, and the processes and threads a command
+//! runs on; each command in a module of its own.
+
+mod analyze;
+mod bench;
+mod render;
+mod run;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{Context, Result};
+use clap::{Args, Parser, Subcommand};
+
+use tinydem::check::{describe, describe_stage};
+use tinydem::comm::Comm;
+use tinydem::run::Interrupted;
+use tinydem::scenario::Scenario;
+
+use run::DefaultRun;
+
+/// A granular DEM simulator (the model of the TinyDEM paper). With no arguments, runs the
+/// paper's default simulation: 1000 particles falling through an hourglass, into ./output.
+#[derive(Parser)]
+#[command(version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+    /// Number of worker threads (default: all cores; under mpirun, the cores shared among
+    /// the processes of this machine).
+    #[arg(long, global = true)]
+    threads: Option<usize>,
+    /// Continue the interrupted default run from its checkpoint.
+    #[arg(long)]
+    resume: Option<PathBuf>,
+    /// Replace the output of an earlier default run in ./output.
+    #[arg(long)]
+    overwrite: bool,
+    /// Run the default simulation even if `check` would refuse it.
+    #[arg(long)]
+    force: bool,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run a scenario file.
+    Run(run::RunArgs),
+    /// Validate a scenario and print derived quantities.
+    Check(CheckArgs),
+    /// Measure every frame of an output directory: kinetic energy, coordination number,
+    /// packing fraction; optionally the angle of repose and the height of large particles.
+    Analyze(analyze::AnalyzeArgs),
+    /// Draw a frame (CSV) as a PNG picture, or every frame of an output directory.
+    Render(render::RenderArgs),
+    /// The dense-packing benchmark of the paper's Section 5: timed steps in settled
+    /// packings; each size and thread count runs in its own process.
+    Bench(bench::BenchArgs),
+}
+
+#[derive(Args)]
+struct CheckArgs {
+    scenario: PathBuf,
+    /// Also say what the scenario changes as a stage after this checkpoint.
+    #[arg(long)]
+    from: Option<PathBuf>,
+    /// The output directory the run would use (for its free space; default [output] dir).
+    #[arg(long, short)]
+    output: Option<PathBuf>,
+}
+
+impl CheckArgs {
+    /// Prints what the run of the scenario would be, or the error that refuses it.
+    fn execute(self) -> Result<()> {
+        let s = Scenario::load(&self.scenario)?;
+        let out = self.output.unwrap_or_else(|| s.output_dir.clone());
+        match self.from {
+            None => print!("{}", describe(&s, &out)?),
+            Some(from) => print!("{}", describe_stage(&s, &from, &out)?),
+        }
+        Ok(())
+    }
+}
+
+/// Large allocations (1 MiB and up) go straight to the operating system and back. glibc
+/// otherwise raises that threshold to the size of the largest block freed: the neighbour
+/// lists, tens of megabytes freed and made again at every rebuild, then come from a heap
+/// that fragments and never shrinks (a 10^5 benchmark grew from 540 to 1,190 bytes per
+/// particle over seven rebuilds; with the fixed threshold it stays at 550).
+fn fix_mmap_threshold() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    // SAFETY: mallopt only sets an allocator parameter; called before any thread starts.
+    unsafe {
+        libc::mallopt(libc::M_MMAP_THRESHOLD, 1 << 20);
+    }
+}
+
+fn main() -> ExitCode {
+    fix_mmap_threshold();
+    let cli = Cli::parse();
+    // Under mpirun, the first process speaks for all (they fail alike, see `domain::agree`).
+    let first = tinydem::comm::launched().is_none_or(|(_, rank)| rank == 0);
+    // Held to the end, after the last words: only then may the other processes exit
+    // (see `Finalize`).
+    let (world, _finalize) = match world() {
+        Ok(w) => w,
+        Err(e) => return last_words(first, Err(e)),
+    };
+    last_words(first, real_main(cli, world))
+}
+
+/// Prints how the command ended (from the first process only) and gives the exit code.
+fn last_words(first: bool, outcome: Result<()>) -> ExitCode {
+    match outcome {
+        Ok(()) => ExitCode::SUCCESS,
+        // Said by the run as soon as its checkpoint was complete.
+        Err(e) if e.downcast_ref::<Interrupted>().is_some() => ExitCode::from(130),
+        Err(e) => {
+            if first {
+                eprintln!("error: {e:#}");
+            }
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// Holds MPI initialized until dropped (nothing without the `mpi` feature).
+#[cfg(feature = "mpi")]
+type Finalize = Option<tinydem::comm::Finalize>;
+#[cfg(not(feature = "mpi"))]
+type Finalize = ();
+
+/// The processes a run is split over when started by an MPI launcher (in a build with the
+/// `mpi` feature); none otherwise.
+fn world() -> Result<(Option<Box<dyn Comm>>, Finalize)> {
+    let Some((size, _)) = tinydem::comm::launched() else {
+        return Ok((None, Finalize::default()));
+    };
+    #[cfg(feature = "mpi")]
+    {
+        let _ = size;
+        let (comm, finalize) = tinydem::comm::Mpi::init()?;
+        let comm: Box<dyn Comm> = Box::new(comm);
+        Ok((Some(comm), Some(finalize)))
+    }
+    #[cfg(not(feature = "mpi"))]
+    {
+        anyhow::ensure!(
+            size <= 1,
+            "started as one of {size} processes, but this tinydem was built without MPI: \
+             build it with `cargo build --release --features mpi` (needs an MPI library, \
+             e.g. Debian's libopenmpi-dev, and libclang-dev)"
+        );
+        Ok((None, ()))
+    }
+}
+
+fn real_main(cli: Cli, world: Option<Box<dyn Comm>>) -> Result<()> {
+    let mut pool = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = cli.threads {
+        anyhow::ensure!(n >= 1, "--threads must be at least 1");
+        pool = pool.num_threads(n);
+    } else if world.is_some() {
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        pool = pool.num_threads((cores / tinydem::comm::processes_on_this_node()).max(1));
+    }
+    // The time loop runs on a worker of the pool, so that small parallel loops run inline
+    // instead of waking another thread for every stage.
+    let pool = pool.build().context("cannot start the thread pool")?;
+    let default = DefaultRun {
+        resume: cli.resume,
+        overwrite: cli.overwrite,
+        force: cli.force,
+    };
+    pool.install(|| execute(cli.command, default, world))
+}
+
+/// Runs `command` (the default run when there is none) on the processes of `world`.
+fn execute(
+    command: Option<Command>,
+    default: DefaultRun,
+    world: Option<Box<dyn Comm>>,
+) -> Result<()> {
+    let first = world.as_ref().is_none_or(|c| c.rank() == 0);
+    // Under mpirun, a command that does not step a simulation runs on the first process
+    // only: the others would do the same work and write the same files at the same time.
+    let splits = match &command {
+        None | Some(Command::Run(_)) => true,
+        Some(Command::Bench(b)) => b.single,
+        _ => false,
+    };
+    if !first && !splits {
+        return Ok(());
+    }
+    match command {
+        None => default.execute(world, first),
+        Some(Command::Run(args)) => args.execute(world, first),
+        Some(Command::Bench(args)) => args.execute(world, first),
+        Some(Command::Render(args)) => args.execute(),
+        Some(Command::Analyze(args)) => args.execute(),
+        Some(Command::Check(args)) => args.execute(),
+    }
+}
