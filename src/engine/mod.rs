@@ -30,8 +30,11 @@ use crate::parallel::domain::Domain;
 mod advance;
 mod checks;
 mod faces;
+mod loads;
+mod meshes;
 mod pairs;
 pub mod records;
+mod regions;
 mod report;
 pub mod setup;
 pub mod spawn;
@@ -40,80 +43,14 @@ use crate::engine::spawn::{Spawner, SpawnerState};
 use crate::geometry::surface::{self, Candidate, Fate};
 use crate::model::springs::Springs;
 use crate::scenario::Scenario;
+use loads::Load;
+pub use loads::LoadScales;
+pub use meshes::MeshFile;
+use meshes::{MovingPart, STATIC};
 
 /// Contacts per group evaluated together: 8 doubles fill an AVX-512 register, two AVX ones.
 const WIDTH: usize = 8;
 type Group = wide::f64x8;
-
-/// Force (components 0-2) and torque (3-5) on one particle, summed over its contacts during
-/// a step (Eqs. 1-2), exactly (`exact.rs`): the same bits in whatever order the contacts add
-/// to it.
-type Load = Sum6;
-
-/// The resolutions of the force and torque sums, from the largest force and torque the
-/// scenario's materials and radii can produce (see [`LoadScales::of`]).
-#[derive(Clone, Copy, Debug)]
-pub struct LoadScales {
-    pub force: Scale,
-    pub torque: Scale,
-    /// Of a load's components.
-    lanes: Scales8,
-}
-
-impl LoadScales {
-    /// The largest radius the scenario's particles can have.
-    fn largest_radius(s: &Scenario) -> f64 {
-        let mut r_max = s.geometry.radius_max;
-        for region in &s.spawn {
-            r_max = r_max.max(region.radius.largest());
-        }
-        r_max
-    }
-
-    /// Room above the largest total load of one step on a wall: 2^20 contacts of the
-    /// largest force (far more than the grains' weight); torques with the lever `lever`.
-    const WALL_ROOM: f64 = 1048576.0;
-
-    /// The scales of a step's loads on the walls, for torques about points at most `lever`
-    /// from the particles.
-    fn walls(&self, lever: f64) -> Scales8 {
-        let largest = LoadScales::WALL_ROOM * self.force.largest();
-        let (force, torque) = (
-            Scale::for_largest(largest),
-            Scale::for_largest((largest * lever).max(f64::MIN_POSITIVE)),
-        );
-        Scales8::new([force, force, force, torque, torque, torque, force, force])
-    }
-
-    /// Room above the largest force of a contact, E* R_max^2 (Hertz at an overlap of R_max,
-    /// or the cohesion k_c pi R_max^2): 2^12, which also holds particles up to 64 R_max.
-    const ROOM: f64 = 4096.0;
-
-    /// The scales of a scenario: from its parameters only (not from the particles of the
-    /// moment), so that a resumed run and every process of a run use the same ones.
-    pub fn of(s: &Scenario) -> LoadScales {
-        let r_max = LoadScales::largest_radius(s);
-        let mut stiffest: f64 = 0.0;
-        for m in &s.materials {
-            let m = &m.properties;
-            let e_star = m.youngs_modulus / (1.0 - m.poisson_ratio * m.poisson_ratio);
-            stiffest = stiffest.max(e_star).max(std::f64::consts::PI * m.cohesion);
-        }
-        for i in &s.interactions {
-            stiffest = stiffest.max(std::f64::consts::PI * i.cohesion.unwrap_or(0.0));
-        }
-        let largest = (LoadScales::ROOM * stiffest * r_max * r_max).max(f64::MIN_POSITIVE);
-        let (force, torque) = (
-            Scale::for_largest(largest),
-            Scale::for_largest((largest * r_max).max(f64::MIN_POSITIVE)),
-        );
-        LoadScales {
-            force,
-            torque,
-            lanes: Scales8::new([force, force, force, torque, torque, torque, force, force]),
-        }
-    }
-}
 
 /// What the tasks of a contact stage find beside the loads: the overlaps deeper than
 /// allowed, and whether a load left the range of its exact sum.
@@ -405,35 +342,6 @@ impl Thermo {
     }
 }
 
-/// `face_part` of a face that does not move.
-const STATIC: u32 = u32::MAX;
-
-/// A mesh file whose faces follow a prescribed motion.
-#[derive(Clone, Debug)]
-struct MovingPart {
-    faces: std::ops::Range<usize>,
-    motion: Motion,
-    /// Velocity field at the current time.
-    velocity: RigidVelocity,
-    /// Corners of its faces at rest, to measure how far they moved.
-    corners: Vec<DVec3>,
-    /// Pose at the last neighbour-list rebuild.
-    pose_at_build: Pose,
-}
-
-/// Where a mesh file's faces are in [`Simulation::mesh`]: `[geometry] mesh` first, then the
-/// `[[meshes]]` in order.
-#[derive(Clone, Debug, PartialEq)]
-pub struct MeshFile {
-    pub name: String,
-    pub faces: std::ops::Range<usize>,
-    pub contacts: Contacts,
-    /// The point torques on it are taken about: the origin, or the centre of its rotation.
-    pub torque_about: DVec3,
-    /// The material of its faces.
-    pub material: u16,
-}
-
 /// A running simulation.
 pub struct Simulation {
     pub scenario: Scenario,
@@ -516,22 +424,6 @@ impl Simulation {
         })
     }
 
-    /// Face count and a hash of the rest geometry of each mesh file (shape, radius and
-    /// contact mode of its faces, in order).
-    pub fn mesh_signatures(&self) -> Vec<(u64, u64)> {
-        self.mesh_files
-            .iter()
-            .map(|file| {
-                let faces = &self.rest_faces[file.faces.clone()];
-                let text: String = faces
-                    .iter()
-                    .map(|f| format!("{:?}{:?}{:?};", f.shape, f.radius, f.contacts))
-                    .collect();
-                (faces.len() as u64, crate::engine::records::hash(&text))
-            })
-            .collect()
-    }
-
     /// Number of neighbour-list rebuilds so far.
     pub fn rebuilds(&self) -> u64 {
         self.neighbours.rebuilds
@@ -596,189 +488,6 @@ impl Simulation {
         self.remove();
         self.stage_times.add(Stage::Remove, t);
         Ok(())
-    }
-
-    /// Stage 7: particles whose centre has entered an outlet or left the domain are
-    /// removed (counted, with their mass, by the outlet or the domain: the first outlet
-    /// that holds a particle takes it). The lists are rebuilt without them; the ids of the
-    /// others stay.
-    #[inline(never)] // a stage of its own in profiles
-    fn remove(&mut self) {
-        let s = &self.scenario;
-        if !s.removes() {
-            return;
-        }
-        let (domain, outlets, periodic) = (s.domain, s.outlets.clone(), s.periodic);
-        // Outside the domain through a side that is not periodic.
-        let outside = move |x: DVec3| {
-            domain.is_some_and(|d| {
-                (0..3).any(|a| !periodic[a] && (x[a] < d.min[a] || x[a] > d.max[a]))
-            })
-        };
-        // Where each removed particle goes: an outlet, or `outlets.len()` for the domain.
-        let fate = move |x: DVec3| -> Option<u32> {
-            if let Some(k) = outlets.iter().position(|o| o.contains(x)) {
-                return Some(k as u32);
-            }
-            outside(x).then_some(outlets.len() as u32)
-        };
-        if self.domain.is_some() {
-            return self.remove_split(fate);
-        }
-        let p = &self.particles;
-        let gone: Vec<(u32, u32)> =
-            p.x.par_iter()
-                .enumerate()
-                .with_min_len(4 * MIN_PARALLEL_LEN)
-                .filter_map(|(i, x)| fate(*x).map(|f| (i as u32, f)))
-                .collect();
-        if gone.is_empty() {
-            return;
-        }
-        // Counted in id order, so the masses sum in an order of their own.
-        let mut by_id: Vec<(u32, u32, u32)> = gone
-            .iter()
-            .map(|&(i, f)| (p.id[i as usize], i, f))
-            .collect();
-        by_id.sort_unstable();
-        let densities = &self.densities;
-        for &(_, i, f) in &by_id {
-            let out = match self.removed.outlets.get_mut(f as usize) {
-                Some(o) => o,
-                None => &mut self.removed.domain,
-            };
-            out.count += 1;
-            let material = densities[p.material[i as usize] as usize];
-            out.mass += Inertia::mass_with(p.radius[i as usize], material.mass_per_r3);
-        }
-        let gone: Vec<u32> = gone.into_iter().map(|(i, _)| i).collect();
-        self.neighbours.rebuild_without(
-            &mut self.particles,
-            &gone,
-            &self.mesh.faces,
-            &self.face_grid,
-        );
-        self.built();
-    }
-
-    /// Whether frames name each particle's id and material: particles can be removed (or
-    /// were, in an earlier stage), so the line of a particle is not its id, or there are
-    /// several materials.
-    pub fn frames_carry_ids(&self) -> bool {
-        let p = &self.particles;
-        self.scenario.removes()
-            || self.scenario.materials.len() > 1
-            || p.next_id as usize != self.particle_count()
-    }
-
-    /// Starts summing the loads on each mesh file (`take_wall_loads`).
-    fn sum_wall_loads(&mut self) {
-        if !self.scenario.wall_forces {
-            return;
-        }
-        self.face_file = vec![0; self.mesh.faces.len()];
-        for (k, file) in self.mesh_files.iter().enumerate() {
-            self.face_file[file.faces.clone()].fill(k as u32);
-        }
-        self.wall_sums = vec![Wrench::default(); self.mesh_files.len()];
-        // The lever of a torque about a file's point: to its farthest corner, or across the
-        // domain, and a particle's radius; 16 times that, for meshes that move.
-        let mut lever: f64 = 0.0;
-        for file in &self.mesh_files {
-            for face in &self.rest_faces[file.faces.clone()] {
-                for c in face.corners() {
-                    lever = lever.max(c.distance(file.torque_about) + face.radius);
-                }
-            }
-        }
-        if let Some(d) = self.scenario.domain {
-            lever = lever.max((d.max - d.min).length());
-        }
-        lever = 16.0 * (lever + LoadScales::largest_radius(&self.scenario));
-        self.wall_scales = self.scales.walls(lever);
-    }
-
-    /// The loads on each mesh file summed over the steps since the last call, and the
-    /// sums set back to zero (empty unless `[output] wall_forces`).
-    pub fn take_wall_loads(&mut self) -> Vec<Wrench> {
-        let zero = vec![Wrench::default(); self.wall_sums.len()];
-        std::mem::replace(&mut self.wall_sums, zero)
-    }
-
-    /// Stage 5b: particles whose centre is inside a `[[tags]]` box take its tag.
-    #[inline(never)] // a stage of its own in profiles
-    fn tag(&mut self) {
-        let regions = &self.scenario.tags;
-        if regions.is_empty() {
-            return;
-        }
-        let p = &mut self.particles;
-        p.tag
-            .par_iter_mut()
-            .zip(p.x.par_iter())
-            .with_min_len(4 * MIN_PARALLEL_LEN)
-            .for_each(|(tag, x)| {
-                for r in regions {
-                    if x.cmpge(r.min).all() && x.cmple(r.max).all() {
-                        *tag = r.tag;
-                    }
-                }
-            });
-    }
-
-    /// Whether frames carry a tag column: the scenario tags particles, or they came tagged.
-    pub fn has_tags(&self) -> bool {
-        let tagged = self.particles.tagged();
-        let tagged = self.domain.as_ref().map_or(tagged, |d| d.comm.any(tagged));
-        !self.scenario.tags.is_empty() || tagged
-    }
-
-    /// Stage 0: moving mesh parts to their pose at the current time, with their velocity.
-    pub(crate) fn move_meshes(&mut self) {
-        let t = self.time;
-        let mut drift: f64 = 0.0;
-        for part in &mut self.moving {
-            let pose = part.motion.pose(t);
-            for f in part.faces.clone() {
-                self.mesh.faces[f] = self.rest_faces[f].moved(&pose);
-            }
-            part.velocity = part.motion.velocity(t);
-            for &c in &part.corners {
-                drift = drift.max(pose.point(c).distance(part.pose_at_build.point(c)));
-            }
-        }
-        self.mesh_drift = drift;
-    }
-
-    /// Records the mesh pose at a neighbour-list rebuild, and re-bins moved faces.
-    fn mark_mesh_built(&mut self) {
-        let t = self.time;
-        for part in &mut self.moving {
-            part.pose_at_build = part.motion.pose(t);
-        }
-        self.mesh_drift = 0.0;
-    }
-
-    /// The rest geometry of the mesh (for checkpoint fingerprints).
-    pub fn rest_mesh(&self) -> Mesh {
-        Mesh {
-            faces: self.rest_faces.clone(),
-            vertices: self.mesh.vertices.clone(),
-        }
-    }
-
-    /// The mesh as it is at time `t` (for pictures of frames).
-    pub fn mesh_at(&mut self, t: f64) -> &Mesh {
-        let now = self.time;
-        self.time = t;
-        self.move_meshes();
-        self.time = now;
-        &self.mesh
-    }
-
-    /// Whether some part of the mesh moves.
-    pub fn mesh_moves(&self) -> bool {
-        !self.moving.is_empty()
     }
 
     /// Particles inserted by each `[[spawn]]` region so far.
