@@ -97,8 +97,10 @@ pub struct Kinetics {
     pub gravity: DVec3,
 }
 
+/// The `[simulation]` table: the time step, the run's length, the spawner's attempts and
+/// seed, the skin and the friction springs' update.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Simulation {
+pub struct SimulationTable {
     /// Δt \[T\]
     pub timestep: f64,
     /// N_max
@@ -119,7 +121,7 @@ pub struct Simulation {
     pub friction_springs: FrictionSprings,
 }
 
-impl Simulation {
+impl SimulationTable {
     /// The shortest period of a periodic domain, in largest radii: twice the reach of the
     /// widest pair (2 R_max and the skin), with R_max to spare, so that a pair sees one
     /// image of the other.
@@ -261,7 +263,7 @@ pub struct Scenario {
     /// Pair coefficients that override the means (`[[interactions]]`).
     pub interactions: Vec<Interaction>,
     pub kinetics: Kinetics,
-    pub simulation: Simulation,
+    pub simulation: SimulationTable,
     /// Further meshes, each with its own radii and motion (`[[meshes]]`).
     pub meshes: Vec<MeshSpec>,
     /// Regions that tag particles passing through them (`[[tags]]`), later ones winning.

@@ -15,7 +15,7 @@ pub(super) fn spawn(
     index: &dyn Fn(&str, &str) -> Result<u16>,
     kinetics: &Kinetics,
     geometry: &Geometry,
-    simulation: &Simulation,
+    simulation: &SimulationTable,
     domain: Option<Region>,
 ) -> Result<Vec<SpawnRegion>> {
     let (radius_min, radius_max) = (geometry.radius_min, geometry.radius_max);

@@ -445,7 +445,11 @@ fn kinetics(k: RawKinetics) -> Result<Kinetics> {
 }
 
 /// `[simulation]`; the time step by default Eq. (50)'s of the stiffest, lightest material.
-fn simulation(s: RawSimulation, materials: &[MaterialSpec], radius_min: f64) -> Result<Simulation> {
+fn simulation(
+    s: RawSimulation,
+    materials: &[MaterialSpec],
+    radius_min: f64,
+) -> Result<SimulationTable> {
     let timestep = match s.timestep {
         Some(dt) => check("[simulation] timestep", dt, Range::Positive)?,
         None => materials
@@ -453,7 +457,7 @@ fn simulation(s: RawSimulation, materials: &[MaterialSpec], radius_min: f64) -> 
             .map(|m| default_timestep(radius_min, &m.properties))
             .fold(f64::INFINITY, f64::min),
     };
-    let simulation = Simulation {
+    let simulation = SimulationTable {
         timestep,
         max_particles: s.max_particles.unwrap_or(1000),
         frames: s.frames.unwrap_or(100),
@@ -562,10 +566,10 @@ fn lees_edwards(le: &RawShear, periodic: [bool; 3]) -> Result<(f64, usize, usize
     ))
 }
 
-/// `[domain]`, its periods at least `Simulation::shortest_period` largest radii.
+/// `[domain]`, its periods at least `SimulationTable::shortest_period` largest radii.
 fn domain(
     raw: Option<RawDomain>,
-    simulation: &Simulation,
+    simulation: &SimulationTable,
     radius_max: f64,
     periodic: [bool; 3],
 ) -> Result<Option<Region>> {

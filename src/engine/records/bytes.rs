@@ -141,12 +141,12 @@ pub fn encode_into(out: &mut Vec<u8>, snapshot: &Snapshot, fingerprint: u64) {
 }
 
 /// A cursor over the checkpoint bytes that reports truncation clearly.
-struct Reader<'a> {
+struct Cursor<'a> {
     bytes: &'a [u8],
     at: usize,
 }
 
-impl Reader<'_> {
+impl Cursor<'_> {
     fn take(&mut self, n: usize) -> Result<&[u8]> {
         if self.bytes.len() - self.at < n {
             bail!(
@@ -293,7 +293,7 @@ pub fn decode(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<Snapsho
 /// The format version of a checkpoint and a reader of its body after the fingerprint,
 /// once its magic, version, checksum and fingerprint (if `expected_fingerprint`) are
 /// checked.
-fn checked_body(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<(u32, Reader<'_>)> {
+fn checked_body(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<(u32, Cursor<'_>)> {
     if bytes.len() < MAGIC.len() + 4 || &bytes[..MAGIC.len()] != MAGIC {
         bail!("not a tinydem checkpoint (no 'TINYDEM CKPT' header)");
     }
@@ -307,7 +307,7 @@ fn checked_body(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<(u32,
     if crc32fast::hash(body).to_le_bytes() != crc {
         bail!("corrupt checkpoint: the checksum does not match (truncated or damaged file)");
     }
-    let mut r = Reader {
+    let mut r = Cursor {
         bytes: body,
         at: 16,
     };
@@ -331,7 +331,7 @@ struct Rest {
     regions: Vec<RegionState>,
 }
 
-impl Reader<'_> {
+impl Cursor<'_> {
     /// The particles (material indices from format 3 on), checked, with their ids below
     /// `next_id`; and their anchors, if the lists were built.
     fn particles(&mut self, v3: bool, next_id: u32) -> Result<(Particles, Vec<DVec3>)> {
@@ -390,7 +390,7 @@ impl Reader<'_> {
     fn rest(&mut self) -> Result<Rest> {
         let r = self;
         let mut rest = Rest::default();
-        let outflow = |r: &mut Reader| -> Result<Outflow> {
+        let outflow = |r: &mut Cursor| -> Result<Outflow> {
             Ok(Outflow {
                 count: r.u64()?,
                 mass: r.f64()?,
