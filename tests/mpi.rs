@@ -153,6 +153,45 @@ fn a_tumbling_drum_on_1_to_3_processes_writes_the_same_bytes() {
     same_output(&path, &[2, 3]);
 }
 
+/// `[simulation] until`: a pour into a box that ends when it is still, and a silo that ends
+/// when its outlet has taken 20 grains, end at the same frame with the same bytes on any
+/// process count.
+#[test]
+fn runs_ended_by_until_on_1_to_3_processes_write_the_same_bytes() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("box.off"),
+        "OFF\n8 5 0\n-0.03 -0.03 0\n0.03 -0.03 0\n0.03 0.03 0\n-0.03 0.03 0\n\
+         -0.03 -0.03 0.2\n0.03 -0.03 0.2\n0.03 0.03 0.2\n-0.03 0.03 0.2\n\
+         4 0 1 2 3\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n",
+    )
+    .unwrap();
+    let pour = dir.path().join("pour.toml");
+    std::fs::write(
+        &pour,
+        "[geometry]\nradius_min = 0.004\nradius_max = 0.005\nmesh = \"box.off\"\nmesh_radii = [0.0]\n\
+         [simulation]\nframes = 100\nsteps_per_frame = 1000\n\
+         until = { kinetic_energy_below = 1e-7 }\n\
+         [[spawn]]\nmin = [-0.025, -0.025, 0.02]\nmax = [0.025, 0.025, 0.1]\ncount = 60\n",
+    )
+    .unwrap();
+    same_output(&pour, &[2, 3]);
+    let silo = silo(dir.path(), 400);
+    let text = std::fs::read_to_string(&silo).unwrap();
+    let text = text.replace(
+        "steps_per_frame = 250\n",
+        "steps_per_frame = 250\nuntil = { removed_at_least = 20 }\n",
+    );
+    std::fs::write(&silo, text).unwrap();
+    same_output(&silo, &[2, 3]);
+    let name = silo.to_str().unwrap();
+    run(1, &["run", name, "-o", "ended", "-q"], dir.path());
+    let log = std::fs::read_to_string(dir.path().join("ended/log.csv")).unwrap();
+    let last = log.lines().last().unwrap();
+    assert!(last.ends_with(",removed_at_least"), "{last}");
+    assert!(log.lines().count() < 402, "not ended early");
+}
+
 #[test]
 fn ctrl_c_on_2_processes_checkpoints_and_3_resume_with_the_same_bytes() {
     let dir = tempfile::tempdir().unwrap();

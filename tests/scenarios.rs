@@ -41,6 +41,12 @@ fn full_scenario_sets_every_key() {
     assert_eq!(s.geometry.mesh_radii, vec![0.0, 0.001]);
     assert_eq!(s.material.friction_twisting, 0.2);
     assert_eq!(s.simulation.seed, 42);
+    let until = tinydem::scenario::Until {
+        kinetic_energy_below: Some(1e-9),
+        time: Some(1.0),
+        removed_at_least: Some(3),
+    };
+    assert_eq!(s.simulation.until, until);
     assert_eq!(s.particles, Some(dir.join("two.csv")));
     assert_eq!(s.output_dir, dir.join("out"));
     assert_eq!(s.geometry.mesh_contacts, Contacts::PerFace);

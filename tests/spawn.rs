@@ -133,3 +133,35 @@ fn radii_follow_their_distribution() {
     );
     assert!(s.particles.radius.iter().all(|&r| r == 0.001 || r == 0.002));
 }
+
+/// Whether spawning is over, for `[simulation] until`'s kinetic energy: once every region is
+/// past its stop or its count, or N_max is reached; the spawn box tries until N_max.
+#[test]
+fn spawning_is_over_past_every_regions_stop_or_count() {
+    let spawning = |s: &Simulation| s.frame_state(&s.thermo()).spawning;
+    let region = "[[spawn]]\nmin = [-0.5, -0.5, -0.5]\nmax = [0.5, 0.5, 0.5]\n";
+    let mut s = sim(
+        &format!("{region}count = 20\n{region}rate = 1000.0\nstop = 0.005\n"),
+        "",
+        50,
+    );
+    assert!(spawning(&s));
+    for _ in 0..49 {
+        s.step().unwrap();
+    }
+    // The count is made at once; the rate's region runs until t = 0.005.
+    assert_eq!(s.spawned()[0], 20);
+    assert!(spawning(&s), "t = {}", s.time);
+    s.step().unwrap();
+    assert!(!spawning(&s), "t = {}", s.time);
+    // The box spawner goes on until max_particles.
+    let mut s = common::simulate(
+        "[geometry]\nradius_min = 0.001\nradius_max = 0.002\nspawn_min = [-0.5, -0.5, -0.5]\n\
+         spawn_max = [0.5, 0.5, 0.5]\n[simulation]\nmax_particles = 30\nspawn_attempts = 50\n",
+        0,
+    );
+    assert!(spawning(&s));
+    s.step().unwrap();
+    assert_eq!(s.particles.len(), 30);
+    assert!(!spawning(&s));
+}

@@ -44,6 +44,7 @@ fn describe_start(s: &Scenario, out: &Path, sim: Simulation) -> Result<String> {
     let bounds = bound_lines(s, &sim);
     let materials = material_lines(s);
     let default_dt = s.eq50_timestep();
+    let until = until_line(s);
     Ok(format!(
         "scenario is valid\n\
          {meshes}\
@@ -56,6 +57,7 @@ fn describe_start(s: &Scenario, out: &Path, sim: Simulation) -> Result<String> {
          stiffness k_n at 10%   {k_10:.6e} N/m (two R_min particles, delta = 0.1 R_min)\n\
          half contact period    {period:.6e} s = {:.1} time steps\n\
          total simulated time   {:.6} s ({} frames x {} steps)\n\
+         {until}\
          output                 {} files ({}), up to {} a frame, {} in all{}\n\
          wall time              {}\n\
          {}",
@@ -84,6 +86,28 @@ fn describe_start(s: &Scenario, out: &Path, sim: Simulation) -> Result<String> {
             .map(|r| format!("warning: {r} (run refuses it unless --force)\n"))
             .collect::<String>(),
     ))
+}
+
+/// The line of `[simulation] until`'s conditions, if it has any.
+fn until_line(s: &Scenario) -> String {
+    let u = &s.simulation.until;
+    let mut any = Vec::new();
+    if let Some(e) = u.kinetic_energy_below {
+        any.push(format!("kinetic energy < {e:e} J (none left to spawn)"));
+    }
+    if let Some(t) = u.time {
+        any.push(format!("t >= {t:e} s"));
+    }
+    if let Some(n) = u.removed_at_least {
+        any.push(format!("{n} particles removed"));
+    }
+    if any.is_empty() {
+        return String::new();
+    }
+    format!(
+        "ends early             at the first frame with {}\n",
+        any.join(", or ")
+    )
 }
 
 /// A line per mesh file: its faces, contact mode (and surfaces) and material.

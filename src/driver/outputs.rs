@@ -8,7 +8,7 @@ use anyhow::{Context, Result};
 use crate::engine::{Simulation, Thermo};
 use crate::io::csv::{Extra, write_frame};
 use crate::io::output::{FRAMES, LOG, LOG_HEADER, OUTLETS, RUN_TOML, WALLS};
-use crate::scenario::{Formats, Scenario};
+use crate::scenario::{Formats, Met, Scenario};
 
 /// Writes frames in the scenario's formats, and the ParaView collection.
 pub(super) struct Frames<'a> {
@@ -179,6 +179,12 @@ macro_rules! whole_log_values {
 }
 whole_log_values!(u64, usize, i32);
 
+impl LogValue for &str {
+    fn put(&self, line: &mut String) {
+        line.push_str(self);
+    }
+}
+
 /// The logs of a run: `frames.csv` and `log.csv`, `outlets.csv` and `walls.csv` when the
 /// scenario asks for them.
 pub(super) struct Logs {
@@ -187,6 +193,8 @@ pub(super) struct Logs {
     outlets: Option<Log>,
     walls: Option<Log>,
     steps_per_frame: u64,
+    /// Whether `log.csv` has the column `until` (the scenario has conditions).
+    until: bool,
 }
 
 impl Logs {
@@ -201,33 +209,42 @@ impl Logs {
             .then(|| Log::open(dir, WALLS, "frame,time,mesh,fx,fy,fz,tx,ty,tz", resumed_at))
             .transpose()?;
         write_run_toml(dir, s)?;
+        let until = !s.simulation.until.is_empty();
+        let header = if until {
+            format!("{LOG_HEADER},until")
+        } else {
+            LOG_HEADER.to_string()
+        };
         Ok(Logs {
             frames: Log::open(dir, FRAMES, "frame,step,time", resumed_at)?,
-            thermo: Log::open(dir, LOG, LOG_HEADER, resumed_at)?,
+            thermo: Log::open(dir, LOG, &header, resumed_at)?,
             outlets,
             walls,
             steps_per_frame: s.simulation.steps_per_frame,
+            until,
         })
     }
 
-    /// A frame's lines in the logs (collective in a split run: the state over all
-    /// processes; the first writes, holding the logs), and its state.
+    /// A frame's lines in the logs, with its state `th` (over all processes) and the
+    /// condition of `[simulation] until` that ends the run at it, if one does (collective in
+    /// a split run: the first writes, holding the logs).
     pub(super) fn frame(
         logs: Option<&mut Logs>,
         sim: &mut Simulation,
         frame: u64,
-    ) -> Result<Thermo> {
-        let th = sim.thermo();
+        (th, met): (&Thermo, Option<&Met>),
+    ) -> Result<()> {
         let loads = if frame > 0 {
             sim.take_wall_loads()
         } else {
             Vec::new()
         };
         let Some(logs) = logs else {
-            return Ok(th);
+            return Ok(());
         };
         logs.frames.row(&[&frame, &sim.steps, &sim.time])?;
-        logs.thermo.row(&[
+        let ended = met.map_or("", |m| m.key);
+        let row: [&dyn LogValue; 12] = [
             &frame,
             &sim.steps,
             &sim.time,
@@ -239,7 +256,9 @@ impl Logs {
             &th.wall_contacts,
             &th.max_overlap,
             &th.removed,
-        ])?;
+            &ended,
+        ];
+        logs.thermo.row(&row[..if logs.until { 12 } else { 11 }])?;
         if let Some(log) = &mut logs.outlets {
             for (k, o) in sim.removed.outlets.iter().enumerate() {
                 log.row(&[&frame, &sim.time, &k, &o.count, &o.mass])?;
@@ -253,6 +272,6 @@ impl Logs {
                 log.row(&[&frame, &sim.time, &k, &f.x, &f.y, &f.z, &t.x, &t.y, &t.z])?;
             }
         }
-        Ok(th)
+        Ok(())
     }
 }

@@ -15,7 +15,7 @@ use crate::io::csv::{Extra, frame_name};
 use crate::io::lock::Lock;
 use crate::io::output::{claim_output, take_output};
 use crate::parallel::comm::Comm;
-use crate::scenario::Scenario;
+use crate::scenario::{Met, Scenario};
 
 pub use crate::io::output::{
     CHECKPOINT, FRAMES, INTERRUPTED, LOG, LOG_HEADER, OUTLETS, RUN_TOML, UNSTABLE, WALLS,
@@ -77,6 +77,9 @@ pub struct Summary {
     pub advice: String,
     /// Particles removed by the outlets and the domain bounds.
     pub removed: crate::engine::records::Removed,
+    /// The condition of `[simulation] until` that ended the run before its last frame, and
+    /// the frame it ended at.
+    pub ended_by: Option<(Met, u64)>,
 }
 
 /// A run stopped on request, with its checkpoint written.
@@ -149,8 +152,10 @@ pub fn run_on(
     let mut record = Record::open(output_dir, &sim, &options, total_steps)?;
     if options.resume.is_none() {
         record.frame(&mut sim, 0)?;
+    } else {
+        record.resumed(&mut sim);
     }
-    while sim.steps < total_steps {
+    while sim.steps < total_steps && record.ended_by.is_none() {
         if let Err(unstable) = sim.step() {
             return Err(unstable_error(
                 &unstable,
@@ -212,6 +217,8 @@ struct Record<'a> {
     frames_written: u64,
     /// Wall time spent writing frames and checkpoints.
     output_seconds: f64,
+    /// The condition of `[simulation] until` that ends the run, and its frame.
+    ended_by: Option<(Met, u64)>,
 }
 
 impl<'a> Record<'a> {
@@ -238,18 +245,39 @@ impl<'a> Record<'a> {
             status: Status::new(options.verbosity, total_steps, sim.steps),
             frames_written: 0,
             output_seconds: 0.0,
+            ended_by: None,
         })
     }
 
-    /// Frame `frame`: its files, its lines in the logs and its status line (collective).
+    /// Frame `frame`: its files, its lines in the logs and its status line, and whether a
+    /// condition of `[simulation] until` ends the run at it (collective).
     fn frame(&mut self, sim: &mut Simulation, frame: u64) -> Result<()> {
         let written = self.out.write(frame, sim);
         sim.agree(written)?;
         self.frames_written += 1;
-        let logged = Logs::frame(self.logs.as_mut(), sim, frame);
-        let th = sim.agree(logged)?;
+        let th = sim.thermo();
+        // Checked from the first frame after a step on.
+        let met = (sim.steps > 0)
+            .then(|| sim.scenario.simulation.until.met(&sim.frame_state(&th)))
+            .flatten();
+        let logged = Logs::frame(self.logs.as_mut(), sim, frame, (&th, met.as_ref()));
+        sim.agree(logged)?;
         self.status.frame(sim, frame, &th);
+        self.ended_by = met.map(|m| (m, frame));
         Ok(())
+    }
+
+    /// A run resumed at a frame where a condition of `[simulation] until` holds ended
+    /// there: it ends again at once (collective).
+    fn resumed(&mut self, sim: &mut Simulation) {
+        let steps_per_frame = sim.scenario.simulation.steps_per_frame;
+        let until = sim.scenario.simulation.until;
+        if until.is_empty() || sim.steps == 0 || !sim.steps.is_multiple_of(steps_per_frame) {
+            return;
+        }
+        let th = sim.thermo();
+        let met = until.met(&sim.frame_state(&th));
+        self.ended_by = met.map(|m| (m, sim.steps / steps_per_frame));
     }
 
     /// The end of a complete run: its last checkpoint, so that it can be extended or
@@ -273,6 +301,7 @@ impl<'a> Record<'a> {
             warnings: sim.warnings().count(),
             advice: sim.advice(),
             removed: sim.removed.clone(),
+            ended_by: self.ended_by,
         })
     }
 }

@@ -497,6 +497,18 @@ impl Simulation {
         n
     }
 
+    /// The state `[simulation] until` is checked on at a frame (collective in a split run).
+    pub fn frame_state(&self, th: &Thermo) -> crate::scenario::FrameState {
+        let p = &self.particles;
+        crate::scenario::FrameState {
+            time: self.time,
+            kinetic_energy: th.kinetic_energy,
+            particles: th.particles,
+            spawning: !self.spawner.finished(&self.scenario, p.next_id, self.time),
+            removed: th.removed,
+        }
+    }
+
     /// Stage 1 (Section 3.1): new particles in the spawn box or the `[[spawn]]` regions.
     #[inline(never)] // a stage of its own in profiles
     fn spawn(&mut self) {

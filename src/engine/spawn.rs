@@ -171,6 +171,20 @@ impl Spawner {
         })
     }
 
+    /// Whether no step from time `t` on will spawn, `next_id` particles having been made:
+    /// `N_max` reached, or every `[[spawn]]` region past its `stop` or its `count` (the
+    /// spawn box tries until `N_max`).
+    pub fn finished(&self, s: &Scenario, next_id: u32, t: f64) -> bool {
+        if s.simulation.spawn_attempts == 0 || next_id as u64 >= s.simulation.max_particles {
+            return true;
+        }
+        !s.spawn.is_empty()
+            && s.spawn.iter().enumerate().all(|(k, r)| {
+                let inserted = self.regions.get(k).map_or(0, |st| st.inserted);
+                t >= r.stop || r.count.is_some_and(|n| inserted >= n)
+            })
+    }
+
     /// The boxes spawned into: the `[[spawn]]` regions, or the spawn box.
     pub fn regions(s: &Scenario) -> Vec<Region> {
         if s.spawn.is_empty() {

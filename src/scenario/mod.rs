@@ -8,7 +8,8 @@
 //!              friction_rolling, friction_twisting, cohesion, viscosity
 //! [kinetics]   initial_velocity, initial_angular_velocity, gravity
 //! [simulation] timestep, max_particles, frames, steps_per_frame, spawn_attempts, seed, skin,
-//!              friction_springs = "advance_first" | "paper"
+//!              friction_springs = "advance_first" | "paper", until = { kinetic_energy_below,
+//!              time, removed_at_least }
 //! [[meshes]]   file, radii, contacts, motion = { type = "harmonic", amplitude, frequency, direction,
 //!              phase } | { type = "velocity", velocity } | { type = "rotation", center, axis,
 //!              angular_velocity }   (any number of these)
@@ -119,6 +120,83 @@ pub struct SimulationTable {
     pub skin: f64,
     /// The order of the friction springs' update, Sec. 2.3.
     pub friction_springs: FrictionSprings,
+    /// Conditions that end the run before its last frame.
+    pub until: Until,
+}
+
+/// `[simulation] until`: conditions checked at every frame after the first step; the run
+/// ends at the first frame where any holds (`frames` stays the upper bound).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Until {
+    /// The kinetic energy, translational and rotational (`log.csv`'s `kinetic_energy`), is
+    /// below this \[M L²/T²\], with particles present and none left to spawn.
+    pub kinetic_energy_below: Option<f64>,
+    /// The run's clock has reached this \[T\].
+    pub time: Option<f64>,
+    /// At least this many particles were removed (by the outlets and the domain).
+    pub removed_at_least: Option<u64>,
+}
+
+/// The state a frame's check of [`Until`] looks at.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameState {
+    pub time: f64,
+    pub kinetic_energy: f64,
+    pub particles: usize,
+    /// Particles still to be spawned after this step.
+    pub spawning: bool,
+    pub removed: u64,
+}
+
+impl Until {
+    /// Whether no condition is set.
+    pub fn is_empty(&self) -> bool {
+        *self == Until::default()
+    }
+
+    /// The first condition that holds in state `s`.
+    pub fn met(&self, s: &FrameState) -> Option<Met> {
+        if let Some(e) = self.kinetic_energy_below
+            && s.particles > 0
+            && !s.spawning
+            && s.kinetic_energy < e
+        {
+            return Some(Met {
+                key: "kinetic_energy_below",
+                said: format!("kinetic energy {:.4e} J below {e:e} J", s.kinetic_energy),
+            });
+        }
+        if let Some(t) = self.time
+            && s.time >= t
+        {
+            return Some(Met {
+                key: "time",
+                said: format!("t = {:.6e} s reached {t:e} s", s.time),
+            });
+        }
+        if let Some(n) = self.removed_at_least
+            && s.removed >= n
+        {
+            return Some(Met {
+                key: "removed_at_least",
+                said: format!("{} removed, at least {n}", s.removed),
+            });
+        }
+        None
+    }
+}
+
+/// A condition of [`Until`] that held: its key, and what held.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Met {
+    pub key: &'static str,
+    pub said: String,
+}
+
+impl std::fmt::Display for Met {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "until.{}: {}", self.key, self.said)
+    }
 }
 
 impl SimulationTable {
@@ -459,6 +537,50 @@ impl Scenario {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn until_holds_on_the_first_condition_met() {
+        let until = Until {
+            kinetic_energy_below: Some(1e-6),
+            time: Some(2.0),
+            removed_at_least: Some(5),
+        };
+        let still = FrameState {
+            time: 1.0,
+            kinetic_energy: 1e-7,
+            particles: 10,
+            spawning: false,
+            removed: 0,
+        };
+        assert_eq!(until.met(&still).unwrap().key, "kinetic_energy_below");
+        // Not while grains are still to come, nor with none at all.
+        let filling = FrameState {
+            spawning: true,
+            ..still
+        };
+        assert_eq!(until.met(&filling), None);
+        let empty = FrameState {
+            particles: 0,
+            ..still
+        };
+        assert_eq!(until.met(&empty), None);
+        let late = FrameState {
+            time: 2.0,
+            ..filling
+        };
+        assert_eq!(until.met(&late).unwrap().key, "time");
+        let drained = FrameState {
+            removed: 5,
+            ..filling
+        };
+        let met = until.met(&drained).unwrap();
+        assert_eq!(
+            met.to_string(),
+            "until.removed_at_least: 5 removed, at least 5"
+        );
+        assert!(Until::default().is_empty());
+        assert_eq!(Until::default().met(&still), None);
+    }
 
     #[test]
     fn defaults_are_table_2() {

@@ -236,6 +236,15 @@ pub(super) struct RawSimulation {
     pub(super) seed: Option<u64>,
     pub(super) skin: Option<f64>,
     pub(super) friction_springs: Option<String>,
+    pub(super) until: Option<RawUntil>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawUntil {
+    pub(super) kinetic_energy_below: Option<f64>,
+    pub(super) time: Option<f64>,
+    pub(super) removed_at_least: Option<u64>,
 }
 
 #[derive(Deserialize, Default)]

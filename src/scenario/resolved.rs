@@ -121,6 +121,20 @@ impl Scenario {
         }
         let _ = writeln!(o, "skin = {}", num(s.skin));
         let _ = writeln!(o, "friction_springs = {}", text(s.friction_springs.key()));
+        let u = &s.until;
+        if !u.is_empty() {
+            let mut conditions = Vec::new();
+            if let Some(e) = u.kinetic_energy_below {
+                conditions.push(format!("kinetic_energy_below = {}", num(e)));
+            }
+            if let Some(t) = u.time {
+                conditions.push(format!("time = {}", num(t)));
+            }
+            if let Some(n) = u.removed_at_least {
+                conditions.push(format!("removed_at_least = {n}"));
+            }
+            let _ = writeln!(o, "until = {{ {} }}", conditions.join(", "));
+        }
     }
 
     fn meshes_toml(&self, o: &mut String) {

@@ -466,6 +466,7 @@ fn simulation(
         seed: s.seed.unwrap_or(1),
         skin: check("[simulation] skin", s.skin.unwrap_or(0.5), Range::Positive)?,
         friction_springs: friction_springs(s.friction_springs)?,
+        until: until(s.until)?,
     };
     if simulation.spawn_attempts > 1_000_000_000 {
         bail!(
@@ -492,6 +493,32 @@ fn simulation(
         );
     }
     Ok(simulation)
+}
+
+/// `[simulation] until`: each condition set is checked; an empty table is refused.
+fn until(raw: Option<RawUntil>) -> Result<Until> {
+    let Some(raw) = raw else {
+        return Ok(Until::default());
+    };
+    let positive = |key: &str, x: Option<f64>| {
+        x.map(|x| check(&format!("[simulation] until.{key}"), x, Range::Positive))
+            .transpose()
+    };
+    let until = Until {
+        kinetic_energy_below: positive("kinetic_energy_below", raw.kinetic_energy_below)?,
+        time: positive("time", raw.time)?,
+        removed_at_least: raw.removed_at_least,
+    };
+    if until.removed_at_least == Some(0) {
+        bail!("[simulation] until.removed_at_least = 0 is not allowed: it must be at least 1");
+    }
+    if until.is_empty() {
+        bail!(
+            "[simulation] until = {{}} names no condition: give kinetic_energy_below, time or \
+             removed_at_least"
+        );
+    }
+    Ok(until)
 }
 
 /// `[[meshes]]`, their materials by name (`index`).

@@ -161,6 +161,9 @@ fn report(summary: &Summary, out: &Path) {
         out.display(),
         summary.wall_seconds
     );
+    if let Some((met, frame)) = &summary.ended_by {
+        eprintln!("ended at frame {frame} by {met}");
+    }
     let r = &summary.removed;
     if r.count() > 0 {
         let mut by = Vec::new();
