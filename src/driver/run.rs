@@ -147,6 +147,11 @@ pub fn run_on(
     if !options.force {
         refuse(&sim, output_dir)?;
     }
+    if options.verbosity == Verbosity::Normal {
+        for c in crate::driver::check::cautions(&sim.scenario) {
+            eprintln!("warning: {c}");
+        }
+    }
     let _lock = lock_output(&sim, output_dir, &options)?;
     let start = Instant::now();
     let mut record = Record::open(output_dir, &sim, &options, total_steps)?;

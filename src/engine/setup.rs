@@ -35,7 +35,7 @@ impl Simulation {
                 moving.push((faces.clone(), motion));
             }
             files.push(MeshFile {
-                name: spec.file.display().to_string(),
+                name: spec.input.name(),
                 faces,
                 contacts: spec.contacts,
                 torque_about: match spec.motion {

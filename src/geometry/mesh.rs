@@ -116,6 +116,15 @@ impl Face {
         }
     }
 
+    /// Area of the (undilated) primitive: 0 for points and segments.
+    pub fn area(&self) -> f64 {
+        match self.shape {
+            Primitive::Point(_) | Primitive::Segment(..) => 0.0,
+            Primitive::Triangle { a, b, c, .. } => 0.5 * (b - a).cross(c - a).length(),
+            Primitive::Rectangle { e1, e2, .. } => e1.cross(e2).length(),
+        }
+    }
+
     /// Axis-aligned bounding box of the dilated face.
     pub fn bounding_box(&self) -> (DVec3, DVec3) {
         let (lo, hi) = match self.shape {
@@ -241,6 +250,27 @@ impl Mesh {
         }
         connect(&mut faces, |f| &corners[f]);
         Ok(Mesh { faces, vertices })
+    }
+
+    /// A mesh of polygons given as indices into `vertices` (one to four corners each, as
+    /// [`primitive`] takes them), all of radius `radius`; faces that share a vertex form
+    /// one surface. For meshes made in code (`shapes.rs`): a bad polygon is a bug there.
+    pub fn from_polygons(vertices: Vec<DVec3>, polygons: &[Vec<usize>], radius: f64) -> Mesh {
+        let corners: Vec<Vec<DVec3>> = polygons
+            .iter()
+            .map(|p| p.iter().map(|&k| vertices[k]).collect())
+            .collect();
+        let mut faces: Vec<Face> = corners
+            .iter()
+            .map(|c| Face {
+                shape: primitive(c).expect("a built-in shape's polygon is a valid face"),
+                radius,
+                surface: 0,
+                contacts: Contacts::Merged,
+            })
+            .collect();
+        connect(&mut faces, |f| &corners[f]);
+        Mesh { faces, vertices }
     }
 
     /// Number of surfaces (one more than the largest label).
@@ -398,17 +428,41 @@ fn stl_ascii(text: &str, file: &str) -> Result<Vec<([DVec3; 3], String)>> {
     Ok(out)
 }
 
+/// The primitive with corners `v` (one to four, in order around the face): a point, a
+/// segment, a triangle (normal by the right-hand rule) or a rectangle (normal `e1 x e2`),
+/// or what is wrong with them.
+pub(crate) fn primitive(v: &[DVec3]) -> std::result::Result<Primitive, &'static str> {
+    match *v {
+        [a] => Ok(Primitive::Point(a)),
+        [a, b] => Ok(Primitive::Segment(a, b)),
+        [a, b, c] => {
+            let normal = (b - a).cross(c - a);
+            if normal.length_squared() == 0.0 {
+                return Err("degenerate triangle (its vertices are collinear)");
+            }
+            Ok(Primitive::Triangle {
+                a,
+                b,
+                c,
+                n: normal.normalize(),
+            })
+        }
+        [v0, v1, v2, v3] => rectangle([v0, v1, v2, v3]),
+        _ => Err("a face has 1 to 4 vertices (point, edge, triangle, rectangle)"),
+    }
+}
+
 /// Checks that four vertices, in order around the face, form a rectangle.
-fn rectangle(v: [DVec3; 4], file: &str, n: usize) -> Result<Primitive> {
+fn rectangle(v: [DVec3; 4]) -> std::result::Result<Primitive, &'static str> {
     let (o, e1, e2) = (v[0], v[1] - v[0], v[3] - v[0]);
     let scale = e1.length().max(e2.length());
     let tol = 1e-9 * scale;
     if scale == 0.0 || e1.length() <= tol || e2.length() <= tol {
-        bail!("{file}:{n}: degenerate rectangle (two corners coincide)");
+        return Err("degenerate rectangle (two corners coincide)");
     }
     if (o + e1 + e2 - v[2]).length() > tol || e1.dot(e2).abs() > tol * scale {
-        bail!(
-            "{file}:{n}: the four vertices do not form a rectangle (v0, v1, v2, v3 in order around it); split other quadrilaterals into two triangles"
+        return Err(
+            "the four vertices do not form a rectangle (v0, v1, v2, v3 in order around it); split other quadrilaterals into two triangles",
         );
     }
     Ok(Primitive::Rectangle {
@@ -516,23 +570,7 @@ fn off_face(
             radii.len()
         );
     }
-    let shape = match count {
-        1 => Primitive::Point(v[0]),
-        2 => Primitive::Segment(v[0], v[1]),
-        3 => {
-            let normal = (v[1] - v[0]).cross(v[2] - v[0]);
-            if normal.length_squared() == 0.0 {
-                bail!("{file}:{n}: degenerate triangle (its vertices are collinear)");
-            }
-            Primitive::Triangle {
-                a: v[0],
-                b: v[1],
-                c: v[2],
-                n: normal.normalize(),
-            }
-        }
-        _ => rectangle(v, file, n)?,
-    };
+    let shape = primitive(&v[..count]).map_err(|e| anyhow::anyhow!("{file}:{n}: {e}"))?;
     let face = Face {
         shape,
         radius: radii[ri as usize],

@@ -2,4 +2,5 @@
 
 pub mod closest;
 pub mod mesh;
+pub mod shapes;
 pub mod surface;

@@ -13,7 +13,7 @@ use crate::engine::setup::Inputs;
 use crate::geometry::mesh::Mesh;
 use crate::io::{csv, files};
 use crate::model::particles::Particles;
-use crate::scenario::{MeshSource, Scenario};
+use crate::scenario::{MeshInput, MeshSource, Scenario};
 
 impl Scenario {
     /// Reads and validates a scenario file.
@@ -55,8 +55,11 @@ pub fn meshes(scenario: &Scenario) -> Result<Vec<(Mesh, String)>> {
     };
     let mut all = vec![main];
     for spec in &scenario.meshes {
-        let name = spec.file.display().to_string();
-        all.push((Mesh::load(&spec.file, &spec.radii)?, name));
+        let mesh = match &spec.input {
+            MeshInput::File(path) => Mesh::load(path, &spec.radii)?,
+            MeshInput::Shape(shape) => shape.mesh(spec.radii[0]),
+        };
+        all.push((mesh, spec.input.name()));
     }
     Ok(all)
 }

@@ -10,9 +10,13 @@
 //! [simulation] timestep, max_particles, frames, steps_per_frame, spawn_attempts, seed, skin,
 //!              friction_springs = "advance_first" | "paper", until = { kinetic_energy_below,
 //!              time, removed_at_least }
-//! [[meshes]]   file, radii, contacts, motion = { type = "harmonic", amplitude, frequency, direction,
-//!              phase } | { type = "velocity", velocity } | { type = "rotation", center, axis,
-//!              angular_velocity }   (any number of these)
+//! [[meshes]]   file | shape = { type = "box", min, max, open } | { type = "cylinder", center,
+//!              axis, radius, height, open, orifice, resolution } | { type = "drum", center,
+//!              axis, radius, length, resolution } | { type = "plane", point, normal, size } |
+//!              { type = "hopper", center, axis, top_radius, outlet_radius, height,
+//!              resolution }, radii, contacts, material, motion = { type = "harmonic",
+//!              amplitude, frequency, direction, phase } | { type = "velocity", velocity } |
+//!              { type = "rotation", center, axis, angular_velocity }   (any number of these)
 //! [[tags]]     min, max, tag   (a box that labels particles entering it; any number)
 //! [domain]     min, max, periodic = [bool, bool, bool]   (particles whose centre leaves
 //!              it through a side that is not periodic are removed)
@@ -33,9 +37,11 @@ use anyhow::{Result, bail};
 use glam::DVec3;
 
 use crate::geometry::mesh::Contacts;
+pub use crate::geometry::shapes::Shape;
 pub use crate::model::materials::{FrictionSprings, Material, PairCoefficients};
 use crate::model::motion::Motion;
 
+mod meshes;
 mod raw;
 mod resolved;
 mod spawn;
@@ -241,11 +247,32 @@ impl Interaction {
     }
 }
 
-/// One mesh file with its radii and, optionally, a prescribed motion (`[[meshes]]`).
+/// Where the faces of a `[[meshes]]` entry come from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum MeshInput {
+    /// A mesh file, OFF or STL (`file`).
+    File(PathBuf),
+    /// A built-in shape (`shape`).
+    Shape(Shape),
+}
+
+impl MeshInput {
+    /// How `tinydem check` and messages name it: the file, or the shape's type.
+    pub fn name(&self) -> String {
+        match self {
+            MeshInput::File(p) => p.display().to_string(),
+            MeshInput::Shape(s) => format!("a built-in {}", s.kind()),
+        }
+    }
+}
+
+/// One mesh file or built-in shape with its radii and, optionally, a prescribed motion
+/// (`[[meshes]]`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct MeshSpec {
-    pub file: PathBuf,
-    /// R_mesh of this file's faces, picked by the OFF colour index (STL: the first).
+    pub input: MeshInput,
+    /// R_mesh of this file's faces, picked by the OFF colour index (STL and shapes: the
+    /// first).
     pub radii: Vec<f64>,
     pub contacts: Contacts,
     pub motion: Option<Motion>,
@@ -493,7 +520,9 @@ impl Scenario {
             s.geometry.mesh = MeshSource::File(abs(p));
         }
         for m in &mut s.meshes {
-            m.file = abs(&m.file);
+            if let MeshInput::File(p) = &m.input {
+                m.input = MeshInput::File(abs(p));
+            }
         }
         s.particles = s.particles.as_deref().map(abs);
         s.output_dir = abs(&s.output_dir);

@@ -8,11 +8,52 @@ use serde::Deserialize;
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawMesh {
-    pub(super) file: PathBuf,
+    pub(super) file: Option<PathBuf>,
+    pub(super) shape: Option<RawShape>,
     pub(super) radii: Option<Vec<f64>>,
     pub(super) contacts: Option<String>,
     pub(super) material: Option<String>,
     pub(super) motion: Option<RawMotion>,
+}
+
+/// `[[meshes]] shape = { type = ... }`: a built-in shape (`geometry/shapes.rs`).
+#[derive(Deserialize)]
+#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
+pub(super) enum RawShape {
+    Box {
+        min: [f64; 3],
+        max: [f64; 3],
+        open: Option<Vec<String>>,
+    },
+    Cylinder {
+        center: [f64; 3],
+        axis: [f64; 3],
+        radius: f64,
+        height: f64,
+        open: Option<Vec<String>>,
+        orifice: Option<f64>,
+        resolution: Option<i64>,
+    },
+    Drum {
+        center: [f64; 3],
+        axis: [f64; 3],
+        radius: f64,
+        length: f64,
+        resolution: Option<i64>,
+    },
+    Plane {
+        point: [f64; 3],
+        normal: [f64; 3],
+        size: f64,
+    },
+    Hopper {
+        center: [f64; 3],
+        axis: [f64; 3],
+        top_radius: f64,
+        outlet_radius: f64,
+        height: f64,
+        resolution: Option<i64>,
+    },
 }
 
 #[derive(Deserialize)]

@@ -7,6 +7,7 @@ use std::fmt::Write;
 use glam::DVec3;
 
 use super::*;
+use crate::geometry::shapes::{BOX_SIDES, CYLINDER_ENDS};
 
 impl Scenario {
     /// The scenario as TOML with every default filled in: parsed again (from a file in the
@@ -140,7 +141,14 @@ impl Scenario {
     fn meshes_toml(&self, o: &mut String) {
         for mesh in &self.meshes {
             *o += "\n[[meshes]]\n";
-            let _ = writeln!(o, "file = {}", path(&mesh.file));
+            match &mesh.input {
+                MeshInput::File(p) => {
+                    let _ = writeln!(o, "file = {}", path(p));
+                }
+                MeshInput::Shape(s) => {
+                    let _ = writeln!(o, "shape = {}", shape(s));
+                }
+            }
             let _ = writeln!(o, "radii = {}", list(&mesh.radii));
             let _ = writeln!(o, "contacts = {}", contacts(mesh.contacts));
             if self.uses_materials() {
@@ -298,6 +306,83 @@ fn motion(m: Motion) -> String {
             num(angular_velocity)
         ),
     }
+}
+
+/// A built-in shape as an inline table.
+fn shape(s: &Shape) -> String {
+    let names = |open: &[bool], names: &[&str]| {
+        let named: Vec<String> = names
+            .iter()
+            .zip(open)
+            .filter(|&(_, &o)| o)
+            .map(|(n, _)| text(n))
+            .collect();
+        format!("[{}]", named.join(", "))
+    };
+    let fields = match *s {
+        Shape::Box { min, max, open } => format!(
+            "min = {}, max = {}, open = {}",
+            vec3(min),
+            vec3(max),
+            names(&open, &BOX_SIDES)
+        ),
+        Shape::Cylinder {
+            center,
+            axis,
+            radius,
+            height,
+            open,
+            orifice,
+            resolution,
+        } => format!(
+            "center = {}, axis = {}, radius = {}, height = {}, open = {}, orifice = {}, resolution = {resolution}",
+            vec3(center),
+            vec3(axis),
+            num(radius),
+            num(height),
+            names(&open, &CYLINDER_ENDS),
+            num(orifice)
+        ),
+        Shape::Drum {
+            center,
+            axis,
+            radius,
+            length,
+            resolution,
+        } => format!(
+            "center = {}, axis = {}, radius = {}, length = {}, resolution = {resolution}",
+            vec3(center),
+            vec3(axis),
+            num(radius),
+            num(length)
+        ),
+        Shape::Plane {
+            point,
+            normal,
+            size,
+        } => format!(
+            "point = {}, normal = {}, size = {}",
+            vec3(point),
+            vec3(normal),
+            num(size)
+        ),
+        Shape::Hopper {
+            center,
+            axis,
+            top_radius,
+            outlet_radius,
+            height,
+            resolution,
+        } => format!(
+            "center = {}, axis = {}, top_radius = {}, outlet_radius = {}, height = {}, resolution = {resolution}",
+            vec3(center),
+            vec3(axis),
+            num(top_radius),
+            num(outlet_radius),
+            num(height)
+        ),
+    };
+    format!("{{ type = \"{}\", {fields} }}", s.kind())
 }
 
 /// A spawn region's radius distribution as an inline table.

@@ -6,6 +6,7 @@ use std::path::Path;
 use anyhow::{Context, Result, bail};
 use glam::DVec3;
 
+use super::meshes::meshes;
 use super::raw::*;
 use super::spawn::spawn;
 use super::*;
@@ -126,7 +127,7 @@ fn material(key: &str, m: RawMaterial, viscosity: f64) -> Result<Material> {
 }
 
 /// The value of a `mesh_contacts` or `contacts` key (default "merged").
-fn contacts(key: &str, value: Option<String>) -> Result<Contacts> {
+pub(super) fn contacts(key: &str, value: Option<String>) -> Result<Contacts> {
     match value.as_deref() {
         None | Some("merged") => Ok(Contacts::Merged),
         Some("per_face") => Ok(Contacts::PerFace),
@@ -145,62 +146,6 @@ fn friction_springs(value: Option<String>) -> Result<FrictionSprings> {
             "[simulation] friction_springs = \"{other}\" is not allowed: it must be \"advance_first\" (advance the spring, then take its force: no energy created) or \"paper\" (the paper's Eqs. 53-55 in their order, as the original program)"
         ),
     }
-}
-
-/// Validates one `[[meshes]]` entry.
-fn mesh_spec(k: usize, m: RawMesh, base: &Path) -> Result<MeshSpec> {
-    let key = |name: &str| format!("[[meshes]] #{} {name}", k + 1);
-    let radii = m.radii.unwrap_or_else(|| vec![0.0]);
-    if radii.is_empty() {
-        bail!("{} must hold at least one radius", key("radii"));
-    }
-    for (i, &r) in radii.iter().enumerate() {
-        check(&key(&format!("radii[{i}]")), r, Range::NonNegative)?;
-    }
-    let unit = |name: &str, v: [f64; 3]| -> Result<DVec3> {
-        let v = check_vec(&key(name), v)?;
-        if v.length_squared() == 0.0 {
-            bail!("{} must not be the zero vector", key(name));
-        }
-        Ok(v.normalize())
-    };
-    let motion = match m.motion {
-        None => None,
-        Some(RawMotion::Harmonic {
-            amplitude,
-            frequency,
-            direction,
-            phase,
-        }) => Some(Motion::Harmonic {
-            amplitude: check(&key("motion.amplitude"), amplitude, Range::NonNegative)?,
-            frequency: check(&key("motion.frequency"), frequency, Range::NonNegative)?,
-            direction: unit("motion.direction", direction)?,
-            phase: check(&key("motion.phase"), phase.unwrap_or(0.0), Range::Finite)?,
-        }),
-        Some(RawMotion::Velocity { velocity }) => Some(Motion::Velocity {
-            velocity: check_vec(&key("motion.velocity"), velocity)?,
-        }),
-        Some(RawMotion::Rotation {
-            center,
-            axis,
-            angular_velocity,
-        }) => Some(Motion::Rotation {
-            center: check_vec(&key("motion.center"), center)?,
-            axis: unit("motion.axis", axis)?,
-            angular_velocity: check(
-                &key("motion.angular_velocity"),
-                angular_velocity,
-                Range::Finite,
-            )?,
-        }),
-    };
-    Ok(MeshSpec {
-        file: base.join(m.file),
-        radii,
-        contacts: contacts(&key("contacts"), m.contacts)?,
-        motion,
-        material: 0,
-    })
 }
 
 impl Scenario {
@@ -519,25 +464,6 @@ fn until(raw: Option<RawUntil>) -> Result<Until> {
         );
     }
     Ok(until)
-}
-
-/// `[[meshes]]`, their materials by name (`index`).
-fn meshes(
-    raw: Vec<RawMesh>,
-    base: &Path,
-    index: &dyn Fn(&str, &str) -> Result<u16>,
-) -> Result<Vec<MeshSpec>> {
-    raw.into_iter()
-        .enumerate()
-        .map(|(k, mut m)| {
-            let name = m.material.take();
-            let mut spec = mesh_spec(k, m, base)?;
-            if let Some(name) = name {
-                spec.material = index(&format!("[[meshes]] #{} material", k + 1), &name)?;
-            }
-            Ok(spec)
-        })
-        .collect()
 }
 
 /// `[[tags]]`.
