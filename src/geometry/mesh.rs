@@ -253,7 +253,7 @@ impl Mesh {
     }
 
     /// A mesh of polygons given as indices into `vertices` (one to four corners each, as
-    /// [`primitive`] takes them), all of radius `radius`; faces that share a vertex form
+    /// `primitive` takes them), all of radius `radius`; faces that share a vertex form
     /// one surface. For meshes made in code (`shapes.rs`): a bad polygon is a bug there.
     pub fn from_polygons(vertices: Vec<DVec3>, polygons: &[Vec<usize>], radius: f64) -> Mesh {
         let corners: Vec<Vec<DVec3>> = polygons
