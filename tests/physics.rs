@@ -134,7 +134,7 @@ fn energy(s: &Simulation) -> f64 {
                 total += 8.0 / 15.0 * e_star_pp * r_star.sqrt() * delta.powf(2.5);
             }
         }
-        for face in &s.mesh.faces {
+        for face in &s.walls.mesh.faces {
             let delta = p.radius[i] + face.radius - p.x[i].distance(face.closest_point(p.x[i]));
             if delta > 0.0 {
                 total += 8.0 / 15.0 * e_star_pw * p.radius[i].sqrt() * delta.powf(2.5);

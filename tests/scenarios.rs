@@ -57,11 +57,11 @@ fn full_scenario_sets_every_key() {
     assert_eq!(s.periodic, [true, false, false]);
     assert!(s.wall_forces);
     let sim = Simulation::new(s).unwrap();
-    assert_eq!(sim.mesh.faces.len(), 10);
-    assert_eq!(sim.mesh.faces[1].radius, 0.001);
+    assert_eq!(sim.walls.mesh.faces.len(), 10);
+    assert_eq!(sim.walls.mesh.faces[1].radius, 0.001);
     // The main box per face (five surfaces), the second one merged: its four faces of
     // radius 0 one surface, the face of radius 0.001 another.
-    assert_eq!(sim.mesh.surfaces(), 7);
+    assert_eq!(sim.walls.mesh.surfaces(), 7);
     assert_eq!(sim.particles.len(), 2);
 }
 

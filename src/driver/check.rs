@@ -39,7 +39,7 @@ fn describe_start(s: &Scenario, out: &Path, sim: Simulation) -> Result<String> {
     let k_10 = law.normal_stiffness(r, r, 0.1 * r);
     let period = std::f64::consts::PI * (0.5 * m_min / k_10).sqrt();
     let max_n = most_particles(s, sim.particles.len());
-    let size = OutputEstimate::of(s, max_n, sim.mesh.faces.len());
+    let size = OutputEstimate::of(s, max_n, sim.walls.mesh.faces.len());
     let meshes = mesh_lines(s, &sim);
     let bounds = bound_lines(s, &sim);
     let materials = material_lines(s);
@@ -114,12 +114,12 @@ fn until_line(s: &Scenario) -> String {
 /// A line per mesh file: its faces, contact mode (and surfaces) and material.
 fn mesh_lines(s: &Scenario, sim: &Simulation) -> String {
     let mut meshes = String::new();
-    for (k, file) in sim.mesh_files.iter().enumerate() {
+    for (k, file) in sim.walls.files.iter().enumerate() {
         if file.faces.is_empty() && k == 0 {
             meshes += "mesh                   none\n";
             continue;
         }
-        let faces = &sim.mesh.faces[file.faces.clone()];
+        let faces = &sim.walls.mesh.faces[file.faces.clone()];
         let surfaces: std::collections::BTreeSet<u32> = faces.iter().map(|f| f.surface).collect();
         let contacts = match file.contacts {
             Contacts::Merged => format!(

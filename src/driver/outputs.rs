@@ -37,8 +37,8 @@ impl<'a> Frames<'a> {
 
     /// Files that do not change during the run (the static mesh).
     pub(super) fn start(&self, sim: &Simulation) -> Result<()> {
-        if self.formats.vtk && !sim.mesh_moves() && sim.is_writer() {
-            crate::io::vtk::write_mesh(&self.dir.join("mesh.vtu"), &sim.mesh)?;
+        if self.formats.vtk && !sim.walls.move_at_all() && sim.is_writer() {
+            crate::io::vtk::write_mesh(&self.dir.join("mesh.vtu"), &sim.walls.mesh)?;
         }
         Ok(())
     }
@@ -71,8 +71,11 @@ impl<'a> Frames<'a> {
                 .map(|f| (f as f64 * self.frame_time, format!("particles{f:06}.vtu")))
                 .collect();
             crate::io::vtk::write_collection(&self.dir.join("particles.pvd"), &entries)?;
-            if sim.mesh_moves() {
-                crate::io::vtk::write_mesh(&self.dir.join(format!("mesh{k:06}.vtu")), &sim.mesh)?;
+            if sim.walls.move_at_all() {
+                crate::io::vtk::write_mesh(
+                    &self.dir.join(format!("mesh{k:06}.vtu")),
+                    &sim.walls.mesh,
+                )?;
                 let entries: Vec<(f64, String)> = (0..=k)
                     .map(|f| (f as f64 * self.frame_time, format!("mesh{f:06}.vtu")))
                     .collect();

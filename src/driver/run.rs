@@ -575,5 +575,5 @@ pub fn write_checkpoint(path: &Path, sim: &Simulation) -> Result<()> {
 
 /// The fingerprint of a simulation's scenario and mesh, for checkpoints.
 fn fingerprint(sim: &Simulation) -> u64 {
-    checkpoint::fingerprint(&sim.scenario, &sim.rest_mesh())
+    checkpoint::fingerprint(&sim.scenario, &sim.walls.rest_mesh())
 }

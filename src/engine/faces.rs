@@ -31,20 +31,14 @@ struct MeshScratch {
 struct FaceStage<'a> {
     p: &'a Particles,
     law: &'a ContactLaw,
-    faces: &'a [Face],
-    face_part: &'a [u32],
-    moving: &'a [MovingPart],
+    /// The faces, what they belong to and the scales of the loads on them.
+    walls: &'a Walls,
     densities: &'a [Density],
-    face_material: &'a [u16],
     uniform: bool,
     one_wall: Coefficients<Group>,
     scales: &'a LoadScales,
-    /// Per face its mesh file, the number of files whose loads are summed (0: none) and
-    /// the files (for their torques' reference points).
-    face_file: &'a [u32],
+    /// The number of files whose loads are summed (0: none).
     files: usize,
-    about: &'a [MeshFile],
-    wall_scales: &'a Scales8,
     /// The own particles of a split run.
     owned: Option<&'a [bool]>,
     /// The particle-face list's run starts and faces.
@@ -76,18 +70,12 @@ impl Simulation {
         let stage = FaceStage {
             p: &self.particles,
             law,
-            faces: &self.mesh.faces,
-            face_part: &self.face_part,
-            moving: &self.moving,
+            walls: &self.walls,
             densities: &self.densities,
-            face_material: &self.face_material,
             uniform: law.uniform(),
             one_wall: law.with_wall(0, 0).splat(),
             scales: &self.scales,
-            face_file: &self.face_file,
-            files: self.wall_sums.len(),
-            about: &self.mesh_files,
-            wall_scales: &self.wall_scales,
+            files: self.walls.sums.len(),
             owned: self.domain.as_ref().map(|d| &d.owned[..]),
             start,
             partner,
@@ -110,8 +98,8 @@ impl Simulation {
     /// The pieces' sums of the loads on the mesh files, added to the files' sums (over all
     /// processes of a split run).
     fn sum_wall_loads_of(&mut self, walls: Vec<(Vec<Sum6>, bool)>) {
-        if !self.wall_sums.is_empty() {
-            let mut step = vec![Sum6::default(); self.wall_sums.len()];
+        if !self.walls.sums.is_empty() {
+            let mut step = vec![Sum6::default(); self.walls.sums.len()];
             for (piece, fine) in walls {
                 self.beyond_range |= !fine;
                 for (sum, w) in step.iter_mut().zip(&piece) {
@@ -119,13 +107,7 @@ impl Simulation {
                 }
             }
             self.reduce_walls(&mut step);
-            for (sum, w) in self.wall_sums.iter_mut().zip(&step) {
-                let [fx, fy, fz, tx, ty, tz] = w.value(&self.wall_scales);
-                *sum += Wrench {
-                    f: DVec3::new(fx, fy, fz),
-                    tau: DVec3::new(tx, ty, tz),
-                };
-            }
+            self.walls.add_step(&step);
         }
     }
 }
@@ -196,14 +178,11 @@ impl FaceStage<'_> {
             };
             for (k, &f) in run.clone().zip(&self.partner[run]) {
                 let kl = k - first;
-                let face = &self.faces[f as usize];
+                let face = &self.walls.mesh.faces[f as usize];
                 let touch = if face.certainly_beyond(body.x, body.radius + face.radius) {
                     None
                 } else {
-                    let wall = match self.face_part[f as usize] {
-                        STATIC => RigidVelocity::default(),
-                        part => self.moving[part as usize].velocity,
-                    };
+                    let wall = self.walls.velocity(f as usize);
                     let (d, feature) = face.separation_and_feature(body.x);
                     let (d, interior) = surface::snap(face, body.x, body.radius, d, feature);
                     Kinematics::with_wall(&body, d, face.radius, &wall)
@@ -260,7 +239,7 @@ impl FaceStage<'_> {
                     interior: c.interior,
                 }));
                 let tol = surface::tolerance(x, radius);
-                surface::resolve(candidates, self.faces, tol, order, fates);
+                surface::resolve(candidates, &self.walls.mesh.faces, tol, order, fates);
                 for (c, fate) in near[a..b].iter().zip(fates.iter()) {
                     let Fate::Absorbed(s) = *fate else { continue };
                     let (k, s) = (c.slot, near[a + s].slot);
@@ -337,7 +316,7 @@ impl FaceStage<'_> {
             )
         } else {
             let m = i.map(|i| self.p.material[i]);
-            let f = c.map(|c| self.face_material[self.partner[first + c.slot] as usize]);
+            let f = c.map(|c| self.walls.face_material[self.partner[first + c.slot] as usize]);
             (
                 Inertia::mass_with(
                     radius,
@@ -364,10 +343,11 @@ impl FaceStage<'_> {
             // The reaction on the mesh file (Newton's third law for the
             // force and for the torque about the file's reference point).
             for l in (0..group.len()).filter(|&l| self.owned.is_none_or(|o| o[i[l]])) {
-                let k = self.face_file[self.partner[first + c[l].slot] as usize] as usize;
-                let arm = self.p.x[i[l]] - self.about[k].torque_about;
+                let w = self.walls;
+                let k = w.face_file[self.partner[first + c[l].slot] as usize] as usize;
+                let arm = self.p.x[i[l]] - w.files[k].torque_about;
                 let reaction = pack(-f[l], -(arm.cross(f[l]) + tau[l]));
-                wall_fine &= wall[k].add(reaction, self.wall_scales);
+                wall_fine &= wall[k].add(reaction, &w.scales);
             }
         }
         wall_fine

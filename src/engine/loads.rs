@@ -79,16 +79,17 @@ impl Simulation {
         if !self.scenario.wall_forces {
             return;
         }
-        self.face_file = vec![0; self.mesh.faces.len()];
-        for (k, file) in self.mesh_files.iter().enumerate() {
-            self.face_file[file.faces.clone()].fill(k as u32);
+        let w = &mut self.walls;
+        w.face_file = vec![0; w.mesh.faces.len()];
+        for (k, file) in w.files.iter().enumerate() {
+            w.face_file[file.faces.clone()].fill(k as u32);
         }
-        self.wall_sums = vec![Wrench::default(); self.mesh_files.len()];
+        w.sums = vec![Wrench::default(); w.files.len()];
         // The lever of a torque about a file's point: to its farthest corner, or across the
         // domain, and a particle's radius; 16 times that, for meshes that move.
         let mut lever: f64 = 0.0;
-        for file in &self.mesh_files {
-            for face in &self.rest_faces[file.faces.clone()] {
+        for file in &w.files {
+            for face in &w.rest_faces[file.faces.clone()] {
                 for c in face.corners() {
                     lever = lever.max(c.distance(file.torque_about) + face.radius);
                 }
@@ -98,13 +99,12 @@ impl Simulation {
             lever = lever.max((d.max - d.min).length());
         }
         lever = 16.0 * (lever + LoadScales::largest_radius(&self.scenario));
-        self.wall_scales = self.scales.walls(lever);
+        w.scales = self.scales.walls(lever);
     }
 
     /// The loads on each mesh file summed over the steps since the last call, and the
     /// sums set back to zero (empty unless `[output] wall_forces`).
     pub fn take_wall_loads(&mut self) -> Vec<Wrench> {
-        let zero = vec![Wrench::default(); self.wall_sums.len()];
-        std::mem::replace(&mut self.wall_sums, zero)
+        self.walls.take_loads()
     }
 }

@@ -31,7 +31,6 @@ mod advance;
 mod checks;
 mod faces;
 mod loads;
-mod meshes;
 mod pairs;
 pub mod records;
 mod regions;
@@ -39,14 +38,14 @@ mod report;
 pub mod setup;
 pub mod spawn;
 mod split;
+mod walls;
 use crate::engine::spawn::{Spawner, SpawnerState};
 use crate::geometry::surface::{self, Candidate, Fate};
 use crate::model::springs::Springs;
 use crate::scenario::Scenario;
 use loads::Load;
 pub use loads::LoadScales;
-pub use meshes::MeshFile;
-use meshes::{MovingPart, STATIC};
+pub use walls::{MeshFile, Walls};
 
 /// Contacts per group evaluated together: 8 doubles fill an AVX-512 register, two AVX ones.
 const WIDTH: usize = 8;
@@ -346,9 +345,8 @@ impl Thermo {
 pub struct Simulation {
     pub scenario: Scenario,
     pub particles: Particles,
-    pub mesh: Mesh,
-    /// The mesh files `mesh` was put together from.
-    pub mesh_files: Vec<MeshFile>,
+    /// The mesh, its files and moving parts, and the loads on them.
+    pub walls: Walls,
     law: ContactLaw,
     pub(crate) neighbours: Neighbours,
     pub(crate) face_grid: CellGrid,
@@ -361,14 +359,6 @@ pub struct Simulation {
     /// Some force or torque of the last step was beyond the range of the sums, or not
     /// finite (the run is unstable).
     beyond_range: bool,
-    /// The mesh as read (at t = 0).
-    rest_faces: Vec<Face>,
-    /// Parts of the mesh that follow a prescribed motion.
-    moving: Vec<MovingPart>,
-    /// For each face, its moving part, or `STATIC`.
-    face_part: Vec<u32>,
-    /// Largest displacement of a moving face since the last neighbour-list rebuild.
-    mesh_drift: f64,
     /// Step of the last neighbour-list rebuild.
     pub(crate) built_at: u64,
     /// Simulated time \[T\] and number of steps taken.
@@ -380,18 +370,8 @@ pub struct Simulation {
     warnings: Warnings,
     /// Particles removed so far by the outlets and the domain bounds.
     pub removed: Removed,
-    /// For each face, its mesh file (an index of `mesh_files`), if wall loads are summed.
-    face_file: Vec<u32>,
-    /// For each face, its material.
-    face_material: Vec<u16>,
     /// For each material, the quotients of its density.
     pub(crate) densities: Vec<Density>,
-    /// The loads on each mesh file summed over the steps since the last call of
-    /// [`Simulation::take_wall_loads`] (`[output] wall_forces`): each step's exactly (over
-    /// all contacts, and all processes), then the steps in order.
-    pub(crate) wall_sums: Vec<Wrench>,
-    /// The resolutions of the wall loads' sums of a step.
-    wall_scales: Scales8,
     /// The largest radius the faces are binned for.
     pub(crate) face_grid_radius: f64,
     /// This process's share of a run split over several (`domain.rs`).
@@ -418,9 +398,9 @@ impl Simulation {
             pair_history: history.pairs.entries(),
             face_history: history.faces.entries(),
             removed: self.removed.clone(),
-            wall_sums: self.wall_sums.clone(),
+            wall_sums: self.walls.sums.clone(),
             scenario: self.scenario.to_toml(),
-            mesh_files: self.mesh_signatures(),
+            mesh_files: self.walls.signatures(),
         })
     }
 
@@ -465,7 +445,7 @@ impl Simulation {
     pub fn step(&mut self) -> Result<(), Unstable> {
         let t = Instant::now();
         self.slide_images();
-        self.move_meshes();
+        self.walls.move_to(self.time);
         let t = self.stage_times.add(Stage::MoveMeshes, t);
         self.spawn();
         let t = self.stage_times.add(Stage::Spawn, t);
@@ -520,7 +500,7 @@ impl Simulation {
             self.spawner.spawn(
                 s,
                 &mut self.particles,
-                &self.mesh.faces,
+                &self.walls.mesh.faces,
                 &self.face_grid,
                 self.time,
                 0.0,
@@ -547,8 +527,8 @@ impl Simulation {
         let stale = self.neighbours.stale(
             &p.x,
             &p.radius,
-            &self.mesh.faces,
-            self.mesh_drift.max(self.neighbours.shear_drift()),
+            &self.walls.mesh.faces,
+            self.walls.drift.max(self.neighbours.shear_drift()),
         );
         match &self.domain {
             // Split over processes: all rebuild when one must.
@@ -556,7 +536,7 @@ impl Simulation {
                 self.redistribute(&Default::default(), crate::parallel::domain::Placement::Now)
             }
             Some(_) => {}
-            None if stale => self.rebuild_lists(!self.moving.is_empty()),
+            None if stale => self.rebuild_lists(self.walls.move_at_all()),
             None => {}
         }
     }
@@ -568,7 +548,7 @@ impl Simulation {
             self.regrid_faces();
         }
         self.neighbours
-            .rebuild(&mut self.particles, &self.mesh.faces, &self.face_grid);
+            .rebuild(&mut self.particles, &self.walls.mesh.faces, &self.face_grid);
         self.built();
     }
 
@@ -584,6 +564,6 @@ impl Simulation {
         self.loads.clear();
         self.loads.resize(self.particles.len(), Load::default());
         self.built_at = self.steps;
-        self.mark_mesh_built();
+        self.walls.mark_built(self.time);
     }
 }

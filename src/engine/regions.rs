@@ -61,7 +61,7 @@ impl Simulation {
         self.neighbours.rebuild_without(
             &mut self.particles,
             &gone,
-            &self.mesh.faces,
+            &self.walls.mesh.faces,
             &self.face_grid,
         );
         self.built();

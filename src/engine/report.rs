@@ -73,18 +73,17 @@ impl Simulation {
         let p = &self.particles;
         let mut out = Vec::new();
         for (i, f, springs, _) in open_contacts(&self.neighbours.faces) {
-            let face = &self.mesh.faces[f];
-            let wall = match self.face_part[f] {
-                STATIC => RigidVelocity::default(),
-                part => self.moving[part as usize].velocity,
-            };
+            let face = &self.walls.mesh.faces[f];
+            let wall = self.walls.velocity(f);
             let b = self.body_of(i);
             let (d, feature) = face.separation_and_feature(b.x);
             let (d, _) = surface::snap(face, b.x, b.radius, d, feature);
             let Some(kin) = Kinematics::with_wall(&b, d, face.radius, &wall) else {
                 continue;
             };
-            let coef = self.law.with_wall(p.material[i], self.face_material[f]);
+            let coef = self
+                .law
+                .with_wall(p.material[i], self.walls.face_material[f]);
             out.push(self.record(i, Other::Wall, &kin, coef, springs, Partner::Face(f)));
         }
         out

@@ -47,28 +47,16 @@ impl Simulation {
             mesh.append(part);
         }
         let mut sim = Simulation::from_parts(scenario, mesh, inputs.particles)?;
-        sim.mesh_files = files;
-        for file in &sim.mesh_files {
-            sim.face_material[file.faces.clone()].fill(file.material);
+        let w = &mut sim.walls;
+        w.files = files;
+        for file in &w.files {
+            w.face_material[file.faces.clone()].fill(file.material);
         }
         sim.sum_wall_loads();
         for (faces, motion) in moving {
-            for f in faces.clone() {
-                sim.face_part[f] = sim.moving.len() as u32;
-            }
-            let corners = sim.rest_faces[faces.clone()]
-                .iter()
-                .flat_map(Face::corners)
-                .collect();
-            sim.moving.push(MovingPart {
-                faces,
-                motion,
-                velocity: RigidVelocity::default(),
-                corners,
-                pose_at_build: Pose::REST,
-            });
+            sim.walls.add_moving(faces, motion);
         }
-        sim.move_meshes();
+        sim.walls.move_to(sim.time);
         Ok(sim)
     }
 
@@ -103,15 +91,15 @@ impl Simulation {
         sim.removed.domain = snapshot.removed.domain;
         sim.removed.outlets[..snapshot.removed.outlets.len()]
             .copy_from_slice(&snapshot.removed.outlets);
-        if !sim.wall_sums.is_empty() && snapshot.wall_sums.len() == sim.wall_sums.len() {
-            sim.wall_sums = snapshot.wall_sums;
+        if !sim.walls.sums.is_empty() && snapshot.wall_sums.len() == sim.walls.sums.len() {
+            sim.walls.sums = snapshot.wall_sums;
         }
         let dt = sim.scenario.simulation.timestep;
         if snapshot.anchors.is_empty() {
             // Taken before the first step: the lists are made as that step would make them.
             sim.steps = snapshot.steps;
             sim.time = sim.steps as f64 * dt;
-            sim.move_meshes();
+            sim.walls.move_to(sim.time);
             sim.neighbours =
                 Neighbours::with_periodic(sim.neighbours.skin, sim.neighbours.periodic);
             return Ok(sim);
@@ -121,11 +109,11 @@ impl Simulation {
         sim.steps = snapshot.built_at;
         sim.time = sim.steps as f64 * dt;
         sim.slide_images();
-        sim.move_meshes();
+        sim.walls.move_to(sim.time);
         sim.rebuild_as_built(snapshot.anchors, snapshot.lonely, &history);
         sim.steps = snapshot.steps;
         sim.time = sim.steps as f64 * dt;
-        sim.move_meshes();
+        sim.walls.move_to(sim.time);
         Ok(sim)
     }
 
@@ -143,7 +131,7 @@ impl Simulation {
                 "it counts the insertions of {regions} [[spawn]] regions, the scenario has {spawn}"
             ));
         }
-        let (sums, files) = (snapshot.wall_sums.len(), self.mesh_files.len());
+        let (sums, files) = (snapshot.wall_sums.len(), self.walls.files.len());
         if sums != 0 && sums != files {
             return Err(format!(
                 "it sums the loads on {sums} mesh files, the scenario has {files}"
@@ -155,7 +143,7 @@ impl Simulation {
                 "it counts {outlets} outlets, the scenario has {have}"
             ));
         }
-        let faces = self.mesh.faces.len();
+        let faces = self.walls.mesh.faces.len();
         if let Some(&(_, f, _)) = snapshot.face_history.iter().find(|e| e.1 as usize >= faces) {
             return Err(format!("contact with face {f}, which the mesh lacks"));
         }
@@ -176,7 +164,7 @@ impl Simulation {
             &self.particles,
             anchors,
             lonely,
-            &self.mesh.faces,
+            &self.walls.mesh.faces,
             &self.face_grid,
             history,
         );
@@ -202,7 +190,7 @@ impl Simulation {
         let p = snapshot.particles;
         check_materials(&p, &sim.scenario).map_err(|e| misfit(format!("{e:#}")))?;
         let mut notes = vec![sim.continue_spawner(&snapshot.scenario, snapshot.spawner)?];
-        let new_files = sim.mesh_signatures();
+        let new_files = sim.walls.signatures();
         let face_history = sim.carried_face_contacts(&snapshot.mesh_files, &snapshot.face_history);
         let dropped = snapshot.face_history.len() - face_history.len();
         notes.push(format!(
@@ -276,7 +264,7 @@ impl Simulation {
         old_files: &[(u64, u64)],
         face_history: &[(u32, u32, Springs)],
     ) -> Vec<(u32, u32, Springs)> {
-        let new_files = self.mesh_signatures();
+        let new_files = self.walls.signatures();
         let mut taken = vec![false; new_files.len()];
         let mut face_map: Vec<Option<u32>> = Vec::new();
         for old in old_files {
@@ -284,7 +272,7 @@ impl Simulation {
             if let Some(j) = found {
                 taken[j] = true;
             }
-            let start = found.map(|j| self.mesh_files[j].faces.start as u32);
+            let start = found.map(|j| self.walls.files[j].faces.start as u32);
             face_map.extend((0..old.0 as u32).map(|f| start.map(|s| s + f)));
         }
         face_history
@@ -326,26 +314,12 @@ impl Simulation {
             loads: Vec::new(),
             scales: LoadScales::of(&scenario),
             beyond_range: false,
-            rest_faces: mesh.faces.clone(),
-            moving: Vec::new(),
-            face_part: vec![STATIC; mesh.faces.len()],
-            mesh_drift: 0.0,
             built_at: 0,
             time: 0.0,
             steps: 0,
             stage_times: StageTimes::default(),
             warnings: Warnings::default(),
-            mesh_files: vec![MeshFile {
-                name: "mesh".into(),
-                faces: 0..mesh.faces.len(),
-                contacts: mesh
-                    .faces
-                    .first()
-                    .map_or_else(Contacts::default, |f| f.contacts),
-                torque_about: DVec3::ZERO,
-                material: scenario.geometry.mesh_material,
-            }],
-            face_material: vec![scenario.geometry.mesh_material; mesh.faces.len()],
+            walls: Walls::of(mesh, scenario.geometry.mesh_material),
             densities: scenario
                 .materials
                 .iter()
@@ -355,14 +329,10 @@ impl Simulation {
                 outlets: vec![Outflow::default(); scenario.outlets.len()],
                 domain: Outflow::default(),
             },
-            face_file: Vec::new(),
-            wall_sums: Vec::new(),
-            wall_scales: Scales8::new([Scale::for_largest(1.0); 8]),
             face_grid_radius: max_radius,
             domain: None,
             scenario,
             particles,
-            mesh,
         };
         sim.sum_wall_loads();
         Ok(sim)

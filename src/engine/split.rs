@@ -149,9 +149,9 @@ impl Simulation {
             pair_history: pairs,
             face_history: faces,
             removed: self.removed.clone(),
-            wall_sums: self.wall_sums.clone(),
+            wall_sums: self.walls.sums.clone(),
             scenario: self.scenario.to_toml(),
-            mesh_files: self.mesh_signatures(),
+            mesh_files: self.walls.signatures(),
         }
     }
 
@@ -218,7 +218,7 @@ impl Simulation {
             self.steps = self.built_at;
             self.time = self.built_at as f64 * self.scenario.simulation.timestep;
             self.slide_images();
-            self.move_meshes();
+            self.walls.move_to(self.time);
         }
         if let (Placement::Now, Some(periodic)) = (placement, self.neighbours.periodic) {
             // As at a rebuild in one process: the particles put back into the box (the
@@ -242,7 +242,7 @@ impl Simulation {
         // The lists, with the faces binned for the largest particle of all processes.
         self.particles = held;
         let max_radius = self.scenario.geometry.radius_max.max(r_max);
-        if self.mesh_moves() || max_radius > self.face_grid_radius {
+        if self.walls.move_at_all() || max_radius > self.face_grid_radius {
             self.regrid_faces_for(max_radius);
         }
         let order = self.neighbours.rebuild_from(
@@ -250,7 +250,7 @@ impl Simulation {
             held_at,
             &pairs,
             &faces,
-            &self.mesh.faces,
+            &self.walls.mesh.faces,
             &self.face_grid,
         );
         if placement == Placement::Anchors && !carry {
@@ -276,7 +276,7 @@ impl Simulation {
         self.built();
         if carry {
             (self.steps, self.time) = clock;
-            self.move_meshes();
+            self.walls.move_to(self.time);
         }
     }
 
@@ -367,7 +367,7 @@ impl Simulation {
         self.spawner.spawn(
             s,
             &mut around,
-            &self.mesh.faces,
+            &self.walls.mesh.faces,
             &self.face_grid,
             self.time,
             present,
@@ -450,7 +450,7 @@ impl Simulation {
 
     /// Bins the faces for particles up to radius `max_radius`.
     pub(crate) fn regrid_faces_for(&mut self, max_radius: f64) {
-        self.face_grid = face_grid(&self.mesh.faces, max_radius, self.neighbours.skin);
+        self.face_grid = face_grid(&self.walls.mesh.faces, max_radius, self.neighbours.skin);
         self.face_grid_radius = max_radius;
     }
 }

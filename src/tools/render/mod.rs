@@ -398,7 +398,7 @@ impl Source {
         let mut mesh = self.extra.clone();
         if let Some(sim) = self.sim.as_mut() {
             mesh.faces
-                .extend(sim.mesh_at(t.unwrap_or(0.0)).faces.iter().copied());
+                .extend(sim.walls.at(t.unwrap_or(0.0)).faces.iter().copied());
         }
         mesh
     }
