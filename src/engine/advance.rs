@@ -3,80 +3,80 @@
 
 use super::*;
 
-impl Simulation {
-    /// Stage 5 (Section 2.3): advance each particle by Δt under the force and torque its
-    /// contacts added to its load (Eqs. 1-2).
-    /// Returns whether some particle's new state is not finite (for stage 6, so that it
-    /// needs no pass of its own).
-    #[inline(never)] // a stage of its own in profiles
-    pub(super) fn integrate(&mut self) -> bool {
-        let s = &self.scenario;
-        let scales = &self.scales;
-        let (dt, g) = (s.simulation.timestep, s.kinetics.gravity);
-        let densities = &self.densities;
-        let uniform = densities.len() == 1;
-        let p = &mut self.particles;
-        let material = &p.material;
-        (
-            p.x.par_chunks_mut(WIDTH),
-            p.v.par_chunks_mut(WIDTH),
-            p.q.par_chunks_mut(WIDTH),
-            p.w.par_chunks_mut(WIDTH),
-            p.radius.par_chunks(WIDTH),
-            material.par_chunks(WIDTH),
-            self.loads.par_chunks_mut(WIDTH),
-        )
-            .into_par_iter()
-            .with_min_len(MIN_PARALLEL_LEN.div_ceil(WIDTH))
-            .map(|(x, v, q, w, radius, material, load)| {
-                // `WIDTH` particles at a time in lanes; a short last group repeats its last
-                // particle in the spare lanes. The loads are used up (zeroed for the next
-                // step).
-                let n = x.len();
-                let lane: [usize; WIDTH] = std::array::from_fn(|l| l.min(n - 1));
-                let (mut f, mut tau) = ([DVec3::ZERO; WIDTH], [DVec3::ZERO; WIDTH]);
-                for l in 0..WIDTH {
-                    let v = load[lane[l]].value(&scales.lanes);
-                    (f[l], tau[l]) = (DVec3::new(v[0], v[1], v[2]), DVec3::new(v[3], v[4], v[5]));
-                }
-                load.fill(Load::default());
-                let state = State::<Group> {
-                    x: Group::gather_vec_at(x, &lane),
-                    v: Group::gather_vec_at(v, &lane),
-                    q: Group::gather_quat_at(q, &lane),
-                    w: Group::gather_vec_at(w, &lane),
-                };
-                let (inv_mass_r3, drag) = if uniform {
-                    let d = densities[0];
-                    (Group::splat(d.inv_mass_r3), Group::splat(d.drag))
-                } else {
-                    let d = lane.map(|l| densities[material[l] as usize]);
-                    (
-                        Group::gather(d.map(|d| d.inv_mass_r3)),
-                        Group::gather(d.map(|d| d.drag)),
-                    )
-                };
-                let body = Response::with(Group::gather_at(radius, &lane), inv_mass_r3, drag);
-                let new = advance(
-                    state,
-                    &body,
-                    Group::gather_vec(f),
-                    Group::gather_vec(tau),
-                    Group::splat_vec(g),
-                    Group::splat(dt),
-                );
-                let (new_x, new_v, new_q, new_w) = (
-                    Group::scatter_vec(new.x),
-                    Group::scatter_vec(new.v),
-                    Group::scatter_quat(new.q),
-                    Group::scatter_vec(new.w),
-                );
-                x.copy_from_slice(&new_x[..n]);
-                v.copy_from_slice(&new_v[..n]);
-                q.copy_from_slice(&new_q[..n]);
-                w.copy_from_slice(&new_w[..n]);
-                (0..n).any(|l| !(x[l].is_finite() && v[l].is_finite() && w[l].is_finite()))
-            })
-            .reduce(|| false, |a, b| a || b)
-    }
+/// Stage 5 (Section 2.3): advance each particle of `p` by `dt` under gravity `g` and the
+/// force and torque its contacts added to its load (Eqs. 1-2), which it uses up (zeroes).
+/// Returns whether some particle's new state is not finite (for stage 6, so that it needs
+/// no pass of its own).
+#[inline(never)] // a stage of its own in profiles
+pub(super) fn run(
+    model: &Model,
+    (dt, g): (f64, DVec3),
+    p: &mut Particles,
+    loads: &mut [Load],
+) -> bool {
+    let scales = &model.scales;
+    let densities = &model.densities;
+    let uniform = densities.len() == 1;
+    let material = &p.material;
+    (
+        p.x.par_chunks_mut(WIDTH),
+        p.v.par_chunks_mut(WIDTH),
+        p.q.par_chunks_mut(WIDTH),
+        p.w.par_chunks_mut(WIDTH),
+        p.radius.par_chunks(WIDTH),
+        material.par_chunks(WIDTH),
+        loads.par_chunks_mut(WIDTH),
+    )
+        .into_par_iter()
+        .with_min_len(MIN_PARALLEL_LEN.div_ceil(WIDTH))
+        .map(|(x, v, q, w, radius, material, load)| {
+            // `WIDTH` particles at a time in lanes; a short last group repeats its last
+            // particle in the spare lanes. The loads are used up (zeroed for the next
+            // step).
+            let n = x.len();
+            let lane: [usize; WIDTH] = std::array::from_fn(|l| l.min(n - 1));
+            let (mut f, mut tau) = ([DVec3::ZERO; WIDTH], [DVec3::ZERO; WIDTH]);
+            for l in 0..WIDTH {
+                let v = load[lane[l]].value(&scales.lanes);
+                (f[l], tau[l]) = (DVec3::new(v[0], v[1], v[2]), DVec3::new(v[3], v[4], v[5]));
+            }
+            load.fill(Load::default());
+            let state = State::<Group> {
+                x: Group::gather_vec_at(x, &lane),
+                v: Group::gather_vec_at(v, &lane),
+                q: Group::gather_quat_at(q, &lane),
+                w: Group::gather_vec_at(w, &lane),
+            };
+            let (inv_mass_r3, drag) = if uniform {
+                let d = densities[0];
+                (Group::splat(d.inv_mass_r3), Group::splat(d.drag))
+            } else {
+                let d = lane.map(|l| densities[material[l] as usize]);
+                (
+                    Group::gather(d.map(|d| d.inv_mass_r3)),
+                    Group::gather(d.map(|d| d.drag)),
+                )
+            };
+            let body = Response::with(Group::gather_at(radius, &lane), inv_mass_r3, drag);
+            let new = advance(
+                state,
+                &body,
+                Group::gather_vec(f),
+                Group::gather_vec(tau),
+                Group::splat_vec(g),
+                Group::splat(dt),
+            );
+            let (new_x, new_v, new_q, new_w) = (
+                Group::scatter_vec(new.x),
+                Group::scatter_vec(new.v),
+                Group::scatter_quat(new.q),
+                Group::scatter_vec(new.w),
+            );
+            x.copy_from_slice(&new_x[..n]);
+            v.copy_from_slice(&new_v[..n]);
+            q.copy_from_slice(&new_q[..n]);
+            w.copy_from_slice(&new_w[..n]);
+            (0..n).any(|l| !(x[l].is_finite() && v[l].is_finite() && w[l].is_finite()))
+        })
+        .reduce(|| false, |a, b| a || b)
 }

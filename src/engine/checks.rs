@@ -30,16 +30,20 @@ pub(super) fn gather_told(
 
 impl Simulation {
     /// Stage 6: stop loudly rather than continue a run that has blown up: a non-finite
-    /// state (`bad`, from the integration) or an overlap past the smaller diameter. `deep`
+    /// state (`non_finite_state`, from the integration) or an overlap past the smaller diameter. `deep`
     /// lists the overlaps deeper than the smaller radius found in this step's contact
     /// stages; those within the diameter are a legitimate transient of a crowded packing
     /// (a small grain squeezed by a large one) and only warned of, once per pair.
     #[inline(never)] // a stage of its own in profiles
     pub(super) fn check_stability(
         &mut self,
-        mut deep: Vec<Deep>,
-        bad: bool,
+        found: Findings,
+        non_finite_state: bool,
     ) -> Result<(), Unstable> {
+        let Findings {
+            mut deep,
+            beyond_range,
+        } = found;
         let p = &self.particles;
         let non_finite =
             |k: usize| !(p.x[k].is_finite() && p.v[k].is_finite() && p.w[k].is_finite());
@@ -49,10 +53,10 @@ impl Simulation {
             Some(d) => {
                 deep.retain(|x| d.owned[x.i]);
                 let own_bad = (0..p.len()).any(|k| d.owned[k] && non_finite(k));
-                let bad = self.beyond_range || own_bad || deep.iter().any(Deep::through);
+                let bad = beyond_range || own_bad || deep.iter().any(Deep::through);
                 d.comm.any(bad)
             }
-            None => bad || deep.iter().any(Deep::through),
+            None => non_finite_state || beyond_range || deep.iter().any(Deep::through),
         };
         if !bad {
             for d in deep {
@@ -67,11 +71,11 @@ impl Simulation {
         // What went wrong, each with the order it is told in: the range of the sums, then
         // up to five particles in id order, then the deepest overlaps by pair.
         let mut told: Vec<(u8, u64, u64, String)> = Vec::new();
-        if self.beyond_range {
+        if beyond_range {
             told.push((0, 0, 0, format!(
                 "a contact force or torque was not finite or beyond the range of the sums ({:.3e} N, {:.3e} N m: 4096 times the largest a contact of these materials and radii should give)",
-                self.scales.force.largest(),
-                self.scales.torque.largest()
+                self.model.scales.force.largest(),
+                self.model.scales.torque.largest()
             )));
         }
         for k in p

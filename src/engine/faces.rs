@@ -46,66 +46,76 @@ struct FaceStage<'a> {
     partner: &'a [u32],
 }
 
-impl Simulation {
-    /// Stage 4 (Sections 2.2, 3.3): the force of every particle-face contact. Returns the
-    /// overlaps deeper than the particle's radius.
-    ///
-    /// Each piece of the list holds whole runs of owners. For each particle it finds the
-    /// faces within reach (closest point, kinematics), decides which of them are contacts
-    /// of their own (one per touch of a connected surface, `surface.rs`; with `per_face`
-    /// every face is a surface of its own), hands the springs of the others to the contact
-    /// that absorbs them, then evaluates the law for `WIDTH` contacts at a time in SIMD
-    /// lanes (bit for bit as alone).
-    #[inline(never)] // a stage of its own in profiles
-    pub(super) fn mesh_contacts(&mut self) -> Vec<Deep> {
-        let found = Found::default();
-        let law = &self.law;
-        let ContactList {
-            start,
-            partner,
-            contact,
-            pieces: bounds,
-            stores,
-        } = &mut self.neighbours.faces;
-        let stage = FaceStage {
-            p: &self.particles,
-            law,
-            walls: &self.walls,
-            densities: &self.densities,
-            uniform: law.uniform(),
-            one_wall: law.with_wall(0, 0).splat(),
-            scales: &self.scales,
-            files: self.walls.sums.len(),
-            owned: self.domain.as_ref().map(|d| &d.owned[..]),
-            start,
-            partner,
-        };
-        thread_local! {
-            static SCRATCH: std::cell::RefCell<MeshScratch> = Default::default();
-        }
-        let all = pieces(bounds, &mut self.loads, start, contact, stores);
-        let walls: Vec<(Vec<Sum6>, bool)> = all
-            .into_par_iter()
-            .with_min_len(MIN_PARALLEL_LEN.div_ceil(FACE_PIECE))
-            .map(|piece| SCRATCH.with_borrow_mut(|scratch| stage.piece(piece, scratch, &found)))
-            .collect();
-        self.sum_wall_loads_of(walls);
-        let (deep, beyond) = found.into_inner();
-        self.beyond_range |= beyond;
-        deep
+/// Stage 4 (Sections 2.2, 3.3): the force of every contact of a particle of `p` with a
+/// face of `walls` in `list` (the particle-face list), added to the particles' `loads`.
+/// Returns what it found, and the step's exact sums of the reactions on each mesh file
+/// (of the `owned` particles of a split run; empty unless wall loads are summed).
+///
+/// Each piece of the list holds whole runs of owners. For each particle it finds the
+/// faces within reach (closest point, kinematics), decides which of them are contacts
+/// of their own (one per touch of a connected surface, `surface.rs`; with `per_face`
+/// every face is a surface of its own), hands the springs of the others to the contact
+/// that absorbs them, then evaluates the law for `WIDTH` contacts at a time in SIMD
+/// lanes (bit for bit as alone).
+#[inline(never)] // a stage of its own in profiles
+pub(super) fn run(
+    model: &Model,
+    p: &Particles,
+    walls: &Walls,
+    owned: Option<&[bool]>,
+    list: &mut ContactList,
+    loads: &mut [Load],
+) -> (Findings, Vec<Sum6>) {
+    let found = Found::default();
+    let law = &model.law;
+    let ContactList {
+        start,
+        partner,
+        contact,
+        pieces: bounds,
+        stores,
+    } = list;
+    let stage = FaceStage {
+        p,
+        law,
+        walls,
+        densities: &model.densities,
+        uniform: law.uniform(),
+        one_wall: law.with_wall(0, 0).splat(),
+        scales: &model.scales,
+        files: walls.sums.len(),
+        owned,
+        start,
+        partner,
+    };
+    thread_local! {
+        static SCRATCH: std::cell::RefCell<MeshScratch> = Default::default();
     }
-
-    /// The pieces' sums of the loads on the mesh files, added to the files' sums (over all
-    /// processes of a split run).
-    fn sum_wall_loads_of(&mut self, walls: Vec<(Vec<Sum6>, bool)>) {
-        if !self.walls.sums.is_empty() {
-            let mut step = vec![Sum6::default(); self.walls.sums.len()];
-            for (piece, fine) in walls {
-                self.beyond_range |= !fine;
-                for (sum, w) in step.iter_mut().zip(&piece) {
-                    sum.merge(w);
-                }
+    let all = pieces(bounds, loads, start, contact, stores);
+    let pieces: Vec<(Vec<Sum6>, bool)> = all
+        .into_par_iter()
+        .with_min_len(MIN_PARALLEL_LEN.div_ceil(FACE_PIECE))
+        .map(|piece| SCRATCH.with_borrow_mut(|scratch| stage.piece(piece, scratch, &found)))
+        .collect();
+    let mut found = found.into_inner();
+    // The pieces' sums of the loads on the mesh files, in order.
+    let mut step = vec![Sum6::default(); walls.sums.len()];
+    if !step.is_empty() {
+        for (piece, fine) in pieces {
+            found.beyond_range |= !fine;
+            for (sum, w) in step.iter_mut().zip(&piece) {
+                sum.merge(w);
             }
+        }
+    }
+    (found, step)
+}
+
+impl Simulation {
+    /// A step's sums of the loads on the mesh files (of this process's own particles),
+    /// added to the files' sums (over all processes of a split run).
+    pub(super) fn add_wall_loads(&mut self, mut step: Vec<Sum6>) {
+        if !step.is_empty() {
             self.reduce_walls(&mut step);
             self.walls.add_step(&step);
         }

@@ -99,7 +99,7 @@ impl Simulation {
             lever = lever.max((d.max - d.min).length());
         }
         lever = 16.0 * (lever + LoadScales::largest_radius(&self.scenario));
-        w.scales = self.scales.walls(lever);
+        w.scales = self.model.scales.walls(lever);
     }
 
     /// The loads on each mesh file summed over the steps since the last call, and the

@@ -42,7 +42,7 @@ mod walls;
 use crate::engine::spawn::{Spawner, SpawnerState};
 use crate::geometry::surface::{self, Candidate, Fate};
 use crate::model::springs::Springs;
-use crate::scenario::Scenario;
+use crate::scenario::{Scenario, TagRegion};
 use loads::Load;
 pub use loads::LoadScales;
 pub use walls::{MeshFile, Walls};
@@ -51,8 +51,41 @@ pub use walls::{MeshFile, Walls};
 const WIDTH: usize = 8;
 type Group = wide::f64x8;
 
-/// What the tasks of a contact stage find beside the loads: the overlaps deeper than
-/// allowed, and whether a load left the range of its exact sum.
+/// The constants the stages compute with: the contact law of the scenario's materials,
+/// each material's density quotients and the resolutions of the loads' sums.
+pub(crate) struct Model {
+    pub(crate) law: ContactLaw,
+    pub(crate) densities: Vec<Density>,
+    pub(crate) scales: LoadScales,
+}
+
+impl Model {
+    /// The mass of particle `k` of `p`.
+    fn mass(&self, p: &Particles, k: usize) -> f64 {
+        Inertia::mass_with(
+            p.radius[k],
+            self.densities[p.material[k] as usize].mass_per_r3,
+        )
+    }
+}
+
+/// What the contact stages of a step find beside the loads, for the stability check: the
+/// overlaps deeper than the smaller radius, and whether a load left the range of its
+/// exact sum (or was not finite).
+#[derive(Default)]
+pub(super) struct Findings {
+    deep: Vec<Deep>,
+    beyond_range: bool,
+}
+
+impl Findings {
+    fn merge(&mut self, other: Findings) {
+        self.deep.extend(other.deep);
+        self.beyond_range |= other.beyond_range;
+    }
+}
+
+/// [`Findings`] as the parallel tasks of a contact stage collect them.
 #[derive(Default)]
 struct Found {
     deep: Mutex<Vec<Deep>>,
@@ -60,11 +93,11 @@ struct Found {
 }
 
 impl Found {
-    fn into_inner(self) -> (Vec<Deep>, bool) {
-        (
-            self.deep.into_inner().expect("not poisoned"),
-            self.beyond.into_inner(),
-        )
+    fn into_inner(self) -> Findings {
+        Findings {
+            deep: self.deep.into_inner().expect("not poisoned"),
+            beyond_range: self.beyond.into_inner(),
+        }
     }
 }
 
@@ -347,18 +380,14 @@ pub struct Simulation {
     pub particles: Particles,
     /// The mesh, its files and moving parts, and the loads on them.
     pub walls: Walls,
-    law: ContactLaw,
+    /// The contact law, densities and load scales.
+    pub(crate) model: Model,
     pub(crate) neighbours: Neighbours,
     pub(crate) face_grid: CellGrid,
     pub(crate) spawner: Spawner,
     /// Force and torque on each particle (storage order), summed by stages 3 and 4 and used
     /// up by stage 5.
     loads: Vec<Load>,
-    /// The resolutions of the loads' sums.
-    scales: LoadScales,
-    /// Some force or torque of the last step was beyond the range of the sums, or not
-    /// finite (the run is unstable).
-    beyond_range: bool,
     /// Step of the last neighbour-list rebuild.
     pub(crate) built_at: u64,
     /// Simulated time \[T\] and number of steps taken.
@@ -370,8 +399,6 @@ pub struct Simulation {
     warnings: Warnings,
     /// Particles removed so far by the outlets and the domain bounds.
     pub removed: Removed,
-    /// For each material, the quotients of its density.
-    pub(crate) densities: Vec<Density>,
     /// The largest radius the faces are binned for.
     pub(crate) face_grid_radius: f64,
     /// This process's share of a run split over several (`domain.rs`).
@@ -451,19 +478,29 @@ impl Simulation {
         let t = self.stage_times.add(Stage::Spawn, t);
         self.update_neighbours();
         let t = self.stage_times.add(Stage::Neighbours, t);
-        let mut deep = self.particle_contacts();
+        let p = &self.particles;
+        let mut found = pairs::run(&self.model, p, &mut self.neighbours, &mut self.loads);
         let t = self.stage_times.add(Stage::ParticleContacts, t);
-        deep.extend(self.mesh_contacts());
+        let owned = self.domain.as_ref().map(|d| &d.owned[..]);
+        let list = &mut self.neighbours.faces;
+        let (on_faces, walls) =
+            faces::run(&self.model, p, &self.walls, owned, list, &mut self.loads);
+        found.merge(on_faces);
+        self.add_wall_loads(walls);
         let t = self.stage_times.add(Stage::MeshContacts, t);
-        let non_finite = self.integrate();
+        let (dt, g) = (
+            self.scenario.simulation.timestep,
+            self.scenario.kinetics.gravity,
+        );
+        let non_finite = advance::run(&self.model, (dt, g), &mut self.particles, &mut self.loads);
         let t = self.stage_times.add(Stage::Integrate, t);
-        self.tag();
+        regions::tag(&self.scenario.tags, &mut self.particles);
         let t = self.stage_times.add(Stage::Tag, t);
         self.refresh_ghosts();
         let t = self.stage_times.add(Stage::Exchange, t);
         self.steps += 1;
         self.time = self.steps as f64 * self.scenario.simulation.timestep;
-        self.check_stability(deep, non_finite || self.beyond_range)?;
+        self.check_stability(found, non_finite)?;
         let t = self.stage_times.add(Stage::Stability, t);
         self.remove();
         self.stage_times.add(Stage::Remove, t);

@@ -38,135 +38,134 @@ type SlabLoads<'s, 'l> = (
     &'s mut Option<(usize, &'l mut [Load])>,
 );
 
-impl Simulation {
-    /// Stage 3 (Section 2.2): the force of every touching particle pair, once per pair,
-    /// added to the loads of both particles (with the reactions of Eqs. 56-60). Returns the
-    /// overlaps deeper than the smaller radius.
-    ///
-    /// The owners are cut into slabs whose partners lie at most in the next slab
-    /// (`Neighbours::slabs`): the even slabs run at the same time, then the odd ones, so a
-    /// load is added to by one slab at a time, in an order that does not depend on the
-    /// number of threads. Each slab first sorts out its touching pairs (a pair that has just
-    /// parted forgets its springs), then evaluates them `WIDTH` at a time in SIMD lanes; a
-    /// lane gives the bits the pair would give alone. Body i of a pair is the particle of
-    /// the lower id, so a pair's force and springs do not depend on the storage order.
-    #[inline(never)] // a stage of its own in profiles
-    pub(super) fn particle_contacts(&mut self) -> Vec<Deep> {
-        let found = Found::default();
-        let law = &self.law;
-        let ContactList {
-            start,
-            partner,
-            contact,
-            pieces: slabs,
-            stores,
-        } = &mut self.neighbours.pairs;
-        let (start, partner, slabs) = (&*start, &*partner, &*slabs);
-        let stage = PairStage {
-            p: &self.particles,
-            law,
-            densities: &self.densities,
-            uniform: law.uniform(),
-            one_pair: law.pair(0, 0).splat(),
-            scales: &self.scales,
-            start,
-            partner,
-        };
-        thread_local! {
-            static TOUCHING: std::cell::RefCell<Vec<[u32; 3]>> = Default::default();
-        }
-        for phase in 0..2 {
-            let mut all: Vec<Option<Piece>> =
-                pieces(slabs, &mut self.loads, start, contact, stores)
-                    .into_iter()
-                    .map(Some)
-                    .collect();
-            // A slab, with the loads of the next one.
-            let tasks: Vec<(Piece, Option<Piece>)> = (phase..all.len())
-                .step_by(2)
-                .map(|s| {
-                    let own = all[s].take().expect("each slab once");
-                    (own, all.get_mut(s + 1).and_then(Option::take))
-                })
-                .collect();
-            tasks.into_par_iter().for_each(|(slab, next)| {
-                TOUCHING.with_borrow_mut(|touching| stage.slab(slab, next, touching, &found));
-            });
-        }
-        let (mut deep, beyond) = found.into_inner();
-        self.beyond_range |= beyond;
-        self.wrapped_contacts(&mut deep);
-        deep
+/// Stage 3 (Section 2.2): the force of every touching particle pair of `lists` (its pair
+/// list and the pairs across periodic sides), once per pair, added to the `loads` of both
+/// particles of `p` (with the reactions of Eqs. 56-60).
+///
+/// The owners are cut into slabs whose partners lie at most in the next slab
+/// (`Neighbours::slabs`): the even slabs run at the same time, then the odd ones, so a
+/// load is added to by one slab at a time, in an order that does not depend on the
+/// number of threads. Each slab first sorts out its touching pairs (a pair that has just
+/// parted forgets its springs), then evaluates them `WIDTH` at a time in SIMD lanes; a
+/// lane gives the bits the pair would give alone. Body i of a pair is the particle of
+/// the lower id, so a pair's force and springs do not depend on the storage order.
+#[inline(never)] // a stage of its own in profiles
+pub(super) fn run(
+    model: &Model,
+    p: &Particles,
+    lists: &mut Neighbours,
+    loads: &mut [Load],
+) -> Findings {
+    let found = Found::default();
+    let law = &model.law;
+    let ContactList {
+        start,
+        partner,
+        contact,
+        pieces: slabs,
+        stores,
+    } = &mut lists.pairs;
+    let (start, partner, slabs) = (&*start, &*partner, &*slabs);
+    let stage = PairStage {
+        p,
+        law,
+        densities: &model.densities,
+        uniform: law.uniform(),
+        one_pair: law.pair(0, 0).splat(),
+        scales: &model.scales,
+        start,
+        partner,
+    };
+    thread_local! {
+        static TOUCHING: std::cell::RefCell<Vec<[u32; 3]>> = Default::default();
     }
+    for phase in 0..2 {
+        let mut all: Vec<Option<Piece>> = pieces(slabs, loads, start, contact, stores)
+            .into_iter()
+            .map(Some)
+            .collect();
+        // A slab, with the loads of the next one.
+        let tasks: Vec<(Piece, Option<Piece>)> = (phase..all.len())
+            .step_by(2)
+            .map(|s| {
+                let own = all[s].take().expect("each slab once");
+                (own, all.get_mut(s + 1).and_then(Option::take))
+            })
+            .collect();
+        tasks.into_par_iter().for_each(|(slab, next)| {
+            TOUCHING.with_borrow_mut(|touching| stage.slab(slab, next, touching, &found));
+        });
+    }
+    let mut found = found.into_inner();
+    wrapped(model, p, lists, loads, &mut found);
+    found
+}
 
-    /// Stage 3, across periodic sides: the pairs of `Neighbours::wrapped`, partner j seen at
-    /// its image x_j + shift, one by one in slot order (they are few: those at the sides),
-    /// after the slabs; the law as for any pair, body i the lower id.
-    pub(super) fn wrapped_contacts(&mut self, deep: &mut Vec<Deep>) {
-        let p = &self.particles;
-        let law = &self.law;
-        let nb = &mut self.neighbours;
-        let images: Vec<(DVec3, DVec3)> = (0..nb.shift.len()).map(|k| nb.image(k)).collect();
-        let ContactList {
-            start,
-            partner,
-            contact,
-            pieces,
-            stores,
-        } = &mut nb.wrapped;
-        let mass = |k: usize| {
-            Inertia::mass_with(
-                p.radius[k],
-                self.densities[p.material[k] as usize].mass_per_r3,
-            )
-        };
-        for piece in 0..pieces.len().saturating_sub(1) {
-            let store = &mut stores[piece];
-            for a in pieces[piece] as usize..pieces[piece + 1] as usize {
-                for k in start[a] as usize..start[a + 1] as usize {
-                    let b = partner[k] as usize;
-                    // Seen from the lower id: the other at its image (and its velocity), as
-                    // `Neighbours::across`.
-                    let (shift, dv) = images[k];
-                    let (i, j) = if p.id[a] < p.id[b] { (a, b) } else { (b, a) };
-                    let body = |k: usize, x: DVec3, dv: DVec3| Body {
-                        x,
-                        radius: p.radius[k],
-                        v: p.v[k] + dv,
-                        w: p.w[k],
-                    };
-                    let (bi, bj) = (body(i, p.x[i], DVec3::ZERO), body(j, p.x[j] + shift, dv));
-                    let Some(kin) = Kinematics::between_particles(&bi, &bj) else {
-                        if contact[k] != NONE {
-                            store.close(contact[k]);
-                            contact[k] = NONE;
-                        }
-                        continue;
-                    };
-                    if contact[k] == NONE {
-                        contact[k] = store.open();
+/// Stage 3, across periodic sides: the pairs of `Neighbours::wrapped`, partner j seen at
+/// its image x_j + shift, one by one in slot order (they are few: those at the sides),
+/// after the slabs; the law as for any pair, body i the lower id.
+fn wrapped(
+    model: &Model,
+    p: &Particles,
+    nb: &mut Neighbours,
+    loads: &mut [Load],
+    found: &mut Findings,
+) {
+    let law = &model.law;
+    let images: Vec<(DVec3, DVec3)> = (0..nb.shift.len()).map(|k| nb.image(k)).collect();
+    let ContactList {
+        start,
+        partner,
+        contact,
+        pieces,
+        stores,
+    } = &mut nb.wrapped;
+    for piece in 0..pieces.len().saturating_sub(1) {
+        let store = &mut stores[piece];
+        for a in pieces[piece] as usize..pieces[piece + 1] as usize {
+            for k in start[a] as usize..start[a + 1] as usize {
+                let b = partner[k] as usize;
+                // Seen from the lower id: the other at its image (and its velocity), as
+                // `Neighbours::across`.
+                let (shift, dv) = images[k];
+                let (i, j) = if p.id[a] < p.id[b] { (a, b) } else { (b, a) };
+                let body = |k: usize, x: DVec3, dv: DVec3| Body {
+                    x,
+                    radius: p.radius[k],
+                    v: p.v[k] + dv,
+                    w: p.w[k],
+                };
+                let (bi, bj) = (body(i, p.x[i], DVec3::ZERO), body(j, p.x[j] + shift, dv));
+                let Some(kin) = Kinematics::between_particles(&bi, &bj) else {
+                    if contact[k] != NONE {
+                        store.close(contact[k]);
+                        contact[k] = NONE;
                     }
-                    let springs = &mut store.springs[contact[k] as usize];
-                    let other = Other::Particle {
-                        r: p.radius[j],
-                        m: mass(j),
-                    };
-                    let coef = law.pair(p.material[i], p.material[j]);
-                    let force = law.evaluate(coef, p.radius[i], mass(i), other, &kin, springs);
-                    let scales = &self.scales;
-                    let (load_i, load_j) = pair_mut(&mut self.loads, i, j);
-                    let fine = load_i.add(pack(force.f, force.tau_i), &scales.lanes)
-                        & load_j.add(pack(-force.f, force.tau_j), &scales.lanes); // Eqs. (56)-(60)
-                    self.beyond_range |= !fine;
-                    let limit = p.radius[i].min(p.radius[j]);
-                    if kin.delta > limit {
-                        deep.push(Deep {
-                            i,
-                            other: Partner::Particle(j),
-                            delta: kin.delta,
-                            limit,
-                        });
-                    }
+                    continue;
+                };
+                if contact[k] == NONE {
+                    contact[k] = store.open();
+                }
+                let springs = &mut store.springs[contact[k] as usize];
+                let other = Other::Particle {
+                    r: p.radius[j],
+                    m: model.mass(p, j),
+                };
+                let coef = law.pair(p.material[i], p.material[j]);
+                let force = law.evaluate(coef, p.radius[i], model.mass(p, i), other, &kin, springs);
+                let lanes = &model.scales.lanes;
+                let (load_i, load_j) = pair_mut(loads, i, j);
+                let fine = load_i.add(pack(force.f, force.tau_i), lanes)
+                    & load_j.add(pack(-force.f, force.tau_j), lanes); // Eqs. (56)-(60)
+                found.beyond_range |= !fine;
+                let limit = p.radius[i].min(p.radius[j]);
+                if kin.delta > limit {
+                    found.deep.push(Deep {
+                        i,
+                        other: Partner::Particle(j),
+                        delta: kin.delta,
+                        limit,
+                    });
                 }
             }
         }

@@ -47,7 +47,7 @@ impl Simulation {
             .map(|&(i, f)| (p.id[i as usize], i, f))
             .collect();
         by_id.sort_unstable();
-        let densities = &self.densities;
+        let densities = &self.model.densities;
         for &(_, i, f) in &by_id {
             let out = match self.removed.outlets.get_mut(f as usize) {
                 Some(o) => o,
@@ -77,31 +77,30 @@ impl Simulation {
             || p.next_id as usize != self.particle_count()
     }
 
-    /// Stage 5b: particles whose centre is inside a `[[tags]]` box take its tag.
-    #[inline(never)] // a stage of its own in profiles
-    pub(super) fn tag(&mut self) {
-        let regions = &self.scenario.tags;
-        if regions.is_empty() {
-            return;
-        }
-        let p = &mut self.particles;
-        p.tag
-            .par_iter_mut()
-            .zip(p.x.par_iter())
-            .with_min_len(4 * MIN_PARALLEL_LEN)
-            .for_each(|(tag, x)| {
-                for r in regions {
-                    if x.cmpge(r.min).all() && x.cmple(r.max).all() {
-                        *tag = r.tag;
-                    }
-                }
-            });
-    }
-
     /// Whether frames carry a tag column: the scenario tags particles, or they came tagged.
     pub fn has_tags(&self) -> bool {
         let tagged = self.particles.tagged();
         let tagged = self.domain.as_ref().map_or(tagged, |d| d.comm.any(tagged));
         !self.scenario.tags.is_empty() || tagged
     }
+}
+
+/// Stage 5b: particles of `p` whose centre is inside one of the boxes `regions` (`[[tags]]`)
+/// take its tag (the last box that holds it).
+#[inline(never)] // a stage of its own in profiles
+pub(super) fn tag(regions: &[TagRegion], p: &mut Particles) {
+    if regions.is_empty() {
+        return;
+    }
+    p.tag
+        .par_iter_mut()
+        .zip(p.x.par_iter())
+        .with_min_len(4 * MIN_PARALLEL_LEN)
+        .for_each(|(tag, x)| {
+            for r in regions {
+                if x.cmpge(r.min).all() && x.cmple(r.max).all() {
+                    *tag = r.tag;
+                }
+            }
+        });
 }

@@ -61,7 +61,7 @@ impl Simulation {
                 r: p.radius[j],
                 m: self.mass_of(j),
             };
-            let coef = self.law.pair(p.material[i], p.material[j]);
+            let coef = self.model.law.pair(p.material[i], p.material[j]);
             let with = Partner::Particle(p.id[j] as usize);
             out.push(self.record(i, other, &kin, coef, springs, with));
         }
@@ -82,6 +82,7 @@ impl Simulation {
                 continue;
             };
             let coef = self
+                .model
                 .law
                 .with_wall(p.material[i], self.walls.face_material[f]);
             out.push(self.record(i, Other::Wall, &kin, coef, springs, Partner::Face(f)));
@@ -93,7 +94,7 @@ impl Simulation {
         let p = &self.particles;
         Inertia::mass_with(
             p.radius[k],
-            self.densities[p.material[k] as usize].mass_per_r3,
+            self.model.densities[p.material[k] as usize].mass_per_r3,
         )
     }
 
@@ -119,9 +120,10 @@ impl Simulation {
         with: Partner,
     ) -> ContactRecord {
         let p = &self.particles;
-        let force = self
-            .law
-            .evaluate(coef, p.radius[i], self.mass_of(i), other, kin, &mut springs);
+        let force =
+            self.model
+                .law
+                .evaluate(coef, p.radius[i], self.mass_of(i), other, kin, &mut springs);
         let f_n = kin.n * kin.n.dot(force.f);
         ContactRecord {
             id: p.id[i],
@@ -143,7 +145,7 @@ impl Simulation {
             .map(|k| {
                 let m = Inertia::mass_with(
                     p.radius[k],
-                    self.densities[p.material[k] as usize].mass_per_r3,
+                    self.model.densities[p.material[k] as usize].mass_per_r3,
                 );
                 let i = 0.4 * m * p.radius[k] * p.radius[k];
                 (

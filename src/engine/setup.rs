@@ -307,24 +307,25 @@ impl Simulation {
         let skin = scenario.simulation.skin * g.radius_max;
         let face_grid = face_grid(&mesh.faces, max_radius, skin);
         let mut sim = Simulation {
-            law: contact_law(&scenario),
+            model: Model {
+                law: contact_law(&scenario),
+                densities: scenario
+                    .materials
+                    .iter()
+                    .map(|m| Density::new(m.properties.density, m.properties.viscosity))
+                    .collect(),
+                scales: LoadScales::of(&scenario),
+            },
             neighbours: Neighbours::with_periodic(skin, scenario.periodicity()),
             face_grid,
             spawner: Spawner::new(scenario.simulation.seed),
             loads: Vec::new(),
-            scales: LoadScales::of(&scenario),
-            beyond_range: false,
             built_at: 0,
             time: 0.0,
             steps: 0,
             stage_times: StageTimes::default(),
             warnings: Warnings::default(),
             walls: Walls::of(mesh, scenario.geometry.mesh_material),
-            densities: scenario
-                .materials
-                .iter()
-                .map(|m| Density::new(m.properties.density, m.properties.viscosity))
-                .collect(),
             removed: Removed {
                 outlets: vec![Outflow::default(); scenario.outlets.len()],
                 domain: Outflow::default(),

@@ -397,7 +397,7 @@ impl Simulation {
         let mut w = Writer::default();
         for i in (0..p.len()).filter(|&i| d.owned[i]) {
             if let Some(f) = fate(p.x[i]) {
-                let density = self.densities[p.material[i] as usize];
+                let density = self.model.densities[p.material[i] as usize];
                 w.u32(p.id[i]);
                 w.u32(f);
                 w.f64(Inertia::mass_with(p.radius[i], density.mass_per_r3));
