@@ -496,7 +496,9 @@ impl Simulation {
         let t = self.stage_times.add(Stage::Integrate, t);
         regions::tag(&self.scenario.tags, &mut self.particles);
         let t = self.stage_times.add(Stage::Tag, t);
-        self.refresh_ghosts();
+        if let Some(d) = &self.domain {
+            split::refresh_ghosts(d, &mut self.particles);
+        }
         let t = self.stage_times.add(Stage::Exchange, t);
         self.steps += 1;
         self.time = self.steps as f64 * self.scenario.simulation.timestep;

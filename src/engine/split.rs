@@ -280,47 +280,6 @@ impl Simulation {
         }
     }
 
-    /// Sends the new states of own particles to the processes that hold them as ghosts,
-    /// and takes theirs (collective).
-    pub(crate) fn refresh_ghosts(&mut self) {
-        let Some(d) = &self.domain else { return };
-        let p = &mut self.particles;
-        let messages: Vec<(usize, Vec<u8>)> = d
-            .send
-            .iter()
-            .enumerate()
-            .filter(|(_, list)| !list.is_empty())
-            .map(|(q, list)| {
-                let mut w = Writer(Vec::with_capacity(list.len() * GHOST_STATE));
-                for &i in list {
-                    let i = i as usize;
-                    w.vec3(p.x[i]);
-                    w.vec3(p.v[i]);
-                    w.quat(p.q[i]);
-                    w.vec3(p.w[i]);
-                    w.u32(p.tag[i]);
-                }
-                (q, w.0)
-            })
-            .collect();
-        // Only the processes that hold ghosts of ours, or ours of theirs, hear from us.
-        let from: Vec<(usize, usize)> = (0..d.recv.len())
-            .filter(|&q| !d.recv[q].is_empty())
-            .map(|q| (q, d.recv[q].len() * GHOST_STATE))
-            .collect();
-        for (m, &(q, _)) in d.comm.exchange(messages, &from).iter().zip(&from) {
-            let mut r = Reader::new(m);
-            for &i in &d.recv[q] {
-                let i = i as usize;
-                p.x[i] = r.vec3();
-                p.v[i] = r.vec3();
-                p.q[i] = r.quat();
-                p.w[i] = r.vec3();
-                p.tag[i] = r.u32();
-            }
-        }
-    }
-
     /// Stage 1 of a split run (collective): every process draws the same candidates and
     /// tests them against the particles of all processes near the spawn regions; each keeps
     /// the new particles in its box.
@@ -703,4 +662,43 @@ fn exchange_ghosts(
         }
     }
     (ghosts_to, ghosts_from)
+}
+
+/// Stage 5c of a split run (collective): sends the new states of own particles of `p` to
+/// the processes of `d` that hold them as ghosts, and takes theirs.
+pub(super) fn refresh_ghosts(d: &Domain, p: &mut Particles) {
+    let messages: Vec<(usize, Vec<u8>)> = d
+        .send
+        .iter()
+        .enumerate()
+        .filter(|(_, list)| !list.is_empty())
+        .map(|(q, list)| {
+            let mut w = Writer(Vec::with_capacity(list.len() * GHOST_STATE));
+            for &i in list {
+                let i = i as usize;
+                w.vec3(p.x[i]);
+                w.vec3(p.v[i]);
+                w.quat(p.q[i]);
+                w.vec3(p.w[i]);
+                w.u32(p.tag[i]);
+            }
+            (q, w.0)
+        })
+        .collect();
+    // Only the processes that hold ghosts of ours, or ours of theirs, hear from us.
+    let from: Vec<(usize, usize)> = (0..d.recv.len())
+        .filter(|&q| !d.recv[q].is_empty())
+        .map(|q| (q, d.recv[q].len() * GHOST_STATE))
+        .collect();
+    for (m, &(q, _)) in d.comm.exchange(messages, &from).iter().zip(&from) {
+        let mut r = Reader::new(m);
+        for &i in &d.recv[q] {
+            let i = i as usize;
+            p.x[i] = r.vec3();
+            p.v[i] = r.vec3();
+            p.q[i] = r.quat();
+            p.w[i] = r.vec3();
+            p.tag[i] = r.u32();
+        }
+    }
 }
