@@ -30,10 +30,11 @@ pub(super) fn gather_told(
 
 impl Simulation {
     /// Stage 6: stop loudly rather than continue a run that has blown up: a non-finite
-    /// state (`non_finite_state`, from the integration) or an overlap past the smaller diameter. `deep`
-    /// lists the overlaps deeper than the smaller radius found in this step's contact
-    /// stages; those within the diameter are a legitimate transient of a crowded packing
-    /// (a small grain squeezed by a large one) and only warned of, once per pair.
+    /// state (`non_finite_state`, from the integration), a load out of the range of its sum
+    /// or an overlap past the smaller diameter (`found` by this step's contact stages, with
+    /// every overlap deeper than the smaller radius). Those within the diameter are a
+    /// legitimate transient of a crowded packing (a small grain squeezed by a large one)
+    /// and only warned of, once per pair.
     #[inline(never)] // a stage of its own in profiles
     pub(super) fn check_stability(
         &mut self,
@@ -68,8 +69,32 @@ impl Simulation {
             }
             return Ok(());
         }
-        // What went wrong, each with the order it is told in: the range of the sums, then
-        // up to five particles in id order, then the deepest overlaps by pair.
+        let told = self.told(deep, beyond_range);
+        let told = match &self.domain {
+            Some(d) => gather_told(&*d.comm, told),
+            None => told,
+        };
+        let mut what: Vec<String> = Vec::new();
+        let kind = |k: u8| told.iter().filter(move |t| t.0 == k).map(|t| t.3.clone());
+        what.extend(kind(0).take(1));
+        what.extend(kind(1).take(5));
+        let room = 5 - what.len().min(5);
+        what.extend(kind(2).take(room));
+        Err(Unstable {
+            step: self.steps,
+            time: self.time,
+            what,
+            advice: self.advice(),
+        })
+    }
+
+    /// What went wrong in a step that stops the run, each with the order it is told in:
+    /// the range of the sums, then up to five particles in id order (own ones, in a split
+    /// run), then the deepest overlaps past the smaller diameter by pair.
+    fn told(&self, mut deep: Vec<Deep>, beyond_range: bool) -> Vec<(u8, u64, u64, String)> {
+        let p = &self.particles;
+        let non_finite =
+            |k: usize| !(p.x[k].is_finite() && p.v[k].is_finite() && p.w[k].is_finite());
         let mut told: Vec<(u8, u64, u64, String)> = Vec::new();
         if beyond_range {
             told.push((0, 0, 0, format!(
@@ -104,21 +129,7 @@ impl Simulation {
             };
             told.push((2, a as u64, b, d.describe(&p.id)));
         }
-        if let Some(d) = &self.domain {
-            told = gather_told(&*d.comm, told);
-        }
-        let mut what: Vec<String> = Vec::new();
-        let kind = |k: u8| told.iter().filter(move |t| t.0 == k).map(|t| t.3.clone());
-        what.extend(kind(0).take(1));
-        what.extend(kind(1).take(5));
-        let room = 5 - what.len().min(5);
-        what.extend(kind(2).take(room));
-        Err(Unstable {
-            step: self.steps,
-            time: self.time,
-            what,
-            advice: self.advice(),
-        })
+        told
     }
 
     /// Overlaps past the smaller radius so far (each pair once).
