@@ -250,7 +250,7 @@ fn a_run_logs_outlets_and_wall_loads_and_resumes_them() {
     );
     let walls = read(a.join("walls.csv"));
     let lines: Vec<&str> = walls.lines().collect();
-    assert_eq!(lines[0], "frame,time,mesh,fx,fy,fz,tx,ty,tz");
+    assert_eq!(lines[0], "frame,time,mesh,x,y,z,fx,fy,fz,tx,ty,tz");
     // Frames 1-4, two mesh files each (the empty main mesh, the plate).
     assert_eq!(lines.len(), 1 + 8, "{walls}");
     assert!(

@@ -192,6 +192,28 @@ fn runs_ended_by_until_on_1_to_3_processes_write_the_same_bytes() {
     assert!(log.lines().count() < 402, "not ended early");
 }
 
+/// A servo lid pressing grains poured into a periodic cell (built-in planes): the same
+/// bytes (frames, `log.csv` with the lid's position and load, `walls.csv`) on any process
+/// count.
+#[test]
+fn a_servo_lid_on_1_to_3_processes_writes_the_same_bytes() {
+    let dir = tempfile::tempdir().unwrap();
+    let cell = dir.path().join("cell.toml");
+    std::fs::write(
+        &cell,
+        "[geometry]\nradius_min = 0.003\nradius_max = 0.004\n\
+         spawn_min = [-0.03, -0.03, 0.005]\nspawn_max = [0.03, 0.03, 0.05]\n\
+         [simulation]\nmax_particles = 250\nframes = 6\nsteps_per_frame = 300\n\
+         [domain]\nmin = [-0.03, -0.03, -0.01]\nmax = [0.03, 0.03, 0.1]\nperiodic = [true, true, false]\n\
+         [output]\nwall_forces = true\n\
+         [[meshes]]\nshape = { type = \"plane\", point = [0.0, 0.0, 0.0], normal = [0.0, 0.0, 1.0], size = 0.4 }\n\
+         [[meshes]]\nshape = { type = \"plane\", point = [0.0, 0.0, 0.06], normal = [0.0, 0.0, 1.0], size = 0.4 }\n\
+         motion = { type = \"servo\", direction = [0.0, 0.0, -1.0], stress = 150.0, max_speed = 0.5 }\n",
+    )
+    .unwrap();
+    same_output(&cell, &[2, 3]);
+}
+
 #[test]
 fn ctrl_c_on_2_processes_checkpoints_and_3_resume_with_the_same_bytes() {
     let dir = tempfile::tempdir().unwrap();

@@ -14,7 +14,7 @@ use crate::io::checkpoint;
 use crate::io::output::{OUTLETS, WALLS};
 use crate::model::contact::{ContactLaw, damping_factor};
 use crate::model::integrate::Inertia;
-use crate::scenario::{FrictionSprings, MeshInput, Scenario};
+use crate::scenario::{FrictionSprings, MeshInput, Scenario, Target};
 
 /// The derived quantities `tinydem check` prints.
 pub fn describe(s: &Scenario, out: &Path) -> Result<String> {
@@ -40,7 +40,7 @@ fn describe_start(s: &Scenario, out: &Path, sim: Simulation) -> Result<String> {
     let period = std::f64::consts::PI * (0.5 * m_min / k_10).sqrt();
     let max_n = most_particles(s, sim.particles.len());
     let size = OutputEstimate::of(s, max_n, sim.walls.mesh.faces.len());
-    let meshes = mesh_lines(s, &sim);
+    let meshes = mesh_lines(s, &sim) + &servo_lines(s, &sim);
     let bounds = bound_lines(s, &sim);
     let materials = material_lines(s);
     let default_dt = s.eq50_timestep();
@@ -154,6 +154,27 @@ fn mesh_lines(s: &Scenario, sim: &Simulation) -> String {
         );
     }
     meshes
+}
+
+/// A line per servo: its direction, target force (and the stress and area it is from),
+/// gain and speed limit.
+fn servo_lines(s: &Scenario, sim: &Simulation) -> String {
+    let mut lines = String::new();
+    for (k, c, _) in sim.walls.servo_controls() {
+        let from = match s.meshes[k - 1].servo.map(|v| v.target) {
+            Some(Target::Stress(p)) => format!(" ({p} Pa over {:.6e} m^2)", c.force / p),
+            _ => String::new(),
+        };
+        lines += &format!(
+            "{:<23}along {}: {:.6e} N{from}, gain {:.3e} m/(s N), at most {} m/s\n",
+            format!("servo (mesh {k})"),
+            c.direction,
+            c.force,
+            c.gain,
+            c.max_speed
+        );
+    }
+    lines
 }
 
 /// The domain (and the initial particles outside it), the outlets and the wall loads.

@@ -209,15 +209,30 @@ impl Logs {
             .transpose()?;
         let walls = s
             .wall_forces
-            .then(|| Log::open(dir, WALLS, "frame,time,mesh,fx,fy,fz,tx,ty,tz", resumed_at))
+            .then(|| {
+                Log::open(
+                    dir,
+                    WALLS,
+                    "frame,time,mesh,x,y,z,fx,fy,fz,tx,ty,tz",
+                    resumed_at,
+                )
+            })
             .transpose()?;
         write_run_toml(dir, s)?;
         let until = !s.simulation.until.is_empty();
-        let header = if until {
-            format!("{LOG_HEADER},until")
-        } else {
-            LOG_HEADER.to_string()
-        };
+        // Each servo's mesh file (`[[meshes]]` #k is file k), in the order of the walls'.
+        let mut header = LOG_HEADER.to_string();
+        for (k, _) in s
+            .meshes
+            .iter()
+            .enumerate()
+            .filter(|(_, m)| m.servo.is_some())
+        {
+            header += &format!(",mesh{}_position,mesh{}_load", k + 1, k + 1);
+        }
+        if until {
+            header += ",until";
+        }
         Ok(Logs {
             frames: Log::open(dir, FRAMES, "frame,step,time", resumed_at)?,
             thermo: Log::open(dir, LOG, &header, resumed_at)?,
@@ -247,7 +262,7 @@ impl Logs {
         };
         logs.frames.row(&[&frame, &sim.steps, &sim.time])?;
         let ended = met.map_or("", |m| m.key);
-        let row: [&dyn LogValue; 12] = [
+        let row: [&dyn LogValue; 11] = [
             &frame,
             &sim.steps,
             &sim.time,
@@ -259,9 +274,26 @@ impl Logs {
             &th.wall_contacts,
             &th.max_overlap,
             &th.removed,
-            &ended,
         ];
-        logs.thermo.row(&row[..if logs.until { 12 } else { 11 }])?;
+        // Each servo's displacement along its direction and the mean load resisting it
+        // since the last frame.
+        let servos: Vec<(f64, f64)> = sim
+            .walls
+            .servo_controls()
+            .iter()
+            .map(|&(k, control, state)| {
+                let load = loads.get(k).map_or(0.0, |w| control.resisting(w.f));
+                (state.position, load / logs.steps_per_frame as f64)
+            })
+            .collect();
+        let mut row: Vec<&dyn LogValue> = row.to_vec();
+        for (position, load) in &servos {
+            row.extend([position as &dyn LogValue, load]);
+        }
+        if logs.until {
+            row.push(&ended);
+        }
+        logs.thermo.row(&row)?;
         if let Some(log) = &mut logs.outlets {
             for (k, o) in sim.removed.outlets.iter().enumerate() {
                 log.row(&[&frame, &sim.time, &k, &o.count, &o.mass])?;
@@ -272,7 +304,11 @@ impl Logs {
             let steps = logs.steps_per_frame as f64;
             for (k, w) in loads.iter().enumerate() {
                 let (f, t) = (w.f / steps, w.tau / steps);
-                log.row(&[&frame, &sim.time, &k, &f.x, &f.y, &f.z, &t.x, &t.y, &t.z])?;
+                let x = sim.walls.reference(k);
+                let row: [&dyn LogValue; 12] = [
+                    &frame, &sim.time, &k, &x.x, &x.y, &x.z, &f.x, &f.y, &f.z, &t.x, &t.y, &t.z,
+                ];
+                log.row(&row)?;
             }
         }
         Ok(())

@@ -118,6 +118,8 @@ impl Simulation {
         if !step.is_empty() {
             self.reduce_walls(&mut step);
             self.walls.add_step(&step);
+            let dt = self.scenario.simulation.timestep;
+            self.walls.drive_servos(&step, dt);
         }
     }
 }

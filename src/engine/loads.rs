@@ -74,9 +74,11 @@ impl LoadScales {
 }
 
 impl Simulation {
-    /// Starts summing the loads on each mesh file (`take_wall_loads`).
+    /// Starts summing the loads on each mesh file (`take_wall_loads`), for `walls.csv` or
+    /// for the servos, which follow the load on their file.
     pub(super) fn sum_wall_loads(&mut self) {
-        if !self.scenario.wall_forces {
+        let servos = self.scenario.meshes.iter().any(|m| m.servo.is_some());
+        if !(self.scenario.wall_forces || servos) {
             return;
         }
         let w = &mut self.walls;

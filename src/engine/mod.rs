@@ -21,6 +21,7 @@ use crate::model::integrate::{Density, Inertia, Response, State, advance};
 use crate::model::lanes::{Gather, Lanes};
 use crate::model::motion::{Motion, Pose, RigidVelocity};
 use crate::model::particles::Particles;
+use crate::model::servo;
 use crate::neighbours::{
     CellGrid, ContactList, FACE_PIECE, Histories, History, MIN_PARALLEL_LEN, NONE, Neighbours,
     Store, cut, face_grid,
@@ -45,6 +46,7 @@ use crate::model::springs::Springs;
 use crate::scenario::{Scenario, TagRegion};
 use loads::Load;
 pub use loads::LoadScales;
+use walls::Drive;
 pub use walls::{MeshFile, Walls};
 
 /// Contacts per group evaluated together: 8 doubles fill an AVX-512 register, two AVX ones.
@@ -428,6 +430,7 @@ impl Simulation {
             wall_sums: self.walls.sums.clone(),
             scenario: self.scenario.to_toml(),
             mesh_files: self.walls.signatures(),
+            servos: self.walls.servos(),
         })
     }
 

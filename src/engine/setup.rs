@@ -26,13 +26,27 @@ impl Simulation {
             contacts: g.mesh_contacts,
             torque_about: DVec3::ZERO,
             material: g.mesh_material,
+            center: MeshFile::center_of(&mesh.faces),
         }];
         let mut moving = Vec::new();
-        for (spec, (part, _)) in scenario.meshes.iter().zip(meshes) {
+        for (k, (spec, (part, _))) in scenario.meshes.iter().zip(meshes).enumerate() {
             let part = part.with_contacts(spec.contacts);
             let faces = mesh.faces.len()..mesh.faces.len() + part.faces.len();
             if let Some(motion) = spec.motion {
-                moving.push((faces.clone(), motion));
+                moving.push((faces.clone(), Drive::Prescribed(motion)));
+            }
+            if let Some(servo) = spec.servo {
+                let control = servo_control(&scenario, servo, spec.material, &part.faces);
+                let state = servo::State::default();
+                let file = k + 1;
+                moving.push((
+                    faces.clone(),
+                    Drive::Servo {
+                        control,
+                        state,
+                        file,
+                    },
+                ));
             }
             files.push(MeshFile {
                 name: spec.input.name(),
@@ -43,6 +57,7 @@ impl Simulation {
                     _ => DVec3::ZERO,
                 },
                 material: spec.material,
+                center: MeshFile::center_of(&part.faces),
             });
             mesh.append(part);
         }
@@ -53,8 +68,8 @@ impl Simulation {
             w.face_material[file.faces.clone()].fill(file.material);
         }
         sim.sum_wall_loads();
-        for (faces, motion) in moving {
-            sim.walls.add_moving(faces, motion);
+        for (faces, drive) in moving {
+            sim.walls.add_moving(faces, drive);
         }
         sim.walls.move_to(sim.time);
         Ok(sim)
@@ -94,6 +109,7 @@ impl Simulation {
         if !sim.walls.sums.is_empty() && snapshot.wall_sums.len() == sim.walls.sums.len() {
             sim.walls.sums = snapshot.wall_sums;
         }
+        sim.walls.set_servos(&snapshot.servos);
         let dt = sim.scenario.simulation.timestep;
         if snapshot.anchors.is_empty() {
             // Taken before the first step: the lists are made as that step would make them.
@@ -109,10 +125,12 @@ impl Simulation {
         sim.steps = snapshot.built_at;
         sim.time = sim.steps as f64 * dt;
         sim.slide_images();
+        let servos = sim.walls.rewind_servos();
         sim.walls.move_to(sim.time);
         sim.rebuild_as_built(snapshot.anchors, snapshot.lonely, &history);
         sim.steps = snapshot.steps;
         sim.time = sim.steps as f64 * dt;
+        sim.walls.set_servos(&servos);
         sim.walls.move_to(sim.time);
         Ok(sim)
     }
@@ -146,6 +164,13 @@ impl Simulation {
         let faces = self.walls.mesh.faces.len();
         if let Some(&(_, f, _)) = snapshot.face_history.iter().find(|e| e.1 as usize >= faces) {
             return Err(format!("contact with face {f}, which the mesh lacks"));
+        }
+        let files = |s: &[(u32, servo::State)]| s.iter().map(|s| s.0).collect::<Vec<_>>();
+        let (held, have) = (files(&snapshot.servos), files(&self.walls.servos()));
+        if held != have {
+            return Err(format!(
+                "it holds servos on mesh files {held:?}, the scenario has them on {have:?}"
+            ));
         }
         Ok(())
     }
@@ -213,16 +238,25 @@ impl Simulation {
             return Err(misfit("one anchor per particle".into()));
         }
         sim.particles = p;
+        let servos = sim.carried_servos(&snapshot.mesh_files, &snapshot.servos);
+        if !servos.is_empty() {
+            notes.push(format!("{} servo(s) carried where they were", servos.len()));
+        }
+        sim.walls.set_servos(&servos);
         if built {
-            // The lists at the positions of the run's last rebuild; the allowances of its
-            // lonely particles hold only for the same mesh.
+            // The lists at the positions of the run's last rebuild (the servos there too);
+            // the allowances of its lonely particles hold only for the same mesh.
             let lonely = if snapshot.mesh_files == new_files {
                 snapshot.lonely
             } else {
                 Vec::new()
             };
+            let servos = sim.walls.rewind_servos();
+            sim.walls.move_to(sim.time);
             sim.rebuild_as_built(snapshot.anchors, lonely, &history);
+            sim.walls.set_servos(&servos);
         }
+        sim.walls.move_to(sim.time);
         Ok((sim, notes))
     }
 
@@ -256,22 +290,33 @@ impl Simulation {
         Ok("spawning continues the random stream of the checkpoint".into())
     }
 
-    /// The contacts with meshes of a run whose mesh files were `old_files` (face count and
-    /// hash) that this simulation's mesh also has, each file found among its own by its
-    /// faces wherever it stands, with the faces renumbered.
+    /// For each mesh file of a run whose files were `old_files` (face count and hash), the
+    /// file of this simulation with the same faces, if it has one (found wherever it stands,
+    /// each file of this simulation once).
+    fn same_files(&self, old_files: &[(u64, u64)]) -> Vec<Option<usize>> {
+        let new_files = self.walls.signatures();
+        let mut taken = vec![false; new_files.len()];
+        old_files
+            .iter()
+            .map(|old| {
+                let found = (0..new_files.len()).find(|&j| !taken[j] && new_files[j] == *old);
+                if let Some(j) = found {
+                    taken[j] = true;
+                }
+                found
+            })
+            .collect()
+    }
+
+    /// The contacts with meshes of a run whose mesh files were `old_files` that this
+    /// simulation's mesh also has ([`Simulation::same_files`]), with the faces renumbered.
     fn carried_face_contacts(
         &self,
         old_files: &[(u64, u64)],
         face_history: &[(u32, u32, Springs)],
     ) -> Vec<(u32, u32, Springs)> {
-        let new_files = self.walls.signatures();
-        let mut taken = vec![false; new_files.len()];
         let mut face_map: Vec<Option<u32>> = Vec::new();
-        for old in old_files {
-            let found = (0..new_files.len()).find(|&j| !taken[j] && new_files[j] == *old);
-            if let Some(j) = found {
-                taken[j] = true;
-            }
+        for (old, found) in old_files.iter().zip(self.same_files(old_files)) {
             let start = found.map(|j| self.walls.files[j].faces.start as u32);
             face_map.extend((0..old.0 as u32).map(|f| start.map(|s| s + f)));
         }
@@ -280,6 +325,24 @@ impl Simulation {
             .filter_map(|&(id, f, springs)| {
                 let f = face_map.get(f as usize).copied().flatten()?;
                 Some((id, f, springs))
+            })
+            .collect()
+    }
+
+    /// The states of a run's servos (on its files `old_files`) for the servos of this
+    /// simulation on the same files: a lid that presses on in the next stage stays where it
+    /// was, with its speed.
+    fn carried_servos(
+        &self,
+        old_files: &[(u64, u64)],
+        servos: &[(u32, servo::State)],
+    ) -> Vec<(u32, servo::State)> {
+        let map = self.same_files(old_files);
+        servos
+            .iter()
+            .filter_map(|&(file, state)| {
+                let new = map.get(file as usize).copied().flatten()?;
+                Some((new as u32, state))
             })
             .collect()
     }
@@ -337,6 +400,58 @@ impl Simulation {
         };
         sim.sum_wall_loads();
         Ok(sim)
+    }
+}
+
+/// A servo's control law on the faces `faces` of material `wall`: the target as a force
+/// (a stress times [`servo_area`]), the gain given or [`servo::default_gain`] for grains of
+/// R_min against the stiffest material.
+pub(super) fn servo_control(
+    s: &Scenario,
+    servo: crate::scenario::Servo,
+    wall: u16,
+    faces: &[Face],
+) -> servo::Control {
+    let d = servo.direction;
+    let area = servo_area(s, d, faces);
+    let force = match servo.target {
+        crate::scenario::Target::Force(f) => f,
+        crate::scenario::Target::Stress(p) => p * area,
+    };
+    let law = contact_law(s);
+    let e_star = (0..s.materials.len() as u16)
+        .map(|a| law.with_wall(a, wall).e_star)
+        .fold(0.0, f64::max);
+    let (r, dt) = (s.geometry.radius_min, s.simulation.timestep);
+    servo::Control {
+        direction: d,
+        force,
+        max_speed: servo.max_speed,
+        gain: servo
+            .gain
+            .unwrap_or_else(|| servo::default_gain(force, area, r, e_star, dt)),
+    }
+}
+
+/// The area a servo's stress acts on: its faces' area projected normal to its direction
+/// `d`, sum |n . d| A_f (a plate's area; a closed body counts both sides), and no more than
+/// the domain's cross-section when `d` is along an axis and the two others are periodic
+/// (a lid spanning a periodic cell presses on the cell).
+pub fn servo_area(s: &Scenario, d: DVec3, faces: &[Face]) -> f64 {
+    let projected = |f: &Face| f.normal().map_or(0.0, |n| n.dot(d).abs()) * f.area();
+    let area: f64 = faces.iter().map(projected).sum();
+    let axis = (0..3).find(|&a| d[a].abs() == 1.0);
+    match (s.domain, axis) {
+        (Some(domain), Some(a)) => {
+            let (b, c) = ((a + 1) % 3, (a + 2) % 3);
+            if s.periodic[b] && s.periodic[c] {
+                let size = domain.max - domain.min;
+                area.min(size[b] * size[c])
+            } else {
+                area
+            }
+        }
+        _ => area,
     }
 }
 

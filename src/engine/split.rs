@@ -152,6 +152,7 @@ impl Simulation {
             wall_sums: self.walls.sums.clone(),
             scenario: self.scenario.to_toml(),
             mesh_files: self.walls.signatures(),
+            servos: self.walls.servos(),
         }
     }
 
@@ -214,10 +215,12 @@ impl Simulation {
         // Carried along with the particles, if any.
         let carry = anchors.is_some();
         let clock = (self.steps, self.time);
+        let mut servos = Vec::new();
         if carry {
             self.steps = self.built_at;
             self.time = self.built_at as f64 * self.scenario.simulation.timestep;
             self.slide_images();
+            servos = self.walls.rewind_servos();
             self.walls.move_to(self.time);
         }
         if let (Placement::Now, Some(periodic)) = (placement, self.neighbours.periodic) {
@@ -276,6 +279,7 @@ impl Simulation {
         self.built();
         if carry {
             (self.steps, self.time) = clock;
+            self.walls.set_servos(&servos);
             self.walls.move_to(self.time);
         }
     }

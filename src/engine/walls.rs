@@ -6,12 +6,43 @@ use super::*;
 /// `face_part` of a face that does not move.
 const STATIC: u32 = u32::MAX;
 
-/// A mesh file whose faces follow a prescribed motion.
+/// What moves a part of the mesh: a prescribed motion, a function of time, or a servo,
+/// which follows the load of the particles on its mesh file (`file`).
+#[derive(Clone, Copy, Debug)]
+pub(super) enum Drive {
+    Prescribed(Motion),
+    Servo {
+        control: servo::Control,
+        state: servo::State,
+        file: usize,
+    },
+}
+
+impl Drive {
+    /// The pose at time `t` (a servo's: where it is now).
+    fn pose(&self, t: f64) -> Pose {
+        match self {
+            Drive::Prescribed(m) => m.pose(t),
+            Drive::Servo { control, state, .. } => control.pose(state.position),
+        }
+    }
+
+    /// The velocity field at time `t` (a servo's: its speed now).
+    fn velocity(&self, t: f64) -> RigidVelocity {
+        match self {
+            Drive::Prescribed(m) => m.velocity(t),
+            Drive::Servo { control, state, .. } => control.velocity(state.speed),
+        }
+    }
+}
+
+/// A mesh file whose faces move.
 #[derive(Clone, Debug)]
 pub(super) struct MovingPart {
     pub(super) faces: std::ops::Range<usize>,
-    pub(super) motion: Motion,
-    /// Velocity field at the current time.
+    pub(super) drive: Drive,
+    /// Pose and velocity field at the current time.
+    pub(super) pose: Pose,
     pub(super) velocity: RigidVelocity,
     /// Corners of its faces at rest, to measure how far they moved.
     pub(super) corners: Vec<DVec3>,
@@ -30,6 +61,19 @@ pub struct MeshFile {
     pub torque_about: DVec3,
     /// The material of its faces.
     pub material: u16,
+    /// Its reference point at rest (`walls.csv`): the mean of its faces' corners.
+    pub center: DVec3,
+}
+
+impl MeshFile {
+    /// The mean of the corners of `faces` (the origin if there are none).
+    pub fn center_of(faces: &[Face]) -> DVec3 {
+        let corners: Vec<DVec3> = faces.iter().flat_map(Face::corners).collect();
+        match corners.len() {
+            0 => DVec3::ZERO,
+            n => corners.iter().sum::<DVec3>() / n as f64,
+        }
+    }
 }
 
 /// The walls of a run: the mesh as it is now, the files it is put together from, the parts
@@ -74,6 +118,7 @@ impl Walls {
                     .map_or_else(Contacts::default, |f| f.contacts),
                 torque_about: DVec3::ZERO,
                 material,
+                center: MeshFile::center_of(&mesh.faces),
             }],
             rest_faces: mesh.faces.clone(),
             moving: Vec::new(),
@@ -87,8 +132,8 @@ impl Walls {
         }
     }
 
-    /// The faces `faces` follow `motion` from now on.
-    pub(super) fn add_moving(&mut self, faces: std::ops::Range<usize>, motion: Motion) {
+    /// The faces `faces` follow `drive` from now on.
+    pub(super) fn add_moving(&mut self, faces: std::ops::Range<usize>, drive: Drive) {
         for f in faces.clone() {
             self.face_part[f] = self.moving.len() as u32;
         }
@@ -98,7 +143,8 @@ impl Walls {
             .collect();
         self.moving.push(MovingPart {
             faces,
-            motion,
+            drive,
+            pose: Pose::REST,
             velocity: RigidVelocity::default(),
             corners,
             pose_at_build: Pose::REST,
@@ -125,11 +171,12 @@ impl Walls {
     pub(super) fn move_to(&mut self, t: f64) {
         let mut drift: f64 = 0.0;
         for part in &mut self.moving {
-            let pose = part.motion.pose(t);
+            let pose = part.drive.pose(t);
             for f in part.faces.clone() {
                 self.mesh.faces[f] = self.rest_faces[f].moved(&pose);
             }
-            part.velocity = part.motion.velocity(t);
+            part.velocity = part.drive.velocity(t);
+            part.pose = pose;
             for &c in &part.corners {
                 drift = drift.max(pose.point(c).distance(part.pose_at_build.point(c)));
             }
@@ -140,9 +187,74 @@ impl Walls {
     /// Records the pose at time `t` as that of a neighbour-list rebuild.
     pub(super) fn mark_built(&mut self, t: f64) {
         for part in &mut self.moving {
-            part.pose_at_build = part.motion.pose(t);
+            part.pose_at_build = part.drive.pose(t);
+            if let Drive::Servo { state, .. } = &mut part.drive {
+                state.built = state.position;
+            }
         }
         self.drift = 0.0;
+    }
+
+    /// The servos' states, with their mesh files (ascending).
+    pub fn servos(&self) -> Vec<(u32, servo::State)> {
+        let state = |p: &MovingPart| match p.drive {
+            Drive::Servo { state, file, .. } => Some((file as u32, state)),
+            Drive::Prescribed(_) => None,
+        };
+        self.moving.iter().filter_map(state).collect()
+    }
+
+    /// Each servo's mesh file, control law and state.
+    pub fn servo_controls(&self) -> Vec<(usize, servo::Control, servo::State)> {
+        let servo = |p: &MovingPart| match p.drive {
+            Drive::Servo {
+                control,
+                state,
+                file,
+            } => Some((file, control, state)),
+            Drive::Prescribed(_) => None,
+        };
+        self.moving.iter().filter_map(servo).collect()
+    }
+
+    /// Sets the states of the servos of the files `states` names (from a checkpoint, or back
+    /// after [`Walls::rewind_servos`]).
+    pub(super) fn set_servos(&mut self, states: &[(u32, servo::State)]) {
+        for part in &mut self.moving {
+            if let Drive::Servo { state, file, .. } = &mut part.drive
+                && let Some(&(_, s)) = states.iter().find(|s| s.0 as usize == *file)
+            {
+                *state = s;
+            }
+        }
+    }
+
+    /// The servos back where they were at the last rebuild (for the lists to be built
+    /// again as then, with the clock there too); their states now, to set back after.
+    pub(super) fn rewind_servos(&mut self) -> Vec<(u32, servo::State)> {
+        let now = self.servos();
+        for part in &mut self.moving {
+            if let Drive::Servo { state, .. } = &mut part.drive {
+                state.position = state.built;
+            }
+        }
+        now
+    }
+
+    /// After a step's contacts, whose loads on each file are `step`: each servo's speed
+    /// from the load on its file, then its position.
+    pub(super) fn drive_servos(&mut self, step: &[Sum6], dt: f64) {
+        for part in &mut self.moving {
+            if let Drive::Servo {
+                control,
+                state,
+                file,
+            } = &mut part.drive
+            {
+                let [fx, fy, fz, ..] = step[*file].value(&self.scales);
+                *state = control.advance(*state, DVec3::new(fx, fy, fz), dt);
+            }
+        }
     }
 
     /// The velocity field of face `f` (zero for a static one).
@@ -169,6 +281,15 @@ impl Walls {
         self.move_to(t);
         self.drift = drift;
         &self.mesh
+    }
+
+    /// Where the reference point of mesh file `k` (its [`MeshFile::center`]) is now.
+    pub fn reference(&self, k: usize) -> DVec3 {
+        let file = &self.files[k];
+        match self.moving.iter().find(|p| p.faces == file.faces) {
+            Some(part) => part.pose.point(file.center),
+            None => file.center,
+        }
     }
 
     /// Whether some part of the mesh moves.

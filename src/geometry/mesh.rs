@@ -116,6 +116,14 @@ impl Face {
         }
     }
 
+    /// The unit normal of a triangle or rectangle (`None` for points and segments).
+    pub fn normal(&self) -> Option<DVec3> {
+        match self.shape {
+            Primitive::Triangle { n, .. } | Primitive::Rectangle { n, .. } => Some(n),
+            Primitive::Point(_) | Primitive::Segment(..) => None,
+        }
+    }
+
     /// Area of the (undilated) primitive: 0 for points and segments.
     pub fn area(&self) -> f64 {
         match self.shape {

@@ -17,7 +17,7 @@ pub const INTERRUPTED: &str = "interrupted.csv";
 pub const UNSTABLE: &str = "unstable.csv";
 /// Name of the log of particles removed by each outlet (`frame,time,outlet,count,mass`).
 pub const OUTLETS: &str = "outlets.csv";
-/// Name of the log of the loads on each mesh file (`frame,time,mesh,fx,fy,fz,tx,ty,tz`).
+/// Name of the log of the loads on each mesh file (`frame,time,mesh,x,y,z,fx,fy,fz,tx,ty,tz`).
 pub const WALLS: &str = "walls.csv";
 /// Name of the list of frames written (`frame,step,time`).
 pub const FRAMES: &str = "frames.csv";

@@ -7,4 +7,5 @@ pub mod lanes;
 pub mod materials;
 pub mod motion;
 pub mod particles;
+pub mod servo;
 pub mod springs;

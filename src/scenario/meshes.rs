@@ -62,11 +62,42 @@ fn mesh_spec(k: usize, m: RawMesh, base: &Path) -> Result<MeshSpec> {
     for (i, &r) in radii.iter().enumerate() {
         check(&key(&format!("radii[{i}]")), r, Range::NonNegative)?;
     }
+    let (motion, servo) = match m.motion {
+        None => (None, None),
+        Some(RawMotion::Servo {
+            direction,
+            force,
+            stress,
+            max_speed,
+            gain,
+        }) => {
+            let key = |name: &str| key(&format!("motion.{name}"));
+            let target = match (force, stress) {
+                (Some(f), None) => Target::Force(check(&key("force"), f, Range::Positive)?),
+                (None, Some(s)) => Target::Stress(check(&key("stress"), s, Range::Positive)?),
+                _ => bail!(
+                    "[[meshes]] #{} motion: a servo needs either `force` [N] or `stress` [Pa], not both",
+                    k + 1
+                ),
+            };
+            let servo = Servo {
+                direction: unit(&key("direction"), direction)?,
+                target,
+                max_speed: check(&key("max_speed"), max_speed, Range::Positive)?,
+                gain: gain
+                    .map(|g| check(&key("gain"), g, Range::Positive))
+                    .transpose()?,
+            };
+            (None, Some(servo))
+        }
+        Some(raw) => (Some(motion(&key, raw)?), None),
+    };
     Ok(MeshSpec {
         input,
         radii,
         contacts: contacts(&key("contacts"), m.contacts)?,
-        motion: m.motion.map(|raw| motion(&key, raw)).transpose()?,
+        motion,
+        servo,
         material: 0,
     })
 }
@@ -110,6 +141,7 @@ fn motion(key: &dyn Fn(&str) -> String, raw: RawMotion) -> Result<Motion> {
                 Range::Finite,
             )?,
         },
+        RawMotion::Servo { .. } => unreachable!("a servo is read by mesh_spec"),
     })
 }
 

@@ -16,7 +16,8 @@
 //!              { type = "hopper", center, axis, top_radius, outlet_radius, height,
 //!              resolution }, radii, contacts, material, motion = { type = "harmonic",
 //!              amplitude, frequency, direction, phase } | { type = "velocity", velocity } |
-//!              { type = "rotation", center, axis, angular_velocity }   (any number of these)
+//!              { type = "rotation", center, axis, angular_velocity } | { type = "servo",
+//!              direction, force | stress, max_speed, gain }   (any number of these)
 //! [[tags]]     min, max, tag   (a box that labels particles entering it; any number)
 //! [domain]     min, max, periodic = [bool, bool, bool]   (particles whose centre leaves
 //!              it through a side that is not periodic are removed)
@@ -40,6 +41,7 @@ use crate::geometry::mesh::Contacts;
 pub use crate::geometry::shapes::Shape;
 pub use crate::model::materials::{FrictionSprings, Material, PairCoefficients};
 use crate::model::motion::Motion;
+pub use crate::model::servo::{Servo, Target};
 
 mod meshes;
 mod raw;
@@ -276,6 +278,8 @@ pub struct MeshSpec {
     pub radii: Vec<f64>,
     pub contacts: Contacts,
     pub motion: Option<Motion>,
+    /// A servo that drives it instead (`motion = { type = "servo", ... }`).
+    pub servo: Option<Servo>,
     /// The material of its faces (an index of `Scenario::materials`).
     pub material: u16,
 }
@@ -642,7 +646,13 @@ mod tests {
     #[test]
     fn the_resolved_toml_parses_back_to_the_same_scenario() {
         let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scenarios/good");
-        for name in ["full.toml", "minimal.toml", "materials.toml"] {
+        for name in [
+            "full.toml",
+            "minimal.toml",
+            "materials.toml",
+            "shapes.toml",
+            "servo.toml",
+        ] {
             let s = Scenario::load(&dir.join(name)).unwrap();
             let again = Scenario::parse(&s.to_toml(), Path::new("run.toml")).unwrap();
             assert_eq!(again, s, "{name}:\n{}", s.to_toml());

@@ -73,6 +73,13 @@ pub(super) enum RawMotion {
         axis: [f64; 3],
         angular_velocity: f64,
     },
+    Servo {
+        direction: [f64; 3],
+        force: Option<f64>,
+        stress: Option<f64>,
+        max_speed: f64,
+        gain: Option<f64>,
+    },
 }
 
 #[derive(Deserialize)]

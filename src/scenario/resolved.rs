@@ -157,6 +157,9 @@ impl Scenario {
             if let Some(m) = mesh.motion {
                 let _ = writeln!(o, "motion = {}", motion(m));
             }
+            if let Some(s) = mesh.servo {
+                let _ = writeln!(o, "motion = {}", servo(s));
+            }
         }
     }
 
@@ -306,6 +309,23 @@ fn motion(m: Motion) -> String {
             num(angular_velocity)
         ),
     }
+}
+
+/// A servo as an inline table (its gain only if given: the default is derived at setup).
+fn servo(s: Servo) -> String {
+    let target = match s.target {
+        Target::Force(f) => format!("force = {}", num(f)),
+        Target::Stress(p) => format!("stress = {}", num(p)),
+    };
+    let gain = s
+        .gain
+        .map(|g| format!(", gain = {}", num(g)))
+        .unwrap_or_default();
+    format!(
+        "{{ type = \"servo\", direction = {}, {target}, max_speed = {}{gain} }}",
+        vec3(s.direction),
+        num(s.max_speed)
+    )
 }
 
 /// A built-in shape as an inline table.

@@ -10,7 +10,10 @@
 //! each particle's position at the last rebuild (3 f64); the lonely particles of the last
 //! rebuild: count (u64) and per entry storage index (u32) and allowance (f64); then the particle-pair and particle-face histories: count (u64) and per
 //! entry the ids (lower, higher) or the id and face (u32, u32) and the springs u_s, u_r (3 f64
-//! each), u_t (f64); last a CRC-32 of everything before it.
+//! each), u_t (f64); from format 3 the removed particles, wall sums, scenario, mesh files and
+//! spawn regions (`Cursor::rest`); from format 4 the servos' states (count, and per servo its
+//! mesh file (u32), position, speed and position at the last rebuild (3 f64)); last a CRC-32
+//! of everything before it.
 //!
 //! The storage order and the positions of the last rebuild let a resumed run rebuild the
 //! very lists the interrupted one had; its results depend on them (the order in which
@@ -22,10 +25,11 @@ use glam::{DQuat, DVec3};
 use super::{Outflow, Removed, Snapshot, Wrench};
 use crate::engine::spawn::{RegionState, SpawnerState};
 use crate::model::particles::{Particle, Particles};
+use crate::model::servo::State;
 use crate::model::springs::Springs;
 
 const MAGIC: &[u8; 12] = b"TINYDEM CKPT";
-const VERSION: u32 = 3;
+const VERSION: u32 = 4;
 /// The oldest version this program reads.
 const OLDEST: u32 = 2;
 
@@ -65,6 +69,7 @@ fn encoded_size(s: &Snapshot) -> usize {
         + 48 * s.wall_sums.len()
         + 16 * s.removed.outlets.len()
         + 17 * s.spawner.regions.len()
+        + 28 * s.servos.len()
 }
 
 /// Appends the checkpoint of `snapshot` to `out` (its checksum covers what it appends).
@@ -135,6 +140,11 @@ pub fn encode_into(out: &mut Vec<u8>, snapshot: &Snapshot, fingerprint: u64) {
         out.extend_from_slice(&r.inserted.to_le_bytes());
         out.push(r.pending_radius.is_some() as u8);
         put_f64s(out, &[r.pending_radius.unwrap_or(0.0)]);
+    }
+    out.extend_from_slice(&(snapshot.servos.len() as u64).to_le_bytes());
+    for (file, s) in &snapshot.servos {
+        out.extend_from_slice(&file.to_le_bytes());
+        put_f64s(out, &[s.position, s.speed, s.built]);
     }
     let crc = crc32fast::hash(&out[start..]);
     out.extend_from_slice(&crc.to_le_bytes());
@@ -263,7 +273,10 @@ pub fn decode(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<Snapsho
     let lonely = r.lonely(particles.len())?;
     let pair_history = r.history()?;
     let face_history = r.history()?;
-    let rest = if v3 { r.rest()? } else { Rest::default() };
+    let mut rest = if v3 { r.rest()? } else { Rest::default() };
+    if version >= 4 {
+        rest.servos = r.servos(rest.mesh_files.len())?;
+    }
     if r.at != r.bytes.len() {
         bail!(
             "corrupt checkpoint: {} unexpected bytes at the end",
@@ -287,6 +300,7 @@ pub fn decode(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<Snapsho
         wall_sums: rest.wall_sums,
         scenario: rest.scenario,
         mesh_files: rest.mesh_files,
+        servos: rest.servos,
     })
 }
 
@@ -329,6 +343,7 @@ struct Rest {
     scenario: String,
     mesh_files: Vec<(u64, u64)>,
     regions: Vec<RegionState>,
+    servos: Vec<(u32, State)>,
 }
 
 impl Cursor<'_> {
@@ -384,6 +399,40 @@ impl Cursor<'_> {
             bail!("corrupt checkpoint: lonely particles out of order or range");
         }
         Ok(lonely)
+    }
+
+    /// The servos' states with their mesh files (below `files`, ascending), finite (format
+    /// 4).
+    fn servos(&mut self, files: usize) -> Result<Vec<(u32, State)>> {
+        let r = self;
+        let count = r.count(4 + 24)?;
+        let servos = (0..count)
+            .map(|_| {
+                let file = r.u32()?;
+                let (position, speed, built) = (r.f64()?, r.f64()?, r.f64()?);
+                Ok((
+                    file,
+                    State {
+                        position,
+                        speed,
+                        built,
+                    },
+                ))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let finite = |s: &State| {
+            [s.position, s.speed, s.built]
+                .iter()
+                .all(|x| x.abs() < 1e30)
+        };
+        if servos
+            .iter()
+            .any(|(f, s)| *f as usize >= files || !finite(s))
+            || !servos.is_sorted_by_key(|s| s.0)
+        {
+            bail!("corrupt checkpoint: a servo's mesh file or state is out of range");
+        }
+        Ok(servos)
     }
 
     /// The removed particles, wall sums, scenario, mesh files and spawn regions (format 3).

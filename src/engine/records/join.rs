@@ -24,7 +24,8 @@ pub fn join(pieces: Vec<Snapshot>) -> Result<Snapshot> {
                 && p.removed == first.removed
                 && p.wall_sums == first.wall_sums
                 && p.scenario == first.scenario
-                && p.mesh_files == first.mesh_files,
+                && p.mesh_files == first.mesh_files
+                && p.servos == first.servos,
             "corrupt: part {k} is not of the state of part 0 (another step or run)"
         );
         ensure!(
@@ -71,6 +72,7 @@ pub fn join(pieces: Vec<Snapshot>) -> Result<Snapshot> {
         wall_sums: first.wall_sums.clone(),
         scenario: first.scenario.clone(),
         mesh_files: first.mesh_files.clone(),
+        servos: first.servos.clone(),
     })
 }
 

@@ -39,6 +39,8 @@ pub struct Snapshot {
     /// Face count and a hash of the faces of each mesh file, to find them in the mesh of a
     /// staged run.
     pub mesh_files: Vec<(u64, u64)>,
+    /// The state of each servo, with its mesh file (format 4).
+    pub servos: Vec<(u32, crate::model::servo::State)>,
 }
 
 /// The partner of a particle in a contact.

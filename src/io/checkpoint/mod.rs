@@ -156,6 +156,14 @@ mod tests {
             }],
             scenario: "[simulation]\nframes = 3\n".into(),
             mesh_files: vec![(0, 1), (12, 0xdead_beef)],
+            servos: vec![(
+                1,
+                crate::model::servo::State {
+                    position: 0.0125,
+                    speed: -3e-4,
+                    built: 0.0124,
+                },
+            )],
         }
     }
 
@@ -194,17 +202,30 @@ mod tests {
         let mut s = snapshot();
         (s.removed, s.wall_sums) = (Removed::default(), Vec::new());
         (s.scenario, s.mesh_files) = (String::new(), Vec::new());
-        s.spawner.regions = Vec::new();
-        let v3 = encode(&s, 7);
-        let body = &v3[..v3.len() - 4];
+        (s.spawner.regions, s.servos) = (Vec::new(), Vec::new());
+        let v4 = encode(&s, 7);
+        let body = &v4[..v4.len() - 4];
         // The one particle's record starts at byte 77 (after the header and the count); its
-        // material is the last 2 of its 122 bytes; the counts of removals, loads, scenario
-        // and mesh files end the body.
-        let mut v2 = [&body[..77 + 120], &body[77 + 122..body.len() - 56]].concat();
+        // material is the last 2 of its 122 bytes; the counts of removals, loads, scenario,
+        // mesh files, spawn regions and servos end the body.
+        let mut v2 = [&body[..77 + 120], &body[77 + 122..body.len() - 64]].concat();
         v2[12..16].copy_from_slice(&2u32.to_le_bytes());
         let crc = crc32fast::hash(&v2);
         v2.extend_from_slice(&crc.to_le_bytes());
         assert_eq!(decode(&v2, Some(7)).unwrap(), s);
+    }
+
+    #[test]
+    fn version_3_is_read_without_servos() {
+        let mut s = snapshot();
+        s.servos = Vec::new();
+        let v4 = encode(&s, 7);
+        // Format 3 ends before the count of servos.
+        let mut v3 = v4[..v4.len() - 4 - 8].to_vec();
+        v3[12..16].copy_from_slice(&3u32.to_le_bytes());
+        let crc = crc32fast::hash(&v3);
+        v3.extend_from_slice(&crc.to_le_bytes());
+        assert_eq!(decode(&v3, Some(7)).unwrap(), s);
     }
 
     #[test]
