@@ -5,7 +5,7 @@ the renderer. Needs the Python package
 (`python3 -m pip install ./python`), the built binary (`cargo build --release`, for
 `analyze --plot`) and, for the pictures of two panels, ffmpeg (its hstack filter).
 
-    python3 docs/pictures.py [--reuse] [NAME ...]   # all, or some of: hourglass b c d e f g h
+    python3 docs/pictures.py [--reuse] [NAME ...]   # all, or some of: hourglass b c d e f g h j
 
 (--reuse: draw from the runs already in /tmp/tinydem-pictures.)
 
@@ -165,7 +165,20 @@ def h():
         side_by_side(tmp / "l.png", tmp / "r.png", DOCS / "h_shear_cell.png")
 
 
-ALL = {"hourglass": hourglass, "b": b, "c": c, "d": d, "e": e, "f": f, "g": g, "h": h}
+def j():
+    """The oedometer study: its script runs the stages; the bed at 32 kPa, and stress against
+    strain (an SVG the script draws)."""
+    out = WORK / "j"
+    if not (REUSE and (out / "study.csv").is_file()):
+        subprocess.run([sys.executable, str(EXAMPLES / "j_oedometer" / "study.py"), "--out", str(out),
+                        "--svg", str(DOCS / "j_oedometer_stress.svg")], check=True)
+    pressed = out / "3_press_5"
+    k = int(tinydem.read_output(pressed).numbers[-1])
+    picture(frame(pressed, k), DOCS / "j_oedometer.png", color="height", view="front",
+            width=480, height=560, scenario=pressed / "run.toml", scale_bar=True)
+
+
+ALL = {"hourglass": hourglass, "b": b, "c": c, "d": d, "e": e, "f": f, "g": g, "h": h, "j": j}
 
 if __name__ == "__main__":
     for name in [a for a in sys.argv[1:] if a != "--reuse"] or ALL:

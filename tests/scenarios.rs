@@ -45,6 +45,7 @@ fn full_scenario_sets_every_key() {
         kinetic_energy_below: Some(1e-9),
         time: Some(1.0),
         removed_at_least: Some(3),
+        servo_within: None,
     };
     assert_eq!(s.simulation.until, until);
     assert_eq!(s.particles, Some(dir.join("two.csv")));

@@ -197,3 +197,42 @@ fn a_stage_checks_its_own_conditions_on_its_own_clock() {
     assert_eq!(rows[2]["until"], "time");
     assert_eq!(value(&rows[0], "particles"), 60.0);
 }
+
+/// A lid over the box, a servo pressing the poured grains with 0.5 N.
+const LID: &str = "[[meshes]]\n\
+    shape = { type = \"plane\", point = [0.0, 0.0, 0.15], normal = [0.0, 0.0, 1.0], size = 0.059 }\n\
+    motion = { type = \"servo\", direction = [0.0, 0.0, -1.0], force = 0.5, max_speed = 0.3 }\n";
+
+#[test]
+fn a_press_ends_when_its_servo_holds_its_load_and_so_does_its_resume() {
+    let t = tempfile::tempdir().unwrap();
+    pour(t.path(), 100, "until = { servo_within = 0.001 }", LID);
+    let err = run(t.path(), &["run", "s.toml", "-o", "out"]);
+    let rows = log(&t.path().join("out"));
+    let last = rows.last().unwrap();
+    assert_eq!(last["until"], "servo_within", "{err}");
+    assert!(rows.len() < 101, "not ended early");
+    // The frame's mean load includes its approach; the last step's is within 0.1 %.
+    assert!((value(last, "mesh1_load") - 0.5).abs() < 0.05, "{last:?}");
+    assert!(
+        err.contains("by until.servo_within: every servo within 1e-3 of its target (mesh 1: 4.99"),
+        "{err}"
+    );
+    // Resumed at that frame, the checkpoint's servo state ends it at once.
+    let err = run(
+        t.path(),
+        &[
+            "run",
+            "s.toml",
+            "-o",
+            "out",
+            "--resume",
+            "out/checkpoint.bin",
+        ],
+    );
+    let frame = rows.len() - 1;
+    assert!(
+        err.contains(&format!("ended at frame {frame} by until.servo_within")),
+        "{err}"
+    );
+}

@@ -102,6 +102,9 @@ fn until_line(s: &Scenario) -> String {
     if let Some(n) = u.removed_at_least {
         any.push(format!("{n} particles removed"));
     }
+    if let Some(f) = u.servo_within {
+        any.push(format!("every servo's load within {f:e} of its target"));
+    }
     if any.is_empty() {
         return String::new();
     }

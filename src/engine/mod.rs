@@ -53,6 +53,13 @@ pub use walls::{MeshFile, Walls};
 const WIDTH: usize = 8;
 type Group = wide::f64x8;
 
+/// The clock and servos of a simulation rewound to its last rebuild.
+pub(crate) struct Rewound {
+    steps: u64,
+    time: f64,
+    servos: Vec<(u32, servo::State)>,
+}
+
 /// The constants the stages compute with: the contact law of the scenario's materials,
 /// each material's density quotients and the resolutions of the loads' sums.
 pub(crate) struct Model {
@@ -528,6 +535,9 @@ impl Simulation {
             particles: th.particles,
             spawning: !self.spawner.finished(&self.scenario, p.next_id, self.time),
             removed: th.removed,
+            servos: (self.walls.servo_controls().iter())
+                .map(|&(k, c, s)| (k, s.load, c.force))
+                .collect(),
         }
     }
 
@@ -598,6 +608,29 @@ impl Simulation {
     fn regrid_faces(&mut self) {
         let g = &self.scenario.geometry;
         self.regrid_faces_for(g.radius_max.max(self.particles.max_radius()));
+    }
+
+    /// The clock, the sheared images and the walls (servos too) back at step `built_at`, for
+    /// the lists to be built again as they were then; what [`Simulation::wind_on`] takes to
+    /// bring them back.
+    pub(crate) fn rewind_to(&mut self, built_at: u64) -> Rewound {
+        let now = Rewound {
+            steps: self.steps,
+            time: self.time,
+            servos: self.walls.rewind_servos(),
+        };
+        self.steps = built_at;
+        self.time = built_at as f64 * self.scenario.simulation.timestep;
+        self.slide_images();
+        self.walls.move_to(self.time);
+        now
+    }
+
+    /// The clock and the walls back where [`Simulation::rewind_to`] took them from.
+    pub(crate) fn wind_on(&mut self, now: Rewound) {
+        (self.steps, self.time) = (now.steps, now.time);
+        self.walls.set_servos(&now.servos);
+        self.walls.move_to(self.time);
     }
 
     /// After a rebuild: loads for the particles, pieces of the face list, and the mesh pose

@@ -122,16 +122,10 @@ impl Simulation {
         }
         // The lists of the last rebuild, built again with the mesh (and sheared images)
         // where they were then.
-        sim.steps = snapshot.built_at;
-        sim.time = sim.steps as f64 * dt;
-        sim.slide_images();
-        let servos = sim.walls.rewind_servos();
-        sim.walls.move_to(sim.time);
+        (sim.steps, sim.time) = (snapshot.steps, snapshot.steps as f64 * dt);
+        let now = sim.rewind_to(snapshot.built_at);
         sim.rebuild_as_built(snapshot.anchors, snapshot.lonely, &history);
-        sim.steps = snapshot.steps;
-        sim.time = sim.steps as f64 * dt;
-        sim.walls.set_servos(&servos);
-        sim.walls.move_to(sim.time);
+        sim.wind_on(now);
         Ok(sim)
     }
 

@@ -214,15 +214,7 @@ impl Simulation {
         };
         // Carried along with the particles, if any.
         let carry = anchors.is_some();
-        let clock = (self.steps, self.time);
-        let mut servos = Vec::new();
-        if carry {
-            self.steps = self.built_at;
-            self.time = self.built_at as f64 * self.scenario.simulation.timestep;
-            self.slide_images();
-            servos = self.walls.rewind_servos();
-            self.walls.move_to(self.time);
-        }
+        let now = carry.then(|| self.rewind_to(self.built_at));
         if let (Placement::Now, Some(periodic)) = (placement, self.neighbours.periodic) {
             // As at a rebuild in one process: the particles put back into the box (the
             // ghosts too, as their owners do, so that every process places them alike).
@@ -277,10 +269,8 @@ impl Simulation {
         d.owned = owned;
         self.domain = Some(d);
         self.built();
-        if carry {
-            (self.steps, self.time) = clock;
-            self.walls.set_servos(&servos);
-            self.walls.move_to(self.time);
+        if let Some(now) = now {
+            self.wind_on(now);
         }
     }
 

@@ -229,6 +229,21 @@ impl Walls {
         }
     }
 
+    /// Puts the servos of the files `positions` names at those displacements (for pictures
+    /// of a run's frames, from its `log.csv`); stage 0 or [`Walls::at`] poses the mesh.
+    pub fn place_servos(&mut self, positions: &[(u32, f64)]) {
+        let states: Vec<(u32, servo::State)> = (positions.iter())
+            .map(|&(k, position)| {
+                let state = servo::State {
+                    position,
+                    ..Default::default()
+                };
+                (k, state)
+            })
+            .collect();
+        self.set_servos(&states);
+    }
+
     /// The servos back where they were at the last rebuild (for the lists to be built
     /// again as then, with the clock there too); their states now, to set back after.
     pub(super) fn rewind_servos(&mut self) -> Vec<(u32, servo::State)> {

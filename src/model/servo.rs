@@ -53,12 +53,14 @@ pub struct Control {
 }
 
 /// Where a servo is: its displacement along its direction from where the mesh put it, its
-/// speed, and its displacement at the last neighbour-list rebuild.
+/// speed, its displacement at the last neighbour-list rebuild, and the load resisting it in
+/// its last step.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct State {
     pub position: f64,
     pub speed: f64,
     pub built: f64,
+    pub load: f64,
 }
 
 impl Control {
@@ -71,16 +73,17 @@ impl Control {
     /// The state after a step of `dt` in which the particles' load on the part was `f`:
     /// touching nothing (no load at all), it approaches at `max_speed`.
     pub fn advance(&self, s: State, f: DVec3, dt: f64) -> State {
+        let load = self.resisting(f);
         let speed = if f == DVec3::ZERO {
             self.max_speed
         } else {
-            let error = self.force - self.resisting(f);
-            (self.gain * error).clamp(-self.max_speed, self.max_speed)
+            (self.gain * (self.force - load)).clamp(-self.max_speed, self.max_speed)
         };
         State {
             position: s.position + speed * dt,
             speed,
             built: s.built,
+            load,
         }
     }
 

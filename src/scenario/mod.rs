@@ -9,7 +9,7 @@
 //! [kinetics]   initial_velocity, initial_angular_velocity, gravity
 //! [simulation] timestep, max_particles, frames, steps_per_frame, spawn_attempts, seed, skin,
 //!              friction_springs = "advance_first" | "paper", until = { kinetic_energy_below,
-//!              time, removed_at_least }
+//!              time, removed_at_least, servo_within }
 //! [[meshes]]   file | shape = { type = "box", min, max, open } | { type = "cylinder", center,
 //!              axis, radius, height, open, orifice, resolution } | { type = "drum", center,
 //!              axis, radius, length, resolution } | { type = "plane", point, normal, size } |
@@ -143,10 +143,12 @@ pub struct Until {
     pub time: Option<f64>,
     /// At least this many particles were removed (by the outlets and the domain).
     pub removed_at_least: Option<u64>,
+    /// Every servo's load (of its last step) is within this fraction of its target.
+    pub servo_within: Option<f64>,
 }
 
 /// The state a frame's check of [`Until`] looks at.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct FrameState {
     pub time: f64,
     pub kinetic_energy: f64,
@@ -154,6 +156,8 @@ pub struct FrameState {
     /// Particles still to be spawned after this step.
     pub spawning: bool,
     pub removed: u64,
+    /// Each servo's mesh file, its load of the last step and its target \[N\].
+    pub servos: Vec<(usize, f64, f64)>,
 }
 
 impl Until {
@@ -188,6 +192,23 @@ impl Until {
             return Some(Met {
                 key: "removed_at_least",
                 said: format!("{} removed, at least {n}", s.removed),
+            });
+        }
+        if let Some(f) = self.servo_within
+            && !s.servos.is_empty()
+            && s.servos
+                .iter()
+                .all(|&(_, load, target)| (load - target).abs() <= f * target)
+        {
+            let loads: Vec<String> = (s.servos.iter())
+                .map(|(k, load, target)| format!("mesh {k}: {load:.6e} N of {target:.6e} N"))
+                .collect();
+            return Some(Met {
+                key: "servo_within",
+                said: format!(
+                    "every servo within {f:e} of its target ({})",
+                    loads.join("; ")
+                ),
             });
         }
         None
@@ -577,6 +598,7 @@ mod tests {
             kinetic_energy_below: Some(1e-6),
             time: Some(2.0),
             removed_at_least: Some(5),
+            servo_within: None,
         };
         let still = FrameState {
             time: 1.0,
@@ -584,27 +606,28 @@ mod tests {
             particles: 10,
             spawning: false,
             removed: 0,
+            servos: Vec::new(),
         };
         assert_eq!(until.met(&still).unwrap().key, "kinetic_energy_below");
         // Not while grains are still to come, nor with none at all.
         let filling = FrameState {
             spawning: true,
-            ..still
+            ..still.clone()
         };
         assert_eq!(until.met(&filling), None);
         let empty = FrameState {
             particles: 0,
-            ..still
+            ..still.clone()
         };
         assert_eq!(until.met(&empty), None);
         let late = FrameState {
             time: 2.0,
-            ..filling
+            ..filling.clone()
         };
         assert_eq!(until.met(&late).unwrap().key, "time");
         let drained = FrameState {
             removed: 5,
-            ..filling
+            ..filling.clone()
         };
         let met = until.met(&drained).unwrap();
         assert_eq!(
@@ -613,6 +636,18 @@ mod tests {
         );
         assert!(Until::default().is_empty());
         assert_eq!(Until::default().met(&still), None);
+        // Servos: every one within the fraction of its target.
+        let press = Until {
+            servo_within: Some(0.01),
+            ..Until::default()
+        };
+        let servos = |loads: &[f64]| FrameState {
+            servos: loads.iter().map(|&l| (1, l, 2.0)).collect(),
+            ..filling.clone()
+        };
+        assert_eq!(press.met(&servos(&[1.99])).unwrap().key, "servo_within");
+        assert_eq!(press.met(&servos(&[1.99, 2.03])), None);
+        assert_eq!(press.met(&servos(&[])), None);
     }
 
     #[test]

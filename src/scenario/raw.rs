@@ -293,6 +293,7 @@ pub(super) struct RawUntil {
     pub(super) kinetic_energy_below: Option<f64>,
     pub(super) time: Option<f64>,
     pub(super) removed_at_least: Option<u64>,
+    pub(super) servo_within: Option<f64>,
 }
 
 #[derive(Deserialize, Default)]

@@ -134,6 +134,9 @@ impl Scenario {
             if let Some(n) = u.removed_at_least {
                 conditions.push(format!("removed_at_least = {n}"));
             }
+            if let Some(f) = u.servo_within {
+                conditions.push(format!("servo_within = {}", num(f)));
+            }
             let _ = writeln!(o, "until = {{ {} }}", conditions.join(", "));
         }
     }

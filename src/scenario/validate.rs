@@ -174,6 +174,11 @@ impl Scenario {
             geometry.mesh_material = index("[geometry] mesh_material", name)?;
         }
         let meshes = meshes(raw.meshes, base, &index)?;
+        if simulation.until.servo_within.is_some() && meshes.iter().all(|m| m.servo.is_none()) {
+            bail!(
+                "[simulation] until.servo_within needs a servo: no [[meshes]] has motion = {{ type = \"servo\", ... }}"
+            );
+        }
         let tags = tags(raw.tags)?;
         let periodic = raw
             .domain
@@ -453,14 +458,24 @@ fn until(raw: Option<RawUntil>) -> Result<Until> {
         kinetic_energy_below: positive("kinetic_energy_below", raw.kinetic_energy_below)?,
         time: positive("time", raw.time)?,
         removed_at_least: raw.removed_at_least,
+        servo_within: raw
+            .servo_within
+            .map(|f| check("[simulation] until.servo_within", f, Range::Positive))
+            .transpose()?,
     };
+    if until.servo_within.is_some_and(|f| f >= 1.0) {
+        bail!(
+            "[simulation] until.servo_within = {} is not allowed: it is a fraction of the target, below 1 (0.01: within 1 %)",
+            until.servo_within.unwrap_or_default()
+        );
+    }
     if until.removed_at_least == Some(0) {
         bail!("[simulation] until.removed_at_least = 0 is not allowed: it must be at least 1");
     }
     if until.is_empty() {
         bail!(
-            "[simulation] until = {{}} names no condition: give kinetic_energy_below, time or \
-             removed_at_least"
+            "[simulation] until = {{}} names no condition: give kinetic_energy_below, time, \
+             removed_at_least or servo_within"
         );
     }
     Ok(until)

@@ -12,7 +12,7 @@
 //! entry the ids (lower, higher) or the id and face (u32, u32) and the springs u_s, u_r (3 f64
 //! each), u_t (f64); from format 3 the removed particles, wall sums, scenario, mesh files and
 //! spawn regions (`Cursor::rest`); from format 4 the servos' states (count, and per servo its
-//! mesh file (u32), position, speed and position at the last rebuild (3 f64)); last a CRC-32
+//! mesh file (u32), position, speed, position at the last rebuild and last load (4 f64)); last a CRC-32
 //! of everything before it.
 //!
 //! The storage order and the positions of the last rebuild let a resumed run rebuild the
@@ -69,7 +69,7 @@ fn encoded_size(s: &Snapshot) -> usize {
         + 48 * s.wall_sums.len()
         + 16 * s.removed.outlets.len()
         + 17 * s.spawner.regions.len()
-        + 28 * s.servos.len()
+        + 36 * s.servos.len()
 }
 
 /// Appends the checkpoint of `snapshot` to `out` (its checksum covers what it appends).
@@ -144,7 +144,7 @@ pub fn encode_into(out: &mut Vec<u8>, snapshot: &Snapshot, fingerprint: u64) {
     out.extend_from_slice(&(snapshot.servos.len() as u64).to_le_bytes());
     for (file, s) in &snapshot.servos {
         out.extend_from_slice(&file.to_le_bytes());
-        put_f64s(out, &[s.position, s.speed, s.built]);
+        put_f64s(out, &[s.position, s.speed, s.built, s.load]);
     }
     let crc = crc32fast::hash(&out[start..]);
     out.extend_from_slice(&crc.to_le_bytes());
@@ -405,23 +405,23 @@ impl Cursor<'_> {
     /// 4).
     fn servos(&mut self, files: usize) -> Result<Vec<(u32, State)>> {
         let r = self;
-        let count = r.count(4 + 24)?;
+        let count = r.count(4 + 32)?;
         let servos = (0..count)
             .map(|_| {
                 let file = r.u32()?;
-                let (position, speed, built) = (r.f64()?, r.f64()?, r.f64()?);
-                Ok((
-                    file,
-                    State {
-                        position,
-                        speed,
-                        built,
-                    },
-                ))
+                let (position, speed) = (r.f64()?, r.f64()?);
+                let (built, load) = (r.f64()?, r.f64()?);
+                let state = State {
+                    position,
+                    speed,
+                    built,
+                    load,
+                };
+                Ok((file, state))
             })
             .collect::<Result<Vec<_>>>()?;
         let finite = |s: &State| {
-            [s.position, s.speed, s.built]
+            [s.position, s.speed, s.built, s.load]
                 .iter()
                 .all(|x| x.abs() < 1e30)
         };

@@ -162,6 +162,7 @@ mod tests {
                     position: 0.0125,
                     speed: -3e-4,
                     built: 0.0124,
+                    load: 2.5,
                 },
             )],
         }

@@ -347,12 +347,40 @@ fn frame_times(dir: &Path) -> std::collections::HashMap<u64, f64> {
         .collect()
 }
 
+/// Each servo's displacement at each frame, from the run's `log.csv` (`meshK_position`).
+fn servo_positions(dir: &Path) -> std::collections::HashMap<u64, Vec<(u32, f64)>> {
+    let Ok(text) = std::fs::read_to_string(dir.join(crate::io::output::LOG)) else {
+        return Default::default();
+    };
+    let mut lines = text.lines();
+    let header = lines.next().unwrap_or_default();
+    let columns: Vec<(usize, u32)> = (header.split(',').enumerate())
+        .filter_map(|(c, name)| {
+            let k = name.strip_prefix("mesh")?.strip_suffix("_position")?;
+            Some((c, k.parse().ok()?))
+        })
+        .collect();
+    if columns.is_empty() {
+        return Default::default();
+    }
+    lines
+        .filter_map(|l| {
+            let v: Vec<&str> = l.split(',').collect();
+            let at = |&(c, k): &(usize, u32)| Some((k, v.get(c)?.parse().ok()?));
+            let positions = columns.iter().map(at).collect::<Option<Vec<_>>>()?;
+            Some((v.first()?.parse().ok()?, positions))
+        })
+        .collect()
+}
+
 /// What the pictures of a run's frames are drawn with: the run's simulation (for its
-/// meshes at each frame's time and its materials), further mesh files, the frames' times.
+/// meshes at each frame's time and its materials), further mesh files, the frames' times
+/// and where its servos were.
 struct Source {
     sim: Option<Simulation>,
     extra: Mesh,
     times: std::collections::HashMap<u64, f64>,
+    servos: std::collections::HashMap<u64, Vec<(u32, f64)>>,
 }
 
 impl Source {
@@ -379,6 +407,7 @@ impl Source {
             sim,
             extra,
             times: frame_times(dir),
+            servos: servo_positions(dir),
         })
     }
 
@@ -393,10 +422,13 @@ impl Source {
         })
     }
 
-    /// The meshes at time `t`.
-    fn mesh_of(&mut self, t: Option<f64>) -> Mesh {
+    /// The meshes of `frame`, at its time `t` (servos where the run's log has them).
+    fn mesh_of(&mut self, frame: &Path, t: Option<f64>) -> Mesh {
         let mut mesh = self.extra.clone();
         if let Some(sim) = self.sim.as_mut() {
+            if let Some(at) = frame_number(frame).and_then(|k| self.servos.get(&k)) {
+                sim.walls.place_servos(at);
+            }
             mesh.faces
                 .extend(sim.walls.at(t.unwrap_or(0.0)).faces.iter().copied());
         }
@@ -449,7 +481,7 @@ pub fn render_path(
     for f in &frames {
         let p = crate::io::csv::load_particles(f)?;
         let t = source.time_of(f);
-        layout.include(&p, &source.mesh_of(t), style);
+        layout.include(&p, &source.mesh_of(f, t), style);
     }
     layout.fix(fixed, style);
     if let Some(sim) = &source.sim {
@@ -478,7 +510,7 @@ pub fn render_path(
     for f in &frames {
         let p = crate::io::csv::load_particles(f)?;
         let t = source.time_of(f);
-        let img = render_in(&p, &source.mesh_of(t), style, &layout, t)?;
+        let img = render_in(&p, &source.mesh_of(f, t), style, &layout, t)?;
         let png = if path.is_dir() {
             out_dir.join(f.with_extension("png").file_name().expect("a file name"))
         } else {
@@ -599,6 +631,30 @@ mod tests {
     use super::*;
     use crate::model::particles::Particle;
     use glam::DQuat;
+
+    #[test]
+    fn servos_are_placed_where_the_log_has_them() {
+        let dir = tempfile::tempdir().unwrap();
+        let header = crate::io::output::LOG_HEADER;
+        let zeros = "0,".repeat(8);
+        let log = format!(
+            "{header},mesh2_position,mesh2_load,mesh4_position,mesh4_load\n\
+             0,0,0.0,{zeros}0.0,0.0,0.0,0.0\n\
+             3,300,0.1,{zeros}0.0125,2.5,-0.5,0.0\n"
+        );
+        std::fs::write(dir.path().join(crate::io::output::LOG), log).unwrap();
+        let at = servo_positions(dir.path());
+        assert_eq!(at[&3], vec![(2, 0.0125), (4, -0.5)]);
+        assert_eq!(at[&0], vec![(2, 0.0), (4, 0.0)]);
+        // A run without servos, or without a log: none.
+        std::fs::write(
+            dir.path().join(crate::io::output::LOG),
+            format!("{header}\n"),
+        )
+        .unwrap();
+        assert!(servo_positions(dir.path()).is_empty());
+        assert!(servo_positions(&dir.path().join("none")).is_empty());
+    }
 
     #[test]
     fn a_sphere_is_drawn_in_the_middle() {
