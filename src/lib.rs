@@ -41,4 +41,4 @@ pub use geometry::{mesh, surface};
 pub use io::{checkpoint, csv, files, lock, output, vtk};
 pub use model::{contact, exact, integrate, lanes, motion, particles, springs};
 pub use parallel::{comm, domain};
-pub use tools::{analyze, bench, plot, render, text};
+pub use tools::{analyze, bench, fields, plot, render, text};

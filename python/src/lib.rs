@@ -470,6 +470,101 @@ fn render<'py>(
     Ok(d)
 }
 
+/// Coarse-grained fields of a run's output directory (as `tinydem analyze --fields`):
+/// density, velocity and stress (compression positive) with its contact and kinetic parts,
+/// on a grid or in slices, each set also written as fieldsNNNNNN.vti and .csv beside the
+/// frames (fields_mean.* averaged). Returns a list of dicts of numpy arrays: points (N, 3),
+/// counts (3,), density (N,), velocity (N, 3), stress, contact_stress, kinetic_stress
+/// (N, 3, 3), frames (how many it averages) and files.
+///
+/// kernel: "gaussian" or "lucy"; width: the Gaussian's standard deviation or Lucy's reach
+/// [m]; slices: "x", "y" or "z"; frames: (first, last), default the last frame; bounds:
+/// ((x0, y0, z0), (x1, y1, z1)), default the domain or the particles' extent.
+#[pyfunction]
+#[pyo3(signature = (directory, scenario=None, spacing=None, kernel="gaussian", width=None, slices=None, frames=None, average=false, bounds=None))]
+#[allow(clippy::too_many_arguments)]
+fn fields<'py>(
+    py: Python<'py>,
+    directory: PathBuf,
+    scenario: Option<PathBuf>,
+    spacing: Option<f64>,
+    kernel: &str,
+    width: Option<f64>,
+    slices: Option<&str>,
+    frames: Option<(u64, u64)>,
+    average: bool,
+    bounds: Option<([f64; 3], [f64; 3])>,
+) -> PyResult<Vec<Bound<'py, PyDict>>> {
+    use tinydem::fields::{Options, Shape, of_directory};
+    let shape = match kernel {
+        "gaussian" => Shape::Gaussian,
+        "lucy" => Shape::Lucy,
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "kernel {other:?}: \"gaussian\" or \"lucy\""
+            )));
+        }
+    };
+    let slices = match slices {
+        None => None,
+        Some("x") => Some(0),
+        Some("y") => Some(1),
+        Some("z") => Some(2),
+        Some(other) => {
+            return Err(PyValueError::new_err(format!(
+                "slices {other:?}: \"x\", \"y\" or \"z\""
+            )));
+        }
+    };
+    let options = Options {
+        spacing,
+        shape: Some(shape),
+        width,
+        slices,
+        frames,
+        average,
+        bounds: bounds.map(|(a, b)| (DVec3::from_array(a), DVec3::from_array(b))),
+    };
+    let sets = guarded(|| {
+        py.detach(|| of_directory(&directory, scenario.as_deref(), &options))
+            .map_err(error)
+    })?;
+    let tensors = |m: &[glam::DMat3]| -> PyResult<_> {
+        let flat: Vec<f64> = m
+            .iter()
+            .flat_map(|m| m.transpose().to_cols_array())
+            .collect();
+        numpy::ndarray::Array3::from_shape_vec((m.len(), 3, 3), flat)
+            .map_err(|e| PyRuntimeError::new_err(e.to_string()))
+    };
+    let mut out = Vec::new();
+    for (f, files) in sets {
+        let n = f.grid.len();
+        let d = PyDict::new(py);
+        let points: Vec<f64> = (0..n).flat_map(|k| f.grid.point(k).to_array()).collect();
+        let velocity: Vec<f64> = f.velocity.iter().flat_map(|v| v.to_array()).collect();
+        let stress: Vec<glam::DMat3> = (0..n).map(|k| f.stress(k)).collect();
+        let shaped = |v: Vec<f64>| Array2::from_shape_vec((n, 3), v).expect("three per point");
+        d.set_item("points", shaped(points).into_pyarray(py))?;
+        d.set_item(
+            "counts",
+            Array1::from_vec(f.grid.counts.map(|c| c as i64).to_vec()).into_pyarray(py),
+        )?;
+        d.set_item(
+            "density",
+            Array1::from_vec(f.density.clone()).into_pyarray(py),
+        )?;
+        d.set_item("velocity", shaped(velocity).into_pyarray(py))?;
+        d.set_item("stress", tensors(&stress)?.into_pyarray(py))?;
+        d.set_item("contact_stress", tensors(&f.contact)?.into_pyarray(py))?;
+        d.set_item("kinetic_stress", tensors(&f.kinetic)?.into_pyarray(py))?;
+        d.set_item("frames", f.frames)?;
+        d.set_item("files", files.to_vec())?;
+        out.push(d);
+    }
+    Ok(out)
+}
+
 /// Reads a numeric CSV file with a header line (a frame, `log.csv`, `frames.csv`):
 /// the column names and the values, row by row, as an (rows, columns) array.
 #[pyfunction]
@@ -530,6 +625,7 @@ fn _tinydem(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(read_csv, m)?)?;
     m.add_function(wrap_pyfunction!(render, m)?)?;
+    m.add_function(wrap_pyfunction!(fields, m)?)?;
     m.add_function(wrap_pyfunction!(_internal_panic, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

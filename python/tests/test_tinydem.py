@@ -225,6 +225,39 @@ def test_render_draws_a_directory_and_an_animation(study, tmp_path):
         tinydem.render(out, range=(1.0, 0.0))
 
 
+def test_fields_of_a_bed_hold_its_mass_and_press_down(tmp_path):
+    """tinydem.fields: slices along z of grains resting on a floor, with their contacts."""
+    s = tmp_path / "bed.toml"
+    s.write_text(
+        "[geometry]\nradius_min = 0.004\nradius_max = 0.005\n"
+        "spawn_min = [-0.02, -0.02, 0.01]\nspawn_max = [0.02, 0.02, 0.06]\n"
+        "[simulation]\nmax_particles = 60\nframes = 3\nsteps_per_frame = 2000\n"
+        "[output]\ncontacts = true\n"
+        "[[meshes]]\nshape = { type = \"box\", min = [-0.03, -0.03, 0.0], max = [0.03, 0.03, 0.1], "
+        "open = [\"+z\"] }\n"
+    )
+    out = Path(tinydem.run(s, output=tmp_path / "out"))
+    # The box reaches below the floor: the grains' kernels (3 mean radii) reach there too.
+    box = ((-0.03, -0.03, -0.02), (0.03, 0.03, 0.1))
+    [f] = tinydem.fields(out, slices="z", spacing=0.005, bounds=box)
+    n = 24
+    assert list(f["counts"]) == [1, 1, n] and f["frames"] == 1
+    assert f["points"].shape == (n, 3) and f["stress"].shape == (n, 3, 3)
+    assert all(Path(p).is_file() for p in f["files"])
+    frame = tinydem.read_frame(out / "particles000003.csv")
+    mass = (1000.0 * 4.0 / 3.0 * np.pi * frame["R"] ** 3).sum()
+    # The slices hold the grains' mass (0.06 x 0.06 m across, 5 mm thick).
+    assert f["density"].sum() * 0.06 * 0.06 * 0.005 == pytest.approx(mass, rel=1e-3)
+    # Under the grains, at the floor, the stress is compressive.
+    assert f["stress"][4, 2, 2] > 0.0
+    assert f["stress"] == pytest.approx(f["contact_stress"] + f["kinetic_stress"])
+    with pytest.raises(ValueError, match="kernel"):
+        tinydem.fields(out, kernel="box")
+    (out / "contacts000003.csv").unlink()
+    with pytest.raises(RuntimeError, match="contacts = true"):
+        tinydem.fields(out)
+
+
 def test_the_example_study_runs():
     """examples/python/study.py, the notebook-style example, runs start to end."""
     script = ROOT / "examples" / "python" / "study.py"

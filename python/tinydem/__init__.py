@@ -22,13 +22,14 @@ from typing import Dict, Iterator, List, Optional, Sequence, Union, overload
 
 import numpy as np
 
-from ._tinydem import Simulation, __version__, read_csv, render, run
+from ._tinydem import Simulation, __version__, fields, read_csv, render, run
 
 __all__ = [
     "Simulation",
     "Output",
     "run",
     "render",
+    "fields",
     "read_frame",
     "read_output",
     "read_table",

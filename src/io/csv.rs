@@ -126,6 +126,63 @@ pub fn write_contacts(dir: &Path, name: &str, contacts: &[ContactRecord]) -> Res
     Ok(path)
 }
 
+/// Reads a contact network written by [`write_contacts`] (`contactsNNNNNN.csv`).
+pub fn load_contacts(path: &Path) -> Result<Vec<ContactRecord>> {
+    let file = path.display().to_string();
+    let text = std::io::read_to_string(
+        crate::io::files::open(path).with_context(|| format!("cannot read contact file {file}"))?,
+    )
+    .with_context(|| format!("cannot read contact file {file}"))?;
+    let mut lines = text.lines();
+    if lines.next().map(str::trim) != Some(CONTACT_COLUMNS) {
+        bail!("{file}:1: expected the header '{CONTACT_COLUMNS}'");
+    }
+    lines
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty())
+        .map(|(k, line)| contact(line, &file, k + 2))
+        .collect()
+}
+
+/// One line `n` of a contact network.
+fn contact(line: &str, file: &str, n: usize) -> Result<ContactRecord> {
+    let fields: Vec<&str> = line.split(',').map(str::trim).collect();
+    if fields.len() != 13 {
+        bail!("{file}:{n}: {} values, expected 13", fields.len());
+    }
+    let int = |k: usize| -> Result<i64> {
+        (fields[k].parse())
+            .map_err(|_| anyhow::anyhow!("{file}:{n}: '{}' is not a whole number", fields[k]))
+    };
+    let mut x = [0.0; 10];
+    for (v, text) in x.iter_mut().zip(&fields[3..]) {
+        *v = text
+            .parse()
+            .ok()
+            .filter(|v: &f64| v.is_finite())
+            .ok_or_else(|| anyhow::anyhow!("{file}:{n}: '{text}' is not a finite number"))?;
+    }
+    let (id, j, face) = (int(0)?, int(1)?, int(2)?);
+    let id =
+        u32::try_from(id).map_err(|_| anyhow::anyhow!("{file}:{n}: id_i {id} out of range"))?;
+    let with = match (j, face) {
+        (j, -1) if (0..=u32::MAX as i64).contains(&j) => Partner::Particle(j as usize),
+        (-1, f) if f >= 0 => Partner::Face(f as usize),
+        _ => bail!(
+            "{file}:{n}: a contact is with a particle (id_j, face = -1) or a face (id_j = -1, face)"
+        ),
+    };
+    let v = |k: usize| DVec3::new(x[k], x[k + 1], x[k + 2]);
+    Ok(ContactRecord {
+        id,
+        with,
+        point: v(0),
+        f_n: v(3),
+        f_t: v(6),
+        overlap: x[9],
+    })
+}
+
 /// The columns of a particle CSV file, from its header.
 struct Header {
     columns: usize,
@@ -328,6 +385,38 @@ pub fn load_particles(path: &Path) -> Result<Particles> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn contact_networks_read_back_as_written() {
+        let dir = tempfile::tempdir().unwrap();
+        let contacts = vec![
+            ContactRecord {
+                id: 3,
+                with: Partner::Particle(7),
+                point: DVec3::new(0.1, 0.2, 1.0 / 3.0),
+                f_n: DVec3::new(0.0, 0.0, 1.5e-3),
+                f_t: DVec3::new(-2e-5, 1e-300, 0.0),
+                overlap: 1e-6,
+            },
+            ContactRecord {
+                id: 4,
+                with: Partner::Face(12),
+                point: DVec3::ZERO,
+                f_n: DVec3::X,
+                f_t: DVec3::ZERO,
+                overlap: 0.0,
+            },
+        ];
+        let path = write_contacts(dir.path(), "contacts000001.csv", &contacts).unwrap();
+        assert_eq!(load_contacts(&path).unwrap(), contacts);
+        let bad = |text: &str| {
+            std::fs::write(&path, format!("{CONTACT_COLUMNS}\n{text}\n")).unwrap();
+            format!("{:#}", load_contacts(&path).unwrap_err())
+        };
+        assert!(bad("1,2,3").contains(":2: 3 values"));
+        assert!(bad("1,2,3,0,0,0,0,0,0,0,0,0,0").contains("a particle (id_j, face = -1)"));
+        assert!(bad("1,2,-1,0,0,nan,0,0,0,0,0,0,0").contains("'nan' is not a finite"));
+    }
 
     #[test]
     fn round_trip_is_exact() {

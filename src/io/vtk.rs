@@ -166,6 +166,46 @@ impl Vtu {
     }
 }
 
+/// A regular grid of points as VTK image data (`.vti`), for fields: `counts` points along
+/// x, y, z (x the fastest), the first at `origin`, `spacing` apart.
+pub struct Image {
+    pub origin: glam::DVec3,
+    pub spacing: glam::DVec3,
+    pub counts: [usize; 3],
+}
+
+impl Image {
+    /// Writes the point arrays `arrays` (a name, its number of components, and the values,
+    /// point by point) to `path`.
+    pub fn write(&self, path: &Path, arrays: &[(&str, usize, &[f64])]) -> Result<()> {
+        let mut v = Vtu::new();
+        for &(name, components, values) in arrays {
+            v.array(
+                Section::PointData,
+                name,
+                components,
+                values.len(),
+                values.iter().copied(),
+            );
+        }
+        let [nx, ny, nz] = self.counts.map(|n| n.max(1) - 1);
+        let extent = format!("0 {nx} 0 {ny} 0 {nz}");
+        let (o, h) = (self.origin, self.spacing);
+        let mut text = String::from("<?xml version=\"1.0\"?>\n");
+        text += "<VTKFile type=\"ImageData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n";
+        text += &format!(
+            "  <ImageData WholeExtent=\"{extent}\" Origin=\"{} {} {}\" Spacing=\"{} {} {}\">\n",
+            o.x, o.y, o.z, h.x, h.y, h.z
+        );
+        text += &format!("    <Piece Extent=\"{extent}\">\n");
+        text += &format!("      <PointData>\n{}      </PointData>\n", v.point_data);
+        text += "      <CellData>\n      </CellData>\n";
+        text += "    </Piece>\n  </ImageData>\n  <AppendedData encoding=\"raw\">\n   _";
+        let tail = "\n  </AppendedData>\n</VTKFile>\n";
+        atomic_write(path, &[text.as_bytes(), &v.appended, tail.as_bytes()])
+    }
+}
+
 /// Writes `parts` to a temporary file and renames it to `path`.
 fn atomic_write(path: &Path, parts: &[&[u8]]) -> Result<()> {
     crate::io::files::write_atomically(path, |w| parts.iter().try_for_each(|p| w.write_all(p)))

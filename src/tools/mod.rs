@@ -2,6 +2,7 @@
 
 pub mod analyze;
 pub mod bench;
+pub mod fields;
 pub mod plot;
 pub mod render;
 pub mod text;

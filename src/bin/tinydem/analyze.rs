@@ -51,11 +51,116 @@ pub struct AnalyzeArgs {
     /// The column to plot (a name from the table's header).
     #[arg(long, default_value = "kinetic_energy")]
     column: String,
+    #[command(flatten)]
+    fields: FieldArgs,
+}
+
+/// `--fields` and its options.
+#[derive(Args)]
+struct FieldArgs {
+    /// Instead of the table: coarse-grained density, velocity and stress (contact and
+    /// kinetic parts, compression positive) on a grid or in slices, as fieldsNNNNNN.vti and
+    /// .csv beside the frames (fields_mean.* with --average). Needs the contact networks
+    /// ([output] contacts = true).
+    #[arg(long)]
+    fields: bool,
+    /// Between the points [m] (default: the mean diameter).
+    #[arg(long, requires = "fields")]
+    spacing: Option<f64>,
+    /// The coarse-graining function.
+    #[arg(long, value_enum, default_value = "gaussian", requires = "fields")]
+    kernel: KernelArg,
+    /// The kernel's width [m]: the Gaussian's standard deviation (cut at 3 widths; default
+    /// the mean radius), or Lucy's reach (default three mean radii).
+    #[arg(long, requires = "fields")]
+    width: Option<f64>,
+    /// Slices along this axis (each spanning the box across it) instead of a grid.
+    #[arg(long, value_enum, requires = "fields")]
+    slices: Option<AxisArg>,
+    /// The frames FROM,TO (default: the last frame).
+    #[arg(
+        long,
+        value_name = "FROM,TO",
+        value_delimiter = ',',
+        requires = "fields"
+    )]
+    frames: Option<Vec<u64>>,
+    /// One set of fields averaged over the frames.
+    #[arg(long, requires = "fields")]
+    average: bool,
+    /// The box X0,Y0,Z0,X1,Y1,Z1 (default: the domain, else the particles' extent).
+    #[arg(
+        long,
+        value_name = "X0,Y0,Z0,X1,Y1,Z1",
+        value_delimiter = ',',
+        requires = "fields",
+        allow_hyphen_values = true
+    )]
+    bounds: Option<Vec<f64>>,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum KernelArg {
+    Gaussian,
+    Lucy,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum AxisArg {
+    X,
+    Y,
+    Z,
+}
+
+impl FieldArgs {
+    /// The fields of the frames of `dir`, with a line per file written.
+    fn execute(&self, dir: &Path, scenario: Option<&Path>) -> Result<()> {
+        use tinydem::fields::{Options, Shape, of_directory};
+        if self.frames.as_ref().is_some_and(|f| f.len() != 2) {
+            anyhow::bail!("--frames takes two frame numbers, FROM,TO");
+        }
+        if self.bounds.as_ref().is_some_and(|b| b.len() != 6) {
+            anyhow::bail!("--bounds takes six numbers, X0,Y0,Z0,X1,Y1,Z1");
+        }
+        let options = Options {
+            spacing: self.spacing,
+            shape: Some(match self.kernel {
+                KernelArg::Gaussian => Shape::Gaussian,
+                KernelArg::Lucy => Shape::Lucy,
+            }),
+            width: self.width,
+            slices: self.slices.map(|a| a as usize),
+            frames: self.frames.as_ref().map(|f| (f[0], f[1])),
+            average: self.average,
+            bounds: self.bounds.as_ref().map(|b| {
+                (
+                    glam::DVec3::new(b[0], b[1], b[2]),
+                    glam::DVec3::new(b[3], b[4], b[5]),
+                )
+            }),
+        };
+        for (fields, files) in of_directory(dir, scenario, &options)? {
+            let g = &fields.grid;
+            println!(
+                "{} and {}: {} x {} x {} points, {} frame(s)",
+                files[0].display(),
+                files[1].display(),
+                g.counts[0],
+                g.counts[1],
+                g.counts[2],
+                fields.frames
+            );
+        }
+        Ok(())
+    }
 }
 
 impl AnalyzeArgs {
     /// Measures every frame, printing a row each, then writes the CSV and the plot.
     pub fn execute(self) -> Result<()> {
+        if self.fields.fields {
+            return self.fields.execute(&self.dir, self.scenario.as_deref());
+        }
         let repose = self
             .repose
             .then(|| ReposeWindow::of(self.rest_speed, self.window.as_deref()))
