@@ -350,7 +350,7 @@ impl Fields {
         self.contact[k] + self.kinetic[k]
     }
 
-    /// The columns of [`Fields::rows`].
+    /// The columns of [`Fields::row`].
     pub fn header() -> String {
         let tensor = |p: &str| {
             ["xx", "xy", "xz", "yx", "yy", "yz", "zx", "zy", "zz"]
