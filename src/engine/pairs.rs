@@ -215,30 +215,36 @@ impl PairStage<'_> {
         store: &mut Store,
         touching: &mut Vec<[u32; 3]>,
     ) {
+        // Room for every slot of the slab, written in turn and counted when touching (no
+        // branch on the outcome, which is a coin toss; a contact that opens or closes is
+        // the rare case that branches).
+        let slots = self.start[owners.end] as usize - self.start[owners.start] as usize;
         touching.clear();
+        touching.resize(slots + 1, [0; 3]);
+        let mut n = 0;
         for i in owners {
             let (xi, ri) = (self.p.x[i], self.p.radius[i]);
             let run = self.start[i] as usize - first..self.start[i + 1] as usize - first;
             for kl in run {
                 let j = self.partner[first + kl] as usize;
                 let reach = ri + self.p.radius[j];
-                if (xi - self.p.x[j]).length_squared() < reach * reach {
-                    let (a, b) = if self.p.id[i] < self.p.id[j] {
-                        (i, j)
-                    } else {
-                        (j, i)
-                    };
-                    if contact[kl] == NONE {
+                let touches = (xi - self.p.x[j]).length_squared() < reach * reach;
+                if touches != (contact[kl] != NONE) {
+                    if touches {
                         contact[kl] = store.open();
+                    } else {
+                        // The contact ended: forget its history.
+                        store.close(contact[kl]);
+                        contact[kl] = NONE;
                     }
-                    touching.push([a as u32, b as u32, contact[kl]]);
-                } else if contact[kl] != NONE {
-                    // The contact ended: forget its history.
-                    store.close(contact[kl]);
-                    contact[kl] = NONE;
                 }
+                let lower = self.p.id[i] < self.p.id[j];
+                let (a, b) = if lower { (i, j) } else { (j, i) };
+                touching[n] = [a as u32, b as u32, contact[kl]];
+                n += touches as usize;
             }
         }
+        touching.truncate(n);
     }
 
     /// The law for one group of touching pairs, added to both particles' loads; deep

@@ -15,7 +15,7 @@
 //! `Simulation`), so the resolution lies some 90 binary orders below it: far below the
 //! rounding of a float sum of the small forces.
 
-use wide::{f64x8, i64x8};
+use wide::{f64x8, i64x4, i64x8};
 
 /// Terms up to this many resolutions (2^104).
 const RANGE: f64 = 20282409603651670423947251286016.0;
@@ -85,10 +85,13 @@ impl Sum6 {
     pub fn add(&mut self, x: f64x8, scales: &Scales8) -> bool {
         let (hi, lo, beyond) = split(x, scales.up);
         let (hi, lo) = (hi.to_array(), lo.to_array());
-        for c in 0..6 {
-            self.words[c] = self.words[c].wrapping_add(hi[c]);
-            self.words[6 + c] = self.words[6 + c].wrapping_add(lo[c]);
-        }
+        // Words 0-7 (hi 0-5, lo 0-1) and 8-11 (lo 2-5) as two vector adds (wrapping).
+        let first = i64x8::from([hi[0], hi[1], hi[2], hi[3], hi[4], hi[5], lo[0], lo[1]]);
+        let (head, tail) = self.words.split_at_mut(8);
+        let head: &mut [i64; 8] = head.try_into().expect("8 words");
+        let tail: &mut [i64; 4] = tail.try_into().expect("4 words");
+        *head = (i64x8::from(*head) + first).to_array();
+        *tail = (i64x4::from(*tail) + i64x4::from([lo[2], lo[3], lo[4], lo[5]])).to_array();
         !beyond
     }
 
