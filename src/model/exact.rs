@@ -144,7 +144,28 @@ fn split(x: f64x8, up: f64x8) -> (i64x8, i64x8, bool) {
     let hi = (a * f64x8::splat(INV_SPLIT)).trunc();
     // Exact: hi 2^52 is a multiple of the last bit of `a`, and |a - hi 2^52| < 2^52.
     let lo = a - hi * f64x8::splat(SPLIT);
-    (hi.trunc_int(), lo.trunc_int(), beyond)
+    (whole(hi), whole(lo), beyond)
+}
+
+/// The lanes of `x`, whole numbers below 2^52 in magnitude when in range, as integers. With
+/// AVX-512 the plain conversion (no saturation of NaN or huge lanes, which stop the run as
+/// beyond the range anyway): the same integers for every lane in range.
+#[inline(always)]
+fn whole(x: f64x8) -> i64x8 {
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx512dq"))]
+    {
+        use std::arch::x86_64::{__m512d, __m512i, _mm512_cvttpd_epi64};
+        // SAFETY: the target has AVX-512DQ (checked at compile time); f64x8 and i64x8 are
+        // 64-byte vectors with the layout of __m512d and __m512i.
+        unsafe {
+            let v: __m512d = std::mem::transmute::<f64x8, __m512d>(x);
+            std::mem::transmute::<__m512i, i64x8>(_mm512_cvttpd_epi64(v))
+        }
+    }
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx512dq")))]
+    {
+        x.trunc_int()
+    }
 }
 
 /// A force and a torque in the lanes of one vector (components 0-2 and 3-5).
