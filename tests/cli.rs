@@ -206,6 +206,55 @@ fn check_says_the_order_of_the_friction_springs() {
 }
 
 #[test]
+fn check_names_periodic_sides_shear_and_spawn_regions_and_warns_only_of_real_removals() {
+    let t = tempfile::tempdir().unwrap();
+    // Two grains just past a periodic side (put back in) and one below the floor (removed).
+    let grains = format!(
+        "{HEADER}0.0505,0,0.05,0.004,0,0,0,1,0,0,0,0,0,0\n0,-0.0502,0.05,0.004,0,0,0,1,0,0,0,0,0,0\n\
+         0,0,-0.06,0.004,0,0,0,1,0,0,0,0,0,0\n"
+    );
+    write(t.path(), "p.csv", &grains);
+    write(
+        t.path(),
+        "s.toml",
+        "[geometry]\nradius_min = 0.004\nradius_max = 0.005\n\
+         [simulation]\nframes = 1\nmax_particles = 50\n\
+         [domain]\nmin = [-0.05, -0.05, -0.05]\nmax = [0.05, 0.05, 0.2]\nperiodic = [true, true, false]\n\
+         [input]\nparticles = \"p.csv\"\n\
+         [[spawn]]\nmin = [-0.04, -0.04, 0.1]\nmax = [0.04, 0.04, 0.15]\ncount = 40\n",
+    );
+    let o = tinydem(&["check", "s.toml"], t.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    for line in [
+        "(periodic along x and y: particles leaving it across another side are removed)",
+        "warning: 1 initial particles lie outside it and are removed at the first step",
+        "spawn region 1         [-0.04, -0.04, 0.1] .. [0.04, 0.04, 0.15]: 40 particles, R uniform in [0.004, 0.005]",
+        "in all at most 50 particles (max_particles)",
+    ] {
+        assert!(out.contains(line), "missing {line} in\n{out}");
+    }
+    // And the shear of a Lees-Edwards box.
+    write(
+        t.path(),
+        "le.toml",
+        "[simulation]\nframes = 1\nmax_particles = 0\n\
+         [domain]\nmin = [-0.05, -0.05, -0.05]\nmax = [0.05, 0.05, 0.05]\nperiodic = [true, true, true]\n\
+         lees_edwards = { velocity = 0.2, shear_axis = \"x\", gradient_axis = \"z\" }\n",
+    );
+    let o = tinydem(&["check", "le.toml"], t.path());
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for line in [
+        "(periodic along x, y and z: nothing leaves it)",
+        "Lees-Edwards           the images across the z sides move at 0.2 m/s along x (shear rate 2.000000e0/s)",
+        "spawning               none",
+    ] {
+        assert!(out.contains(line), "missing {line} in\n{out}");
+    }
+}
+
+#[test]
 fn check_says_which_meshes_merge_their_contacts() {
     let t = tempfile::tempdir().unwrap();
     let square = "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n";

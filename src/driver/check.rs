@@ -7,6 +7,7 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
+use glam::DVec3;
 
 use crate::engine::Simulation;
 use crate::geometry::mesh::Contacts;
@@ -182,31 +183,120 @@ fn servo_lines(s: &Scenario, sim: &Simulation) -> String {
 
 /// The domain (and the initial particles outside it), the outlets and the wall loads.
 fn bound_lines(s: &Scenario, sim: &Simulation) -> String {
-    let mut bounds = String::new();
-    if let Some(d) = s.domain {
-        bounds += &format!(
-            "domain                 {} .. {} (particles leaving it are removed)\n",
-            d.min, d.max
-        );
-        let outside = sim.particles.x.iter().filter(|&&x| !d.contains(x)).count();
-        if outside > 0 {
-            bounds += &format!(
-                "                       warning: {outside} initial particles lie outside it and are removed at the first step\n"
-            );
-        }
-    }
+    let mut bounds = domain_lines(s, sim);
     for (k, o) in s.outlets.iter().enumerate() {
         bounds += &format!(
             "outlet {k:<16}{} .. {} (removes particles entering it; {OUTLETS})\n",
             o.min, o.max
         );
     }
+    bounds += &spawn_lines(s);
     if s.wall_forces {
         bounds += &format!(
             "wall loads             force and torque on each mesh file, mean per frame ({WALLS})\n"
         );
     }
     bounds
+}
+
+const AXES: [&str; 3] = ["x", "y", "z"];
+
+/// The domain: its periodic axes and Lees-Edwards shear, and the initial particles it will
+/// remove (outside it across a side that is not periodic; across a periodic one they are put
+/// back in).
+fn domain_lines(s: &Scenario, sim: &Simulation) -> String {
+    let Some(d) = s.domain else {
+        return String::new();
+    };
+    let periodic: Vec<&str> = (0..3).filter(|&a| s.periodic[a]).map(|a| AXES[a]).collect();
+    let leaving = match periodic.len() {
+        0 => "particles leaving it are removed".to_string(),
+        3 => "periodic along x, y and z: nothing leaves it".to_string(),
+        _ => format!(
+            "periodic along {}: particles leaving it across another side are removed",
+            periodic.join(" and ")
+        ),
+    };
+    let mut lines = format!(
+        "domain                 {} .. {} ({leaving})\n",
+        d.min, d.max
+    );
+    if let Some((velocity, axis, gradient)) = s.lees_edwards {
+        lines += &format!(
+            "Lees-Edwards           the images across the {g} sides move at {velocity} m/s along {a} (shear rate {:.6e}/s)\n",
+            velocity / (d.max[gradient] - d.min[gradient]),
+            g = AXES[gradient],
+            a = AXES[axis],
+        );
+    }
+    let removed =
+        |x: &DVec3| (0..3).any(|a| !s.periodic[a] && (x[a] < d.min[a] || x[a] > d.max[a]));
+    let outside = sim.particles.x.iter().filter(|x| removed(x)).count();
+    if outside > 0 {
+        lines += &format!(
+            "                       warning: {outside} initial particles lie outside it and are removed at the first step\n"
+        );
+    }
+    lines
+}
+
+/// Where particles come from: the `[[spawn]]` regions, or the spawn box.
+fn spawn_lines(s: &Scenario) -> String {
+    let most = s.simulation.max_particles;
+    if s.simulation.spawn_attempts == 0 || most == 0 {
+        return format!("{:<23}none\n", "spawning");
+    }
+    if s.spawn.is_empty() {
+        let g = &s.geometry;
+        return format!(
+            "spawning               the spawn box {} .. {}, up to {most} particles, R uniform in [{}, {}]\n",
+            g.spawn_min, g.spawn_max, g.radius_min, g.radius_max
+        );
+    }
+    let mut lines = String::new();
+    for (k, r) in s.spawn.iter().enumerate() {
+        let amount = match (r.count, r.rate) {
+            (Some(n), Some(q)) => format!("{n} particles at {q}/s"),
+            (Some(n), None) => format!("{n} particles"),
+            (None, Some(q)) => format!("{q} particles/s"),
+            (None, None) => "particles".to_string(),
+        };
+        let window = match (r.start, r.stop) {
+            (a, b) if a == 0.0 && b == f64::INFINITY => String::new(),
+            (a, b) => format!(", from t = {a} to {b} s"),
+        };
+        lines += &format!(
+            "{:<23}{} .. {}: {amount}{window}, R {}\n",
+            format!("spawn region {}", k + 1),
+            r.region.min,
+            r.region.max,
+            radius_words(&r.radius)
+        );
+    }
+    lines + &format!("                       in all at most {most} particles (max_particles)\n")
+}
+
+/// A radius distribution in words.
+fn radius_words(r: &crate::scenario::RadiusDistribution) -> String {
+    use crate::scenario::RadiusDistribution::*;
+    match r {
+        Uniform { min, max } => format!("uniform in [{min}, {max}]"),
+        Normal {
+            mean,
+            std,
+            min,
+            max,
+        } => format!("normal ({mean} +- {std}) in [{min}, {max}]"),
+        LogNormal {
+            mean,
+            std,
+            min,
+            max,
+        } => {
+            format!("log-normal ({mean} +- {std}) in [{min}, {max}]")
+        }
+        Table { radii, weights } => format!("from {radii:?} weighted {weights:?}"),
+    }
 }
 
 /// The materials and the coefficients of each pair of them (where named).
