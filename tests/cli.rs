@@ -255,6 +255,34 @@ fn check_names_periodic_sides_shear_and_spawn_regions_and_warns_only_of_real_rem
 }
 
 #[test]
+fn a_run_that_would_spawn_in_the_default_box_outside_its_domain_says_how_to_fix_it() {
+    let t = tempfile::tempdir().unwrap();
+    write(
+        t.path(),
+        "s.toml",
+        "[simulation]\nframes = 1\n[domain]\nmin = [-0.2, -0.2, -0.2]\nmax = [0.2, 0.2, 0.35]\n",
+    );
+    for command in ["check", "run"] {
+        let o = tinydem(&[command, "s.toml"], t.path());
+        let err = stderr(&o);
+        assert!(!o.status.success(), "{command}");
+        assert!(
+            err.contains("spawn box [-0.1, -0.1, 0.3] .. [0.1, 0.1, 0.4] must lie inside [domain]")
+                && err.contains("the paper's default, as the scenario names no spawn box: name one, add [[spawn]] regions, or set [simulation] max_particles = 0"),
+            "{command}: {err}"
+        );
+    }
+    // With nothing to spawn, the default box does not matter.
+    write(
+        t.path(),
+        "s.toml",
+        "[simulation]\nframes = 1\nmax_particles = 0\n[domain]\nmin = [-0.2, -0.2, -0.2]\nmax = [0.2, 0.2, 0.35]\n",
+    );
+    let o = tinydem(&["check", "s.toml"], t.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+#[test]
 fn check_says_which_meshes_merge_their_contacts() {
     let t = tempfile::tempdir().unwrap();
     let square = "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n";

@@ -168,3 +168,87 @@ fn a_stage_refuses_particles_of_its_own() {
     let out = common::tinydem(&["run", "next.toml", "--from", "a", "--resume", "b"], d);
     assert!(String::from_utf8_lossy(&out.stderr).contains("cannot be used with"));
 }
+
+/// The number of particles of the last frame of `out` (its `log.csv`).
+fn particles_at_end(out: &Path) -> u64 {
+    let log = read(out.join("log.csv"));
+    let last = log.lines().last().unwrap();
+    last.split(',').nth(3).unwrap().parse().unwrap()
+}
+
+#[test]
+fn a_stage_naming_no_spawn_box_spawns_nothing_even_resumed() {
+    let dir = setup();
+    let d = dir.path();
+    // The fill makes its 300 grains.
+    write(d, "fill.toml", &silo(2, true));
+    run(d, &["run", "fill.toml", "-o", "fill", "-q"]);
+    let filled = particles_at_end(&d.join("fill"));
+    assert_eq!(filled, 300);
+    // The next stage names neither [[spawn]] nor a spawn box: it spawns nothing (it used to
+    // fill up to max_particles = 1000 in the paper's default box), and says so.
+    let next = silo(2, true)
+        .replace(
+            "spawn_min = [-0.05, -0.05, 0.06]\nspawn_max = [0.05, 0.05, 0.14]\n",
+            "",
+        )
+        .replace("max_particles = 300\n", "");
+    write(d, "next.toml", &next);
+    let said = run(d, &["check", "next.toml", "--from", "fill/checkpoint.bin"]);
+    assert!(
+        said.contains("nothing is spawned: the scenario has no [[spawn]] region"),
+        "{said}"
+    );
+    assert!(
+        said.contains("spawning               none (a stage spawns in the spawn box only if"),
+        "{said}"
+    );
+    let said = run(
+        d,
+        &[
+            "run",
+            "next.toml",
+            "--from",
+            "fill/checkpoint.bin",
+            "-o",
+            "next",
+        ],
+    );
+    assert!(said.contains("nothing is spawned"), "{said}");
+    assert!(particles_at_end(&d.join("next")) <= filled);
+    // Resumed for more frames, it still spawns nothing (the checkpoint keeps it).
+    write(
+        d,
+        "next.toml",
+        &next.replace("frames = 2\n", "frames = 4\n"),
+    );
+    run(
+        d,
+        &[
+            "run",
+            "next.toml",
+            "-o",
+            "next",
+            "--resume",
+            "next/checkpoint.bin",
+            "-q",
+        ],
+    );
+    assert!(particles_at_end(&d.join("next")) <= filled);
+    // A stage that names its spawn box spawns in it (with room for 100 more).
+    let more = silo(2, true).replace("max_particles = 300\n", "max_particles = 400\n");
+    write(d, "more.toml", &more);
+    run(
+        d,
+        &[
+            "run",
+            "more.toml",
+            "--from",
+            "fill/checkpoint.bin",
+            "-o",
+            "more",
+            "-q",
+        ],
+    );
+    assert!(particles_at_end(&d.join("more")) > filled);
+}

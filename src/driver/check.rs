@@ -19,6 +19,9 @@ use crate::scenario::{FrictionSprings, MeshInput, Scenario, Target};
 
 /// The derived quantities `tinydem check` prints.
 pub fn describe(s: &Scenario, out: &Path) -> Result<String> {
+    if let Some(why) = s.spawn_box_outside() {
+        anyhow::bail!("{why}");
+    }
     describe_start(s, out, Simulation::new(s.clone())?)
 }
 
@@ -190,7 +193,7 @@ fn bound_lines(s: &Scenario, sim: &Simulation) -> String {
             o.min, o.max
         );
     }
-    bounds += &spawn_lines(s);
+    bounds += &spawn_lines(s, sim.spawner.box_off);
     if s.wall_forces {
         bounds += &format!(
             "wall loads             force and torque on each mesh file, mean per frame ({WALLS})\n"
@@ -240,11 +243,18 @@ fn domain_lines(s: &Scenario, sim: &Simulation) -> String {
     lines
 }
 
-/// Where particles come from: the `[[spawn]]` regions, or the spawn box.
-fn spawn_lines(s: &Scenario) -> String {
+/// Where particles come from: the `[[spawn]]` regions, or the spawn box (unless it is
+/// `box_off`, in a stage that names none).
+fn spawn_lines(s: &Scenario, box_off: bool) -> String {
     let most = s.simulation.max_particles;
     if s.simulation.spawn_attempts == 0 || most == 0 {
         return format!("{:<23}none\n", "spawning");
+    }
+    if s.spawn.is_empty() && box_off {
+        return format!(
+            "{:<23}none (a stage spawns in the spawn box only if its scenario names one)\n",
+            "spawning"
+        );
     }
     if s.spawn.is_empty() {
         let g = &s.geometry;

@@ -491,7 +491,13 @@ pub fn open(
             Simulation::stage(scenario, snapshot)
                 .with_context(|| format!("cannot start a stage from {}", path.display()))
         }
-        (None, None) => Ok((Simulation::new(scenario)?, Vec::new())),
+        (None, None) => {
+            // A fresh run spawns in the default box where a stage would not.
+            if let Some(why) = scenario.spawn_box_outside() {
+                anyhow::bail!("{why}");
+            }
+            Ok((Simulation::new(scenario)?, Vec::new()))
+        }
     }
 }
 

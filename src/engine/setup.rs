@@ -209,6 +209,17 @@ impl Simulation {
         let p = snapshot.particles;
         check_materials(&p, &sim.scenario).map_err(|e| misfit(format!("{e:#}")))?;
         let mut notes = vec![sim.continue_spawner(&snapshot.scenario, snapshot.spawner)?];
+        let g = &sim.scenario.geometry;
+        if sim.scenario.spawn.is_empty()
+            && !g.spawn_box_named
+            && sim.spawner.active(&sim.scenario, 0, 0.0)
+        {
+            sim.spawner.box_off = true;
+            notes.push(
+                "nothing is spawned: the scenario has no [[spawn]] region and names no spawn box"
+                    .into(),
+            );
+        }
         let new_files = sim.walls.signatures();
         let face_history = sim.carried_face_contacts(&snapshot.mesh_files, &snapshot.face_history);
         let dropped = snapshot.face_history.len() - face_history.len();

@@ -24,6 +24,9 @@ pub struct Spawner {
     /// The periodic axes of the domain, as they are now (its shear offset), to test
     /// candidates against the images of particles across the sides.
     pub periodic: Option<Periodic>,
+    /// The spawn box is off: a stage whose scenario has no `[[spawn]]` region and names no
+    /// spawn box spawns nothing (rather than in the paper's default box).
+    pub box_off: bool,
 }
 
 /// How far a `[[spawn]]` region has got: particles inserted, and its pending radius.
@@ -115,6 +118,7 @@ pub struct SpawnerState {
     pub word_pos: u128,
     pub pending_radius: Option<f64>,
     pub regions: Vec<RegionState>,
+    pub box_off: bool,
 }
 
 /// What one insertion draws from and where it puts its particles.
@@ -131,6 +135,7 @@ impl Spawner {
             word_pos: self.rng.get_word_pos(),
             pending_radius: self.pending_radius,
             regions: self.regions.clone(),
+            box_off: self.box_off,
         }
     }
 
@@ -140,6 +145,7 @@ impl Spawner {
         s.rng.set_word_pos(state.word_pos);
         s.pending_radius = state.pending_radius;
         s.regions = state.regions;
+        s.box_off = state.box_off;
         s
     }
 
@@ -149,6 +155,7 @@ impl Spawner {
             pending_radius: None,
             regions: Vec::new(),
             periodic: None,
+            box_off: false,
         }
     }
 
@@ -163,7 +170,7 @@ impl Spawner {
             return false;
         }
         if s.spawn.is_empty() {
-            return true;
+            return !self.box_off;
         }
         s.spawn.iter().enumerate().any(|(k, r)| {
             let inserted = self.regions.get(k).map_or(0, |st| st.inserted);
@@ -176,6 +183,9 @@ impl Spawner {
     /// spawn box tries until `N_max`).
     pub fn finished(&self, s: &Scenario, next_id: u32, t: f64) -> bool {
         if s.simulation.spawn_attempts == 0 || next_id as u64 >= s.simulation.max_particles {
+            return true;
+        }
+        if s.spawn.is_empty() && self.box_off {
             return true;
         }
         !s.spawn.is_empty()
@@ -219,7 +229,8 @@ impl Spawner {
         let g = &s.geometry;
         let max = s.simulation.max_particles;
         let attempts = s.simulation.spawn_attempts;
-        if attempts == 0 || particles.next_id as u64 >= max {
+        if attempts == 0 || particles.next_id as u64 >= max || (s.spawn.is_empty() && self.box_off)
+        {
             return 0;
         }
         if s.spawn.is_empty() {

@@ -94,6 +94,8 @@ pub struct Geometry {
     /// s_min, s_max \[L\]: the spawn box.
     pub spawn_min: DVec3,
     pub spawn_max: DVec3,
+    /// Whether the scenario names the spawn box (a stage spawns in it only then).
+    pub spawn_box_named: bool,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -487,6 +489,14 @@ impl Scenario {
     /// `[material]`.
     pub fn uses_materials(&self) -> bool {
         self.materials.len() > 1 || self.materials[0].name != "default"
+    }
+
+    /// Why a run of this scenario that spawns in the spawn box cannot (see `box_outside`).
+    pub fn spawn_box_outside(&self) -> Option<String> {
+        if !self.spawn.is_empty() {
+            return None;
+        }
+        spawn::box_outside(&self.geometry, &self.simulation, self.domain)
     }
 
     /// The time step of Eq. (50) for the stiffest, lightest of the materials.

@@ -49,8 +49,10 @@ impl Scenario {
         if self.uses_materials() {
             let _ = writeln!(o, "mesh_material = {}", self.material_name(g.mesh_material));
         }
-        let _ = writeln!(o, "spawn_min = {}", vec3(g.spawn_min));
-        let _ = writeln!(o, "spawn_max = {}", vec3(g.spawn_max));
+        if g.spawn_box_named {
+            let _ = writeln!(o, "spawn_min = {}", vec3(g.spawn_min));
+            let _ = writeln!(o, "spawn_max = {}", vec3(g.spawn_max));
+        }
     }
 
     fn materials_toml(&self, o: &mut String) {

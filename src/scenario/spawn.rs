@@ -19,7 +19,6 @@ pub(super) fn spawn(
     domain: Option<Region>,
 ) -> Result<Vec<SpawnRegion>> {
     let (radius_min, radius_max) = (geometry.radius_min, geometry.radius_max);
-    let (spawn_min, spawn_max) = (geometry.spawn_min, geometry.spawn_max);
     let spawn = raw
         .into_iter()
         .enumerate()
@@ -47,20 +46,38 @@ pub(super) fn spawn(
             );
         }
     }
-    if let Some(d) = domain
-        && spawn.is_empty()
-        && simulation.max_particles > 0
-        && simulation.spawn_attempts > 0
-        && !(d.contains(spawn_min) && d.contains(spawn_max))
+    if geometry.spawn_box_named
+        && let Some(why) = box_outside(geometry, simulation, domain)
     {
-        bail!(
-            "[geometry] spawn box {spawn_min} .. {spawn_max} must lie inside [domain] {} .. {} \
-             (particles spawned outside it would be removed at once)",
-            d.min,
-            d.max
-        );
+        bail!("{why}");
     }
     Ok(spawn)
+}
+
+/// Why the spawn box (with no `[[spawn]]` regions) cannot be spawned in: it reaches out of
+/// the domain (a named box is refused at once; the default one only by a run that would
+/// spawn in it, not by a stage, which spawns in no box it does not name).
+pub(super) fn box_outside(
+    g: &Geometry,
+    simulation: &SimulationTable,
+    domain: Option<Region>,
+) -> Option<String> {
+    let d = domain?;
+    let spawning = simulation.max_particles > 0 && simulation.spawn_attempts > 0;
+    if !spawning || d.contains(g.spawn_min) && d.contains(g.spawn_max) {
+        return None;
+    }
+    let default = if g.spawn_box_named {
+        ""
+    } else {
+        " (the paper's default, as the scenario names no spawn box: name one, add [[spawn]] \
+         regions, or set [simulation] max_particles = 0)"
+    };
+    Some(format!(
+        "[geometry] spawn box {} .. {} must lie inside [domain] {} .. {} (particles spawned \
+         outside it would be removed at once){default}",
+        g.spawn_min, g.spawn_max, d.min, d.max
+    ))
 }
 
 /// Validates one `[[spawn]]` region: `index` finds a material by name, `velocity` is the

@@ -255,6 +255,7 @@ fn geometry(g: RawGeometry, base: &Path) -> Result<Geometry> {
             Range::NonNegative,
         )?;
     }
+    let spawn_box_named = g.spawn_min.is_some() || g.spawn_max.is_some();
     let spawn_min = check_vec(
         "[geometry] spawn_min",
         g.spawn_min.unwrap_or([-0.1, -0.1, 0.3]),
@@ -281,6 +282,7 @@ fn geometry(g: RawGeometry, base: &Path) -> Result<Geometry> {
         mesh_material: 0,
         spawn_min,
         spawn_max,
+        spawn_box_named,
     })
 }
 

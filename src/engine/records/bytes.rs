@@ -11,7 +11,7 @@
 //! rebuild: count (u64) and per entry storage index (u32) and allowance (f64); then the particle-pair and particle-face histories: count (u64) and per
 //! entry the ids (lower, higher) or the id and face (u32, u32) and the springs u_s, u_r (3 f64
 //! each), u_t (f64); from format 3 the removed particles, wall sums, scenario, mesh files and
-//! spawn regions (`Cursor::rest`); from format 4 the servos' states (count, and per servo its
+//! spawn regions (`Cursor::rest`); from format 4 whether the spawn box is off (u8) and the servos' states (count, and per servo its
 //! mesh file (u32), position, speed, position at the last rebuild and last load (4 f64)); last a CRC-32
 //! of everything before it.
 //!
@@ -69,6 +69,7 @@ fn encoded_size(s: &Snapshot) -> usize {
         + 48 * s.wall_sums.len()
         + 16 * s.removed.outlets.len()
         + 17 * s.spawner.regions.len()
+        + 1
         + 36 * s.servos.len()
 }
 
@@ -141,6 +142,7 @@ pub fn encode_into(out: &mut Vec<u8>, snapshot: &Snapshot, fingerprint: u64) {
         out.push(r.pending_radius.is_some() as u8);
         put_f64s(out, &[r.pending_radius.unwrap_or(0.0)]);
     }
+    out.push(snapshot.spawner.box_off as u8);
     out.extend_from_slice(&(snapshot.servos.len() as u64).to_le_bytes());
     for (file, s) in &snapshot.servos {
         out.extend_from_slice(&file.to_le_bytes());
@@ -274,7 +276,9 @@ pub fn decode(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<Snapsho
     let pair_history = r.history()?;
     let face_history = r.history()?;
     let mut rest = if v3 { r.rest()? } else { Rest::default() };
+    let mut box_off = false;
     if version >= 4 {
+        box_off = r.u8()? != 0;
         rest.servos = r.servos(rest.mesh_files.len())?;
     }
     if r.at != r.bytes.len() {
@@ -291,6 +295,7 @@ pub fn decode(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<Snapsho
             word_pos,
             pending_radius: has_pending.then_some(pending),
             regions: rest.regions,
+            box_off,
         },
         anchors,
         lonely,

@@ -135,6 +135,7 @@ mod tests {
                         pending_radius: Some(0.003),
                     },
                 ],
+                box_off: true,
             },
             anchors: vec![DVec3::new(0.1, 0.2, 0.2999)],
             lonely: vec![(0, 0.25)],
@@ -204,12 +205,13 @@ mod tests {
         (s.removed, s.wall_sums) = (Removed::default(), Vec::new());
         (s.scenario, s.mesh_files) = (String::new(), Vec::new());
         (s.spawner.regions, s.servos) = (Vec::new(), Vec::new());
+        s.spawner.box_off = false;
         let v4 = encode(&s, 7);
         let body = &v4[..v4.len() - 4];
         // The one particle's record starts at byte 77 (after the header and the count); its
         // material is the last 2 of its 122 bytes; the counts of removals, loads, scenario,
-        // mesh files, spawn regions and servos end the body.
-        let mut v2 = [&body[..77 + 120], &body[77 + 122..body.len() - 64]].concat();
+        // mesh files, spawn regions, the spawn box's flag and servos end the body.
+        let mut v2 = [&body[..77 + 120], &body[77 + 122..body.len() - 65]].concat();
         v2[12..16].copy_from_slice(&2u32.to_le_bytes());
         let crc = crc32fast::hash(&v2);
         v2.extend_from_slice(&crc.to_le_bytes());
@@ -219,10 +221,10 @@ mod tests {
     #[test]
     fn version_3_is_read_without_servos() {
         let mut s = snapshot();
-        s.servos = Vec::new();
+        (s.servos, s.spawner.box_off) = (Vec::new(), false);
         let v4 = encode(&s, 7);
-        // Format 3 ends before the count of servos.
-        let mut v3 = v4[..v4.len() - 4 - 8].to_vec();
+        // Format 3 ends before the spawn box's flag and the count of servos.
+        let mut v3 = v4[..v4.len() - 4 - 9].to_vec();
         v3[12..16].copy_from_slice(&3u32.to_le_bytes());
         let crc = crc32fast::hash(&v3);
         v3.extend_from_slice(&crc.to_le_bytes());
