@@ -790,6 +790,23 @@ fn output_of_another_run_is_not_mixed_in() {
     let o = tinydem(&["run", "short.toml", "-q"], t.path());
     fails_with(&o, &["holds the output of an earlier run", "--overwrite"]);
     std::fs::write(t.path().join("output/notes.txt"), "mine").unwrap();
+    // What the tools made of the first run goes with it too (a stale animation.gif stayed).
+    let o = tinydem(
+        &[
+            "render", "output", "--gif", "--width", "160", "--height", "120",
+        ],
+        t.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let made = [
+        "animation.gif",
+        "particles000003.png",
+        "fields_mean.vti",
+        "fields000003.csv",
+    ];
+    for name in &made[2..] {
+        std::fs::write(t.path().join("output").join(name), "derived").unwrap();
+    }
     let o = tinydem(&["run", "short.toml", "-q", "--overwrite"], t.path());
     assert!(o.status.success(), "{}", stderr(&o));
     let out = t.path().join("output");
@@ -798,6 +815,9 @@ fn output_of_another_run_is_not_mixed_in() {
         !out.join("particles000003.csv").exists(),
         "frames of the first run are gone"
     );
+    for name in made {
+        assert!(!out.join(name).exists(), "{name} of the first run stayed");
+    }
     assert!(out.join("notes.txt").exists(), "other files stay");
     assert!(
         !out.join(".tinydem.lock").exists(),

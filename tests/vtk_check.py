@@ -17,6 +17,10 @@ checks = {
 }
 tags = col("tag").reshape(-1) if "tag" in rows[0] else np.zeros(len(rows))
 checks["tag"] = (m.point_data["tag"].reshape(-1).astype(float), tags)
+materials = col("material").reshape(-1) if "material" in rows[0] else np.zeros(len(rows))
+checks["material"] = (m.point_data["material"].reshape(-1).astype(float), materials)
+if "id" in rows[0]:
+    checks["id"] = (m.point_data["id"].reshape(-1).astype(float), col("id").reshape(-1))
 assert len(rows) > 0, "empty frame"
 for name, (vtk, ref) in checks.items():
     assert vtk.shape == ref.shape, (name, vtk.shape, ref.shape)

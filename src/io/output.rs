@@ -58,7 +58,9 @@ pub fn take_output(dir: &Path) -> Result<Lock> {
     Ok(lock)
 }
 
-/// Whether a file name is output a run writes (frames, logs, checkpoints, its scenario).
+/// Whether a file name is output a run writes (frames, logs, checkpoints, its scenario), or
+/// what the tools make of it beside its frames (pictures and animations, fields), which a
+/// new run into the directory would leave stale.
 pub fn is_run_output(name: &str) -> bool {
     let frame = |prefix: &str| {
         name.strip_prefix(prefix).is_some_and(|rest| {
@@ -70,6 +72,7 @@ pub fn is_run_output(name: &str) -> bool {
         || checkpoint::is_part(name)
         || frame("contacts")
         || frame("mesh")
+        || frame("fields")
         || [
             RUN_TOML,
             FRAMES,
@@ -83,6 +86,10 @@ pub fn is_run_output(name: &str) -> bool {
             "particles.pvd",
             "mesh.pvd",
             "contacts.pvd",
+            "animation.gif",
+            "animation.mp4",
+            "fields_mean.vti",
+            "fields_mean.csv",
         ]
         .contains(&name)
 }

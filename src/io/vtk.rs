@@ -2,8 +2,9 @@
 //! data, and a `.pvd` collection that lists the frames with their times.
 //!
 //! Particles are points with one vertex cell each and the point arrays `radius`,
-//! `velocity`, `angular_velocity`, `orientation` (the quaternion q0, q1, q2, q3) and `tag`; the mesh
-//! is its faces (vertex, line, triangle and quad cells) with the cell array `radius`.
+//! `velocity`, `angular_velocity`, `orientation` (the quaternion q0, q1, q2, q3), `tag`,
+//! `id` and `material` (its index in the scenario's materials); the mesh is its faces
+//! (vertex, line, triangle and quad cells) with the cell array `radius`.
 
 use std::io::Write;
 use std::path::Path;
@@ -231,6 +232,13 @@ pub fn write_particles(path: &Path, p: &Particles) -> Result<()> {
         by_id().flat_map(|i| [p.q[i].w, p.q[i].x, p.q[i].y, p.q[i].z]),
     );
     v.array(PointData, "tag", 1, n, by_id().map(|i| p.tag[i]));
+    v.array(
+        PointData,
+        "material",
+        1,
+        n,
+        by_id().map(|i| p.material[i] as u32),
+    );
     v.vectors(Points, "points", n, by_id().map(|i| p.x[i]));
     v.array(Cells, "connectivity", 1, n, 0..n as i64);
     v.array(Cells, "offsets", 1, n, 1..=n as i64);
