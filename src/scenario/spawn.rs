@@ -177,14 +177,32 @@ impl Radii<'_> {
         Ok((min, max))
     }
 
-    /// The `mean` and `std` of a distribution truncated to [`min`, `max`].
-    fn spread(&self, mean: f64, std: f64, (min, max): (f64, f64)) -> Result<(f64, f64)> {
+    /// The `mean` and `std` of a distribution (of the radius, or `log`-normal) truncated to
+    /// [`min`, `max`], which must hold at least 1 % of it: the sampler draws again outside
+    /// and gives up after 1,000 draws (at 1 % that happens once in about 20,000 radii).
+    fn spread(&self, mean: f64, std: f64, (min, max): (f64, f64), log: bool) -> Result<(f64, f64)> {
         let mean = check(&self.k("radius.mean"), mean, Range::Positive)?;
         let std = check(&self.k("radius.std"), std, Range::NonNegative)?;
         if std == 0.0 && (mean < min || mean > max) {
             bail!(
                 "{} = {mean} must lie within [{min}, {max}]",
                 self.k("radius.mean")
+            );
+        }
+        let inside = if std == 0.0 {
+            1.0
+        } else if log {
+            // ln R ~ N(mu, sigma^2) with the mean and deviation of R.
+            let sigma = (1.0 + (std / mean).powi(2)).ln().sqrt();
+            let mu = mean.ln() - 0.5 * sigma * sigma;
+            normal_cdf((max.ln() - mu) / sigma) - normal_cdf((min.ln() - mu) / sigma)
+        } else {
+            normal_cdf((max - mean) / std) - normal_cdf((min - mean) / std)
+        };
+        if inside < 0.01 {
+            bail!(
+                "{}: the distribution (mean {mean}, std {std}) puts only {inside:.1e} of its radii within [{min}, {max}], where they are drawn; move the mean or widen the bounds",
+                self.k("radius")
             );
         }
         Ok((mean, std))
@@ -239,7 +257,7 @@ impl Radii<'_> {
                 max,
             }) => {
                 let (min, max) = self.bounds(min, max)?;
-                let (mean, std) = self.spread(mean, std, (min, max))?;
+                let (mean, std) = self.spread(mean, std, (min, max), false)?;
                 RadiusDistribution::Normal {
                     mean,
                     std,
@@ -254,7 +272,7 @@ impl Radii<'_> {
                 max,
             }) => {
                 let (min, max) = self.bounds(min, max)?;
-                let (mean, std) = self.spread(mean, std, (min, max))?;
+                let (mean, std) = self.spread(mean, std, (min, max), true)?;
                 RadiusDistribution::LogNormal {
                     mean,
                     std,
@@ -264,5 +282,39 @@ impl Radii<'_> {
             }
             Some(RawRadius::Table { radii, weights }) => self.table(radii, weights)?,
         })
+    }
+}
+
+/// The standard normal distribution function, to 1.5e-7 (Abramowitz & Stegun 7.1.26 for
+/// erf).
+fn normal_cdf(x: f64) -> f64 {
+    let z = x.abs() / std::f64::consts::SQRT_2;
+    let t = 1.0 / (1.0 + 0.327_591_1 * z);
+    let poly = t
+        * (0.254_829_592
+            + t * (-0.284_496_736
+                + t * (1.421_413_741 + t * (-1.453_152_027 + t * 1.061_405_429))));
+    let erf = 1.0 - poly * (-z * z).exp();
+    if x >= 0.0 {
+        0.5 * (1.0 + erf)
+    } else {
+        0.5 * (1.0 - erf)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::normal_cdf;
+
+    #[test]
+    fn the_normal_distribution_function_has_its_known_values() {
+        for (x, p) in [
+            (0.0, 0.5),
+            (1.0, 0.841_344_746),
+            (-1.96, 0.024_997_895),
+            (3.0, 0.998_650_102),
+        ] {
+            assert!((normal_cdf(x) - p).abs() < 2e-7, "{x}: {}", normal_cdf(x));
+        }
     }
 }
