@@ -114,6 +114,30 @@ fn malformed_csv_files() {
             format!("{HEADER}0,0,0.1,-0.005,0,0,0,1,0,0,0,0,0,0\n"),
             &["p.csv:2", "radius R = -0.005 must be > 0"],
         ),
+        // Radii far from the scenario's [R_min, R_max] = [0.002, 0.01] (Table 2).
+        (
+            format!("{HEADER}{row}0,0,0.1,5.0,0,0,0,1,0,0,0,0,0,0\n"),
+            &[
+                "p.csv:3",
+                "radius R = 5 is more than 64 times [geometry] radius_max = 0.01",
+            ],
+        ),
+        (
+            format!("{HEADER}0,0,0.1,0.0005,0,0,0,1,0,0,0,0,0,0\n"),
+            &[
+                "p.csv:2",
+                "radius R = 0.0005 is below half [geometry] radius_min = 0.002",
+            ],
+        ),
+        (
+            "x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz,material\n\
+             0,0,0.1,0.005,0,0,0,1,0,0,0,0,0,0,0\n0,0,0.2,0.005,0,0,0,1,0,0,0,0,0,0,3\n"
+                .to_string(),
+            &[
+                "p.csv:3",
+                "material 3, but the scenario has 1 material (0 to 0)",
+            ],
+        ),
         (
             format!("{HEADER}{row}0,0,nan,0.005,0,0,0,1,0,0,0,0,0,0\n"),
             &["p.csv:3", "finite"],

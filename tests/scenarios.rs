@@ -132,7 +132,7 @@ fn particles_of_a_material_the_scenario_lacks_are_refused() {
             .unwrap()
     );
     assert!(
-        err.contains("particle 0 has material 2, but the scenario has 1 material (0 to 0)"),
+        err.contains("p.csv:2: material 2, but the scenario has 1 material (0 to 0)"),
         "{err}"
     );
 }

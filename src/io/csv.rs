@@ -332,7 +332,61 @@ fn keep_ids(particles: &mut Particles, ids: Vec<u32>, file: &str) -> Result<()> 
 /// Reads particles from CSV text. The header names the 14 columns (in any order); every
 /// value must be a finite number, every radius positive, every quaternion non-zero (it
 /// is normalised).
+/// What a scenario allows of the particles of its input file (`[input] particles`): their
+/// materials, and radii from half R_min (a shorter contact than Eq. 50's step resolves) to
+/// 64 R_max (the most the exact load sums hold).
+#[derive(Clone, Copy, Debug)]
+pub struct Limits {
+    pub materials: usize,
+    pub radius_min: f64,
+    pub radius_max: f64,
+}
+
+impl Limits {
+    /// What is wrong with particle `p` on line `n` of `file`, if anything.
+    fn check(&self, p: &Particle, n: usize, file: &str) -> Result<()> {
+        let (count, m) = (self.materials, p.material as usize);
+        if m >= count {
+            bail!(
+                "{file}:{n}: material {m}, but the scenario has {count} material{} (0 to {})",
+                if count == 1 { "" } else { "s" },
+                count - 1
+            );
+        }
+        if p.radius > 64.0 * self.radius_max {
+            bail!(
+                "{file}:{n}: radius R = {} is more than 64 times [geometry] radius_max = {}, the most the load sums hold: raise radius_max",
+                p.radius,
+                self.radius_max
+            );
+        }
+        if p.radius < 0.5 * self.radius_min {
+            bail!(
+                "{file}:{n}: radius R = {} is below half [geometry] radius_min = {}: the time step (Eq. 50, of R_min) is too long for it; lower radius_min",
+                p.radius,
+                self.radius_min
+            );
+        }
+        Ok(())
+    }
+}
+
+/// Reads particles in the CSV format of the frames, each within `limits` (a scenario's).
+pub fn load_particles_within(path: &Path, limits: &Limits) -> Result<Particles> {
+    let f = crate::io::files::open(path)
+        .with_context(|| format!("cannot read particle file {}", path.display()))?;
+    read_particles_within(f, &path.display().to_string(), Some(limits))
+}
+
 pub fn read_particles(input: impl Read, file: &str) -> Result<Particles> {
+    read_particles_within(input, file, None)
+}
+
+fn read_particles_within(
+    input: impl Read,
+    file: &str,
+    limits: Option<&Limits>,
+) -> Result<Particles> {
     let mut lines = BufReader::with_capacity(1 << 16, input);
     let mut header = String::new();
     if lines
@@ -364,7 +418,11 @@ pub fn read_particles(input: impl Read, file: &str) -> Result<Particles> {
             continue;
         }
         let (values, ints) = columns.row(line, n, file)?;
-        particles.push(particle(values, ints, n, file)?);
+        let p = particle(values, ints, n, file)?;
+        if let Some(limits) = limits {
+            limits.check(&p, n, file)?;
+        }
+        particles.push(p);
         if columns.int_column[1].is_some() {
             ids.push(ints[1]);
         }

@@ -68,7 +68,15 @@ pub fn meshes(scenario: &Scenario) -> Result<Vec<(Mesh, String)>> {
 pub fn read(scenario: &Scenario) -> Result<Inputs> {
     let meshes = meshes(scenario)?;
     let particles = match &scenario.particles {
-        Some(path) => csv::load_particles(path)?,
+        Some(path) => {
+            let g = &scenario.geometry;
+            let limits = csv::Limits {
+                materials: scenario.materials.len(),
+                radius_min: g.radius_min,
+                radius_max: g.radius_max,
+            };
+            csv::load_particles_within(path, &limits)?
+        }
         None => Particles::default(),
     };
     Ok(Inputs { meshes, particles })
