@@ -8,7 +8,7 @@ use std::sync::atomic::Ordering;
 
 use glam::{DQuat, DVec3};
 use numpy::ndarray::{Array1, Array2};
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
+use numpy::{AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArrayLike1, PyArrayLike2};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -19,7 +19,32 @@ use tinydem::scenario::Scenario;
 
 /// An error of the engine as a Python exception, with its whole chain of causes.
 fn error(e: anyhow::Error) -> PyErr {
-    PyRuntimeError::new_err(format!("{e:#}"))
+    PyRuntimeError::new_err(pythonic(&format!("{e:#}")))
+}
+
+/// A message of the engine with the command line's options named as Python's arguments.
+fn pythonic(message: &str) -> String {
+    [
+        (
+            "pass --overwrite to replace it",
+            "pass overwrite=True to replace it",
+        ),
+        (
+            "--resume to continue it",
+            "resume=its checkpoint to continue it",
+        ),
+        ("or --output another directory", "or another output="),
+        (
+            "(run with --force to run it anyway)",
+            "(pass force=True to run it anyway)",
+        ),
+        ("continue with --resume", "continue with resume="),
+        (" --output ", " output="),
+    ]
+    .iter()
+    .fold(message.to_string(), |m, (cli, python)| {
+        m.replace(cli, python)
+    })
 }
 
 /// A thread pool of `threads` workers (None: all cores).
@@ -58,17 +83,21 @@ fn guarded<T>(f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
 
 /// A simulation of a scenario file, stepped from Python.
 ///
-/// Simulation(scenario, threads=None, resume=None, from_checkpoint=None)
+/// Simulation(scenario, threads=None, resume=None, from_checkpoint=None, force=False)
 ///
 /// `scenario` is a scenario TOML file (or a `run.toml` of an output directory). `threads`
 /// is the number of worker threads (default: all cores; results are the same for any
 /// number). `resume` continues an interrupted run of the same scenario from its checkpoint;
-/// `from_checkpoint` starts a new stage from another run's checkpoint. Stepping gives
-/// bitwise the states of `tinydem run`.
+/// `from_checkpoint` starts a new stage from another run's checkpoint. A time step `tinydem
+/// run` refuses is refused unless `force=True`. Stepping gives bitwise the states of
+/// `tinydem run`; once a step has become unstable, later steps raise its diagnosis unless
+/// `force=True`.
 #[pyclass(module = "tinydem")]
 struct Simulation {
     sim: tinydem::simulation::Simulation,
     pool: Arc<rayon::ThreadPool>,
+    /// The diagnosis of the step that became unstable, if one did.
+    unstable: Option<String>,
 }
 
 impl Simulation {
@@ -91,37 +120,47 @@ impl Simulation {
     }
 
     /// The rows of an (N, 3) array in id order, checked against the particle count.
-    fn rows(&self, name: &str, a: PyReadonlyArray2<f64>) -> PyResult<Vec<(usize, DVec3)>> {
-        let a = a.as_array();
-        let n = self.sim.particles.len();
-        if a.shape() != [n, 3] {
-            return Err(PyValueError::new_err(format!(
-                "{name} must have shape ({n}, 3), not {:?}",
-                a.shape()
-            )));
-        }
-        let rows: Vec<(usize, DVec3)> = self
-            .order()
-            .into_iter()
-            .enumerate()
-            .map(|(k, i)| (i, DVec3::new(a[[k, 0]], a[[k, 1]], a[[k, 2]])))
-            .collect();
-        if rows.iter().any(|(_, v)| !v.is_finite()) {
-            return Err(PyValueError::new_err(format!("{name} must be finite")));
-        }
-        Ok(rows)
+    fn rows(&self, name: &str, a: Vectors) -> PyResult<Vec<(usize, DVec3)>> {
+        let v = vectors(name, a, self.sim.particles.len())?;
+        Ok(self.order().into_iter().zip(v).collect())
     }
+}
+
+/// An array-like of numbers (lists, ints, float32 converted to float64).
+type Vectors<'py> = PyArrayLike2<'py, f64, AllowTypeChange>;
+type Numbers<'py> = PyArrayLike1<'py, f64, AllowTypeChange>;
+
+/// The rows of `a`, an (n, 3) array-like named `name`, finite.
+fn vectors(name: &str, a: Vectors, n: usize) -> PyResult<Vec<DVec3>> {
+    let a = a.as_array();
+    if a.shape() != [n, 3] {
+        return Err(PyValueError::new_err(format!(
+            "{name} must have shape ({n}, 3), not {:?}",
+            a.shape()
+        )));
+    }
+    let rows: Vec<DVec3> = (0..n)
+        .map(|k| DVec3::new(a[[k, 0]], a[[k, 1]], a[[k, 2]]))
+        .collect();
+    if let Some(k) = rows.iter().position(|v| !v.is_finite()) {
+        return Err(PyValueError::new_err(format!(
+            "{name}[{k}] = {} must be finite",
+            rows[k]
+        )));
+    }
+    Ok(rows)
 }
 
 #[pymethods]
 impl Simulation {
     #[new]
-    #[pyo3(signature = (scenario, threads=None, resume=None, from_checkpoint=None))]
+    #[pyo3(signature = (scenario, threads=None, resume=None, from_checkpoint=None, force=false))]
     fn new(
         scenario: PathBuf,
         threads: Option<usize>,
         resume: Option<PathBuf>,
         from_checkpoint: Option<PathBuf>,
+        force: bool,
     ) -> PyResult<Simulation> {
         if resume.is_some() && from_checkpoint.is_some() {
             return Err(PyValueError::new_err(
@@ -130,35 +169,59 @@ impl Simulation {
         }
         let pool = pool(threads)?;
         let s = Scenario::load(&scenario).map_err(error)?;
+        if let Some(why) = tinydem::check::timestep_refusal(&s).filter(|_| !force) {
+            return Err(PyValueError::new_err(format!(
+                "{why} (pass force=True to run it anyway)"
+            )));
+        }
         let (sim, _) = guarded(|| {
             pool.install(|| tinydem::run::open(s, resume.as_deref(), from_checkpoint.as_deref()))
                 .map_err(error)
         })?;
-        Ok(Simulation { sim, pool })
+        Ok(Simulation {
+            sim,
+            pool,
+            unstable: None,
+        })
     }
 
     /// Advances the simulation by `n` time steps (the GIL is released meanwhile; Ctrl-C
     /// stops it between steps, seen within 0.1 s). Raises RuntimeError when the run
-    /// becomes unstable.
-    #[pyo3(signature = (n=1))]
-    fn step(&mut self, py: Python<'_>, n: u64) -> PyResult<()> {
+    /// becomes unstable, and so does every later call, with that diagnosis, unless
+    /// `force=True` (the state is as the failing step left it).
+    #[pyo3(signature = (n=1, force=false))]
+    fn step(&mut self, py: Python<'_>, n: u64, force: bool) -> PyResult<()> {
+        if let Some(why) = self.unstable.as_ref().filter(|_| !force) {
+            return Err(PyRuntimeError::new_err(format!(
+                "{why}\n(this simulation became unstable then; its state is as that step left it: step(force=True) steps on anyway)"
+            )));
+        }
         let mut left = n;
         while left > 0 {
             let (sim, pool) = (&mut self.sim, &self.pool);
             let done = guarded(|| {
-                py.detach(|| {
-                    pool.install(|| {
-                        let start = std::time::Instant::now();
-                        let mut done = 0;
-                        while done < left && (done == 0 || start.elapsed() < SIGNAL_CHECK) {
-                            sim.step()?;
-                            done += 1;
-                        }
-                        Ok::<u64, tinydem::simulation::Unstable>(done)
+                Ok(py
+                    .detach(|| {
+                        pool.install(|| {
+                            let start = std::time::Instant::now();
+                            let mut done = 0;
+                            while done < left && (done == 0 || start.elapsed() < SIGNAL_CHECK) {
+                                sim.step()?;
+                                done += 1;
+                            }
+                            Ok::<u64, tinydem::simulation::Unstable>(done)
+                        })
                     })
-                })
-                .map_err(|e| PyRuntimeError::new_err(e.to_string()))
-            })?;
+                    .map_err(|e| e.to_string()))
+            });
+            let done = match done {
+                Ok(Ok(done)) => done,
+                Ok(Err(why)) => {
+                    self.unstable.get_or_insert(why.clone());
+                    return Err(PyRuntimeError::new_err(why));
+                }
+                Err(e) => return Err(e),
+            };
             left -= done;
             py.check_signals()?;
         }
@@ -194,6 +257,77 @@ impl Simulation {
         self.vectors(py, |i| self.sim.particles.x[i])
     }
 
+    /// Sets the centres (any (N, 3) array-like of numbers); the neighbour lists are made
+    /// anew at the next step.
+    #[setter]
+    fn set_positions(&mut self, x: Vectors) -> PyResult<()> {
+        for (i, x) in self.rows("positions", x)? {
+            self.sim.particles.x[i] = x;
+        }
+        self.sim.particles_moved();
+        Ok(())
+    }
+
+    /// Adds particles at `positions` (N, 3) with `radii` (N,) [m], `velocities` and
+    /// `angular_velocities` (default zero), `material` (an index of the scenario's
+    /// materials) and `tag`; returns their ids (the next ones). Array-likes of numbers.
+    #[pyo3(signature = (positions, radii, velocities=None, angular_velocities=None, material=0, tag=0))]
+    #[allow(clippy::too_many_arguments)] // Python's keyword arguments
+    fn add<'py>(
+        &mut self,
+        py: Python<'py>,
+        positions: Vectors,
+        radii: Numbers,
+        velocities: Option<Vectors>,
+        angular_velocities: Option<Vectors>,
+        material: u16,
+        tag: u32,
+    ) -> PyResult<Bound<'py, PyArray1<i64>>> {
+        let r = radii.as_array().to_vec();
+        let n = r.len();
+        let x = vectors("positions", positions, n)?;
+        let zero = vec![DVec3::ZERO; n];
+        let v = velocities.map_or(Ok(zero.clone()), |v| vectors("velocities", v, n))?;
+        let w = angular_velocities.map_or(Ok(zero), |w| vectors("angular_velocities", w, n))?;
+        if let Some(k) = r.iter().position(|&r| !(r > 0.0 && r.is_finite())) {
+            return Err(PyValueError::new_err(format!(
+                "radii[{k}] = {} must be a finite number > 0",
+                r[k]
+            )));
+        }
+        let new: Vec<tinydem::particles::Particle> = (0..n)
+            .map(|k| tinydem::particles::Particle {
+                x: x[k],
+                radius: r[k],
+                v: v[k],
+                q: DQuat::IDENTITY,
+                w: w[k],
+                tag,
+                material,
+            })
+            .collect();
+        let ids = self
+            .sim
+            .add_particles(&new)
+            .map_err(|e| PyValueError::new_err(format!("material: {e:#}")))?;
+        Ok(Array1::from_iter(ids.into_iter().map(i64::from)).into_pyarray(py))
+    }
+
+    /// Removes the particles of `ids` (an array-like of ids), with the springs of their
+    /// contacts; not counted as removed by an outlet.
+    fn remove(&mut self, ids: PyArrayLike1<'_, i64, AllowTypeChange>) -> PyResult<()> {
+        let ids: Vec<u32> = ids
+            .as_array()
+            .iter()
+            .map(|&id| {
+                u32::try_from(id).map_err(|_| PyValueError::new_err(format!("ids: {id} is no id")))
+            })
+            .collect::<PyResult<_>>()?;
+        self.sim
+            .remove_particles(&ids)
+            .map_err(|e| PyValueError::new_err(format!("ids: {e:#}")))
+    }
+
     /// Velocities [m/s], (N, 3), in id order.
     #[getter]
     fn velocities<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
@@ -201,7 +335,7 @@ impl Simulation {
     }
 
     #[setter]
-    fn set_velocities(&mut self, v: PyReadonlyArray2<f64>) -> PyResult<()> {
+    fn set_velocities(&mut self, v: Vectors) -> PyResult<()> {
         for (i, v) in self.rows("velocities", v)? {
             self.sim.particles.v[i] = v;
         }
@@ -215,7 +349,7 @@ impl Simulation {
     }
 
     #[setter]
-    fn set_angular_velocities(&mut self, w: PyReadonlyArray2<f64>) -> PyResult<()> {
+    fn set_angular_velocities(&mut self, w: Vectors) -> PyResult<()> {
         for (i, w) in self.rows("angular_velocities", w)? {
             self.sim.particles.w[i] = w;
         }

@@ -196,12 +196,100 @@ def test_an_unstable_run_raises(tmp_path):
         "[simulation]\ntimestep = 1e-3\nmax_particles = 0\n"
         '[input]\nparticles = "p.csv"\n'
     )
-    sim = tinydem.Simulation(s)
-    with pytest.raises(RuntimeError, match="unstable"):
-        sim.step(10)
-    # run() refuses that time step unless forced.
-    with pytest.raises(RuntimeError, match="--force"):
+    # As run() does, the constructor refuses that time step unless forced.
+    with pytest.raises(ValueError, match="pass force=True"):
+        tinydem.Simulation(s)
+    with pytest.raises(RuntimeError, match=r"pass force=True to run it anyway\)"):
         tinydem.run(s, output=tmp_path / "out")
+    sim = tinydem.Simulation(s, force=True)
+    with pytest.raises(RuntimeError, match="unstable") as first:
+        sim.step(10)
+    # The simulation is poisoned: a later step raises that diagnosis and does nothing...
+    steps = sim.steps
+    with pytest.raises(RuntimeError, match="became unstable then") as again:
+        sim.step(1)
+    assert str(first.value) in str(again.value) and sim.steps == steps
+    # ...unless forced, when it steps on.
+    try:
+        sim.step(1, force=True)
+    except RuntimeError:
+        pass
+    assert sim.steps == steps + 1
+
+
+def test_setters_take_array_likes_and_positions_can_be_set(study):
+    s, _ = study
+    sim, twin = tinydem.Simulation(s), tinydem.Simulation(s)
+    sim.step(100)
+    twin.step(100)
+    n = len(sim)
+    sim.velocities = [[0.0, 0.0, -1.0]] * n
+    assert np.array_equal(sim.velocities[:, 2], -np.ones(n))
+    sim.angular_velocities = np.ones((n, 3), dtype=np.float32)
+    sim.angular_velocities = np.ones((n, 3), dtype=np.int64)
+    assert sim.angular_velocities.dtype == np.float64
+    # Positions set to where they are: the same run, to the bit (the lists are made anew).
+    twin.positions = twin.positions.tolist()
+    sim.velocities, sim.angular_velocities = twin.velocities, twin.angular_velocities
+    sim.step(100)
+    twin.step(100)
+    assert np.array_equal(sim.positions, twin.positions)
+    # A particle moved: it is where it was put.
+    x = twin.positions
+    x[0] = [0.0, 0.0, 0.35]
+    twin.positions = x
+    assert np.array_equal(twin.positions[0], [0.0, 0.0, 0.35])
+    with pytest.raises(ValueError, match=r"positions\[1\] = .* must be finite"):
+        twin.positions = np.where(np.arange(n)[:, None] == 1, np.nan, x)
+    with pytest.raises(ValueError, match="shape"):
+        twin.positions = x[:-1]
+
+
+def test_add_and_remove_give_the_run_that_had_them_from_the_start(study, tmp_path):
+    """Particles added (or removed) from Python before stepping: the bits of a run that
+    read (or never had) them."""
+    _, out = study
+    rows = (out / "particles000004.csv").read_text().splitlines()
+    header, body = rows[0], rows[1:]
+    frame = tinydem.read_frame(out / "particles000004.csv")
+
+    def sim_of(name, lines):
+        (tmp_path / f"{name}.csv").write_text("\n".join([header] + lines) + "\n")
+        scenario(tmp_path, f'spawn_attempts = 0\n[input]\nparticles = "{name}.csv"\n').rename(
+            tmp_path / f"{name}.toml"
+        )
+        return tinydem.Simulation(tmp_path / f"{name}.toml")
+
+    whole = sim_of("whole", body)
+    added = sim_of("part", body[:-5])
+    ids = added.add(
+        np.c_[frame["x"], frame["y"], frame["z"]][-5:],
+        frame["R"][-5:].tolist(),
+        velocities=np.c_[frame["vx"], frame["vy"], frame["vz"]][-5:],
+        angular_velocities=np.c_[frame["wx"], frame["wy"], frame["wz"]][-5:],
+    )
+    assert list(ids) == list(range(len(body) - 5, len(body)))
+    extra = [line.replace(line.split(",")[2], "0.3", 1) for line in body[:3]]
+    removed = sim_of("more", body + extra)
+    removed.remove([len(body), len(body) + 1, len(body) + 2])
+    assert len(removed) == len(whole) == len(added)
+    for sim in (whole, added, removed):
+        sim.step(200)
+    for sim in (added, removed):
+        assert np.array_equal(sim.positions, whole.positions)
+        assert np.array_equal(sim.velocities, whole.velocities)
+    with pytest.raises(ValueError, match="radii\\[0\\] = -1"):
+        added.add([[0.0, 0.0, 0.3]], [-1.0])
+    with pytest.raises(ValueError, match="ids: there is no particle 99999"):
+        added.remove([99999])
+
+
+def test_errors_name_python_arguments(study, tmp_path):
+    s, _ = study
+    tinydem.run(s, output=tmp_path / "out")
+    with pytest.raises(RuntimeError) as e:
+        tinydem.run(s, output=tmp_path / "out")
+    assert "overwrite=True" in str(e.value) and "--overwrite" not in str(e.value)
 
 
 def test_render_draws_a_directory_and_an_animation(study, tmp_path):

@@ -22,9 +22,11 @@ class Simulation:
         threads: Optional[int] = None,
         resume: Optional[_Path] = None,
         from_checkpoint: Optional[_Path] = None,
+        force: bool = False,
     ) -> None: ...
-    def step(self, n: int = 1) -> None:
-        """Advances by n time steps; RuntimeError when the run becomes unstable."""
+    def step(self, n: int = 1, force: bool = False) -> None:
+        """Advances by n time steps; RuntimeError when the run becomes unstable, and at every
+        later call (with that diagnosis, doing nothing) unless force=True."""
     @property
     def time(self) -> float:
         """Simulated time [s]."""
@@ -37,7 +39,21 @@ class Simulation:
     def __len__(self) -> int: ...
     @property
     def positions(self) -> npt.NDArray[np.float64]:
-        """(N, 3) centres [m]."""
+        """(N, 3) centres [m]; settable with an (N, 3) array-like."""
+    @positions.setter
+    def positions(self, x: npt.ArrayLike) -> None: ...
+    def add(
+        self,
+        positions: npt.ArrayLike,
+        radii: npt.ArrayLike,
+        velocities: Optional[npt.ArrayLike] = None,
+        angular_velocities: Optional[npt.ArrayLike] = None,
+        material: int = 0,
+        tag: int = 0,
+    ) -> npt.NDArray[np.int64]:
+        """Adds particles with the next ids, which it returns."""
+    def remove(self, ids: npt.ArrayLike) -> None:
+        """Removes the particles of these ids."""
     @property
     def velocities(self) -> npt.NDArray[np.float64]:
         """(N, 3) velocities [m/s]; settable with an (N, 3) array."""
@@ -99,3 +115,17 @@ def render(
 ) -> Dict[str, object]:
     """Pictures of a frame or of every frame of a directory in one view and colour range;
     returns {"pictures": [paths], "animation": path or None, "notes": [str]}."""
+
+def fields(
+    directory: _Path,
+    scenario: Optional[_Path] = None,
+    spacing: Optional[float] = None,
+    kernel: str = "gaussian",
+    width: Optional[float] = None,
+    slices: Optional[str] = None,
+    frames: Optional[Tuple[int, int]] = None,
+    average: bool = False,
+    bounds: Optional[Tuple[Tuple[float, float, float], Tuple[float, float, float]]] = None,
+) -> List[Dict[str, object]]:
+    """Coarse-grained density, velocity and stress of a run's frames (as `tinydem analyze
+    --fields`): a dict of numpy arrays per set, also written as fieldsNNNNNN.vti and .csv."""

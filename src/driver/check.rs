@@ -450,17 +450,7 @@ pub fn most_particles(s: &Scenario, initial: usize) -> usize {
 /// Why `run` refuses `s` (with at most `n` particles, into `out`) unless `--force`: a time
 /// step past [`TIMESTEP_TOLERANCE`] times Eq. 50, more output than the free space.
 pub fn refusals(s: &Scenario, n: usize, out: &Path) -> Vec<String> {
-    let mut why = Vec::new();
-    let (dt, eq50) = (s.simulation.timestep, s.eq50_timestep());
-    if dt > TIMESTEP_TOLERANCE * eq50 {
-        why.push(format!(
-            "time step {dt:.3e} s is {:.1} x Eq. 50's {eq50:.3e} s, more than the {TIMESTEP_TOLERANCE} x \
-             a contact tolerates: the run is likely to blow up (leave [simulation] timestep unset, \
-             or set it at most {:.3e} s)",
-            dt / eq50,
-            TIMESTEP_TOLERANCE * eq50
-        ));
-    }
+    let mut why: Vec<String> = timestep_refusal(s).into_iter().collect();
     let need = OutputEstimate::of(s, n, 0).total;
     if let Some(free) = free_space(out)
         && need > free
@@ -519,6 +509,20 @@ pub fn cautions(s: &Scenario) -> Vec<String> {
         }
     }
     why
+}
+
+/// Why the time step is refused: past [`TIMESTEP_TOLERANCE`] times Eq. 50.
+pub fn timestep_refusal(s: &Scenario) -> Option<String> {
+    let (dt, eq50) = (s.simulation.timestep, s.eq50_timestep());
+    (dt > TIMESTEP_TOLERANCE * eq50).then(|| {
+        format!(
+            "time step {dt:.3e} s is {:.1} x Eq. 50's {eq50:.3e} s, more than the {TIMESTEP_TOLERANCE} x \
+             a contact tolerates: the run is likely to blow up (leave [simulation] timestep unset, \
+             or set it at most {:.3e} s)",
+            dt / eq50,
+            TIMESTEP_TOLERANCE * eq50
+        )
+    })
 }
 
 /// The largest the output of a run can grow, in all its formats.

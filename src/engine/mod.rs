@@ -30,6 +30,7 @@ use crate::parallel::domain::Domain;
 
 mod advance;
 mod checks;
+mod edit;
 mod faces;
 mod loads;
 mod pairs;

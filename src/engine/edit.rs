@@ -1,0 +1,65 @@
+//! Changes to a simulation from outside its step (Python's setters, `add`, `remove`): the
+//! particles placed, added or removed between steps, and the lists made to fit.
+
+use super::*;
+
+impl Simulation {
+    /// After particles were moved from outside the step: the lists are made anew at the
+    /// next step (with the springs of the contacts they keep).
+    pub fn particles_moved(&mut self) {
+        self.neighbours.forget_anchors();
+    }
+
+    /// Adds `new` particles with the next ids (returned); the lists take them in at the
+    /// next step. Their materials must be the scenario's.
+    pub fn add_particles(&mut self, new: &[crate::model::particles::Particle]) -> Result<Vec<u32>> {
+        self.refuse_split("add particles")?;
+        let n = self.scenario.materials.len();
+        if let Some(p) = new.iter().find(|p| p.material as usize >= n) {
+            bail!(
+                "material {} is not one of the scenario's {n} (0 to {})",
+                p.material,
+                n - 1
+            );
+        }
+        let first = self.particles.next_id;
+        for p in new {
+            self.particles.push(*p);
+        }
+        self.particles_moved();
+        Ok((first..self.particles.next_id).collect())
+    }
+
+    /// Removes the particles of `ids` (each must be present) and the springs of their
+    /// contacts; the others keep theirs. Not counted as outflow.
+    pub fn remove_particles(&mut self, ids: &[u32]) -> Result<()> {
+        self.refuse_split("remove particles")?;
+        let at: rustc_hash::FxHashMap<u32, u32> = (self.particles.id.iter().enumerate())
+            .map(|(k, &id)| (id, k as u32))
+            .collect();
+        let mut gone = Vec::with_capacity(ids.len());
+        for id in ids {
+            match at.get(id) {
+                Some(&k) => gone.push(k),
+                None => bail!("there is no particle {id}"),
+            }
+        }
+        gone.sort_unstable();
+        gone.dedup();
+        self.neighbours.rebuild_without(
+            &mut self.particles,
+            &gone,
+            &self.walls.mesh.faces,
+            &self.face_grid,
+        );
+        self.built();
+        Ok(())
+    }
+
+    fn refuse_split(&self, what: &str) -> Result<()> {
+        if self.domain.is_some() {
+            bail!("a run split over processes cannot {what} from outside its step");
+        }
+        Ok(())
+    }
+}
