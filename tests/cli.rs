@@ -451,7 +451,14 @@ fn render_draws_frames_and_directories() {
             &["render", "out/particles000004.csv", "--width", "0"],
             t.path(),
         ),
-        &["picture size 0x600"],
+        &["picture size 0x1200"],
+    );
+    fails_with(
+        &tinydem(
+            &["render", "out/particles000004.csv", "--size", "800by600"],
+            t.path(),
+        ),
+        &["\"800by600\" is no WIDTHxHEIGHT"],
     );
 }
 
@@ -466,10 +473,8 @@ fn renders_a_frame(dir: &Path) {
             mesh.to_str().unwrap(),
             "-o",
             "f.png",
-            "--width",
-            "320",
-            "--height",
-            "200",
+            "--size",
+            "320x200",
         ],
         dir,
     );

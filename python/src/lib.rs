@@ -525,7 +525,7 @@ fn run(
 /// or "iso"; range: (lo, hi) of the colour bar; bounds: ((x0, y0, z0), (x1, y1, z1)), the
 /// box to show; scenario: whose meshes to draw (default: the directory's run.toml).
 #[pyfunction]
-#[pyo3(signature = (path, output=None, color="speed", view="iso", width=800, height=600, gif=false, movie=false, range=None, bounds=None, scale_bar=false, scenario=None))]
+#[pyo3(signature = (path, output=None, color="speed", view="iso", width=1600, height=1200, gif=false, movie=false, range=None, bounds=None, scale_bar=false, scenario=None))]
 #[allow(clippy::too_many_arguments)]
 fn render<'py>(
     py: Python<'py>,

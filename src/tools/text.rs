@@ -1,47 +1,85 @@
-//! Text and number labels on pictures (plots, renders): the 8x8 bitmap font of `font8x8`
-//! (ASCII, Latin-1 and Greek, so "µ", "°" and "ω" too), drawn at an integer scale.
+//! Text and number labels on pictures (plots, renders): DejaVu Sans (`assets/fonts`, its
+//! licence beside it), anti-aliased, at a size that `scale` sets as the 8x8 cells of a
+//! bitmap font would be (a line is `LINE` x `scale` pixels).
 
-use font8x8::{BASIC_FONTS, GREEK_FONTS, LATIN_FONTS, UnicodeFonts};
+use std::sync::OnceLock;
+
+use ab_glyph::{Font, FontVec, PxScale, ScaleFont, point};
 use image::{Rgb, RgbImage};
 
-/// Width of a glyph cell at scale 1 [px] (the font's 8, less the blank column most glyphs
-/// end with, so that text does not look spaced out).
-const ADVANCE: i64 = 7;
 /// Height of a line at scale 1 \[px\].
 pub const LINE: i64 = 8;
 
-fn glyph(c: char) -> [u8; 8] {
-    BASIC_FONTS
-        .get(c)
-        .or_else(|| LATIN_FONTS.get(c))
-        .or_else(|| GREEK_FONTS.get(c))
-        .unwrap_or([0; 8])
+/// The font's em at scale 1 \[px\]: its capitals 6.2 px tall, as the bitmap font's were.
+const EM: f32 = 8.5;
+
+/// The font, inflated and parsed on first use.
+fn font() -> &'static FontVec {
+    static FONT: OnceLock<FontVec> = OnceLock::new();
+    FONT.get_or_init(|| {
+        use std::io::Read;
+        let gz: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf.gz");
+        let mut ttf = Vec::with_capacity(800_000);
+        flate2::read::GzDecoder::new(gz)
+            .read_to_end(&mut ttf)
+            .expect("the font built in is gzip");
+        FontVec::try_from_vec(ttf).expect("the font built in is a TrueType font")
+    })
+}
+
+/// Each glyph of `s` at `scale` with its pen position along the line \[px\], and the
+/// line's width.
+fn layout(s: &str, scale: u32) -> (Vec<(ab_glyph::GlyphId, f32)>, f32) {
+    let f = font().as_scaled(PxScale::from(EM * scale as f32));
+    let mut x = 0.0;
+    let mut last = None;
+    let mut glyphs = Vec::with_capacity(s.len());
+    for c in s.chars() {
+        let id = f.glyph_id(c);
+        if let Some(prev) = last {
+            x += f.kern(prev, id);
+        }
+        glyphs.push((id, x));
+        x += f.h_advance(id);
+        last = Some(id);
+    }
+    (glyphs, x)
 }
 
 /// The width of `s` at `scale` \[px\].
 pub fn width(s: &str, scale: u32) -> i64 {
-    s.chars().count() as i64 * ADVANCE * scale as i64
+    layout(s, scale).1.ceil() as i64
 }
 
-/// Draws `s` with its top-left corner at (x, y), each font pixel a `scale` x `scale` block.
+/// Draws `s` with its top-left corner at (x, y): capitals from about y + scale to the
+/// baseline at y + 7.2 scale, anti-aliased over what is there.
 pub fn draw(img: &mut RgbImage, x: i64, y: i64, s: &str, scale: u32, colour: Rgb<u8>) {
-    let k = scale as i64;
-    for (n, c) in s.chars().enumerate() {
-        let rows = glyph(c);
-        let x0 = x + n as i64 * ADVANCE * k;
-        for (r, bits) in rows.iter().enumerate() {
-            for col in 0..8 {
-                // Bit 0 is the leftmost pixel.
-                if bits & (1 << col) == 0 {
-                    continue;
-                }
-                for dy in 0..k {
-                    for dx in 0..k {
-                        put(img, x0 + col * k + dx, y + r as i64 * k + dy, colour);
-                    }
-                }
-            }
-        }
+    let size = PxScale::from(EM * scale as f32);
+    let f = font().as_scaled(size);
+    let baseline = y as f32 + 7.2 * scale as f32;
+    for (id, pen) in layout(s, scale).0 {
+        let glyph = id.with_scale_and_position(size, point(x as f32 + pen, baseline));
+        let Some(outline) = f.outline_glyph(glyph) else {
+            continue;
+        };
+        let b = outline.px_bounds();
+        outline.draw(|gx, gy, coverage| {
+            let (px, py) = (b.min.x as i64 + gx as i64, b.min.y as i64 + gy as i64);
+            blend(img, px, py, colour, coverage);
+        });
+    }
+}
+
+/// Mixes `colour` into the pixel at (x, y) by `coverage` (0 to 1), if it lies in the
+/// picture.
+fn blend(img: &mut RgbImage, x: i64, y: i64, colour: Rgb<u8>, coverage: f32) {
+    if x < 0 || y < 0 || x as u32 >= img.width() || y as u32 >= img.height() {
+        return;
+    }
+    let c = coverage.clamp(0.0, 1.0);
+    let p = img.get_pixel_mut(x as u32, y as u32);
+    for k in 0..3 {
+        p.0[k] = (p.0[k] as f32 * (1.0 - c) + colour.0[k] as f32 * c).round() as u8;
     }
 }
 
@@ -148,11 +186,23 @@ mod tests {
 
     #[test]
     fn text_is_drawn_where_asked() {
-        let mut img = RgbImage::from_pixel(100, 20, Rgb([255, 255, 255]));
+        let mut img = RgbImage::from_pixel(100, 24, Rgb([255, 255, 255]));
         draw(&mut img, 2, 2, "m/s µ", 2, Rgb([0, 0, 0]));
-        let dark = img.pixels().filter(|p| p.0 == [0, 0, 0]).count();
-        assert!(dark > 40, "{dark}");
-        assert_eq!(width("abc", 2), 42);
-        assert!(img.get_pixel(99, 19).0 == [255, 255, 255]);
+        // Anti-aliased: some pixels wholly ink, more partly.
+        let dark = img.pixels().filter(|p| p.0[0] < 128).count();
+        let ink = img.pixels().filter(|p| p.0 == [0, 0, 0]).count();
+        assert!(dark > 40 && ink > 0, "{dark} {ink}");
+        // Within the line: from y to y + LINE x scale, and descenders a little below.
+        let rows: Vec<u32> = img
+            .enumerate_pixels()
+            .filter(|(_, _, p)| p.0[0] < 128)
+            .map(|(_, y, _)| y)
+            .collect();
+        assert!(rows.iter().all(|&y| (2..24).contains(&y)), "{rows:?}");
+        assert!(img.get_pixel(99, 23).0 == [255, 255, 255]);
+        // Widths grow with the text and the scale; an unknown character still advances.
+        let (one, two) = (width("abc", 1), width("abc", 2));
+        assert!(one > 10 && (two - 2 * one).abs() <= 1, "{one} {two}");
+        assert!(width("abcd", 1) > one && width("\u{10FFFF}", 1) >= 0);
     }
 }

@@ -21,9 +21,12 @@ pub struct RenderArgs {
     /// Draw this mesh file (OFF or STL); may be repeated.
     #[arg(long)]
     mesh: Vec<PathBuf>,
-    #[arg(long, default_value_t = 800)]
+    /// The picture's size in pixels, WIDTHxHEIGHT (or --width, --height).
+    #[arg(long, value_name = "WIDTHxHEIGHT", value_parser = size, conflicts_with_all = ["width", "height"])]
+    size: Option<(u32, u32)>,
+    #[arg(long, default_value_t = 1600)]
     width: u32,
-    #[arg(long, default_value_t = 600)]
+    #[arg(long, default_value_t = 1200)]
     height: u32,
     /// Particle colour.
     #[arg(long, value_enum, default_value_t = ColorBy::Speed)]
@@ -53,8 +56,8 @@ impl RenderArgs {
     /// Draws the pictures (and the animation) and says where they are.
     pub fn execute(self) -> Result<()> {
         let style = Style {
-            width: self.width,
-            height: self.height,
+            width: self.size.map_or(self.width, |s| s.0),
+            height: self.size.map_or(self.height, |s| s.1),
             color: self.color,
             view: self.view,
             scale_bar: self.scale_bar,
@@ -112,4 +115,16 @@ fn fixed(range: Option<Vec<f64>>, bounds: Option<Vec<f64>>) -> Result<Fixed> {
         );
     }
     Ok(fixed)
+}
+
+/// `--size WIDTHxHEIGHT`.
+fn size(text: &str) -> Result<(u32, u32), String> {
+    let parse = |t: &str| t.trim().parse::<u32>().ok();
+    match text
+        .split_once(['x', 'X'])
+        .map(|(w, h)| (parse(w), parse(h)))
+    {
+        Some((Some(w), Some(h))) => Ok((w, h)),
+        _ => Err(format!("{text:?} is no WIDTHxHEIGHT, e.g. 1600x1200")),
+    }
 }

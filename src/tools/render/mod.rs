@@ -201,20 +201,22 @@ impl Layout {
         l
     }
 
-    /// Grows the layout to show the frame `p` with `mesh`: the mesh, the particles without
-    /// the farthest half per cent on each side (a few escaped grains should not shrink the
-    /// picture), and the colour values from the 1 % to the 99 % quantile (radii: all, as a
+    /// Grows the layout to show the frame `p` with `mesh`: the particles without the
+    /// farthest half per cent on each side (a few escaped grains should not shrink the
+    /// picture; the mesh where there are none), and the colour values from the 1 % to the 99 % quantile (radii: all, as a
     /// few special particles are the point of such a picture).
     pub fn include(&mut self, p: &Particles, mesh: &Mesh, style: &Style) {
         let cam = camera(style.view);
-        for face in &mesh.faces {
-            for c in face.corners() {
-                let c = cam * c;
-                self.lo = self.lo.min(c - face.radius);
-                self.hi = self.hi.max(c + face.radius);
-            }
-        }
+        // The view is the particles' (a settled bed fills it, not a strip at the bottom of
+        // its container); the mesh's only where there are none.
         if p.is_empty() {
+            for face in &mesh.faces {
+                for c in face.corners() {
+                    let c = cam * c;
+                    self.lo = self.lo.min(c - face.radius);
+                    self.hi = self.hi.max(c + face.radius);
+                }
+            }
             return;
         }
         let r_max = p.max_radius();
