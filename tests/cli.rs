@@ -624,7 +624,7 @@ fn analyze_prints_a_table_and_writes_csv_and_plot() {
             "--plot",
             "a.png",
             "--column",
-            "coordination",
+            "coordination,packing_fraction",
         ],
         t.path(),
     );
@@ -655,8 +655,61 @@ fn analyze_prints_a_table_and_writes_csv_and_plot() {
             &["analyze", "out", "--plot", "b.png", "--column", "nope"],
             t.path(),
         ),
-        &["--column nope"],
+        &["no column \"nope\" (the columns: frame, time,"],
     );
+    plots_the_log(t.path());
+}
+
+/// `tinydem plot` of the run's log: two columns on a log axis as SVG, wall loads of one
+/// mesh as PNG; a missing column or a bad filter is refused.
+fn plots_the_log(dir: &Path) {
+    let o = tinydem(
+        &[
+            "plot",
+            "out/log.csv",
+            "-y",
+            "kinetic_energy,rotational_energy",
+            "--log-y",
+            "-o",
+            "e.svg",
+        ],
+        dir,
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let svg = std::fs::read_to_string(dir.join("e.svg")).unwrap();
+    assert!(svg.contains("kinetic_energy [J]") && svg.contains("rotational_energy [J]"));
+    assert!(svg.contains("time [s]"));
+    fails_with(
+        &tinydem(&["plot", "out/log.csv", "-y", "energy"], dir),
+        &["no column \"energy\" (the columns: frame, step, time,"],
+    );
+    fails_with(
+        &tinydem(
+            &["plot", "out/log.csv", "-y", "time", "--where", "frame"],
+            dir,
+        ),
+        &["--where frame: expected COLUMN=NUMBER"],
+    );
+    let o = tinydem(
+        &[
+            "plot",
+            "out/log.csv",
+            "-x",
+            "step",
+            "-y",
+            "particles",
+            "--where",
+            "frame=2",
+            "-o",
+            "p.png",
+            "--plot-size",
+            "400x300",
+        ],
+        dir,
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let img = image::open(dir.join("p.png")).unwrap();
+    assert_eq!((img.width(), img.height()), (400, 300));
 }
 
 /// `analyze --repose`: both flanks with their errors from the resting grains; frames without

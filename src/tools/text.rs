@@ -4,7 +4,7 @@
 
 use std::sync::OnceLock;
 
-use ab_glyph::{Font, FontVec, PxScale, ScaleFont, point};
+use ab_glyph::{Font, FontRef, PxScale, ScaleFont, point};
 use image::{Rgb, RgbImage};
 
 /// Height of a line at scale 1 \[px\].
@@ -13,17 +13,25 @@ pub const LINE: i64 = 8;
 /// The font's em at scale 1 \[px\]: its capitals 6.2 px tall, as the bitmap font's were.
 const EM: f32 = 8.5;
 
-/// The font, inflated and parsed on first use.
-fn font() -> &'static FontVec {
-    static FONT: OnceLock<FontVec> = OnceLock::new();
-    FONT.get_or_init(|| {
+/// The font file, inflated on first use.
+pub fn ttf() -> &'static [u8] {
+    static TTF: OnceLock<Vec<u8>> = OnceLock::new();
+    TTF.get_or_init(|| {
         use std::io::Read;
         let gz: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf.gz");
         let mut ttf = Vec::with_capacity(800_000);
         flate2::read::GzDecoder::new(gz)
             .read_to_end(&mut ttf)
             .expect("the font built in is gzip");
-        FontVec::try_from_vec(ttf).expect("the font built in is a TrueType font")
+        ttf
+    })
+}
+
+/// The font, parsed on first use.
+fn font() -> &'static FontRef<'static> {
+    static FONT: OnceLock<FontRef<'static>> = OnceLock::new();
+    FONT.get_or_init(|| {
+        FontRef::try_from_slice(ttf()).expect("the font built in is a TrueType font")
     })
 }
 

@@ -45,12 +45,15 @@ pub struct AnalyzeArgs {
     /// Also write the table as CSV to this file.
     #[arg(long)]
     csv: Option<PathBuf>,
-    /// Also plot one column against time as a PNG (see --column).
+    /// Also plot columns against time, as SVG if the name ends in .svg, else PNG (see
+    /// --column).
     #[arg(long)]
     plot: Option<PathBuf>,
-    /// The column to plot (a name from the table's header).
-    #[arg(long, default_value = "kinetic_energy")]
-    column: String,
+    /// The columns to plot, comma-separated (names from the table's header).
+    #[arg(long, value_delimiter = ',', default_value = "kinetic_energy")]
+    column: Vec<String>,
+    #[command(flatten)]
+    style: crate::plot::Style,
     #[command(flatten)]
     fields: FieldArgs,
 }
@@ -210,7 +213,10 @@ impl AnalyzeArgs {
             .with_context(|| format!("cannot write {}", path.display()))?;
         }
         if let Some(path) = self.plot {
-            plot(&header, &rows, &path, &self.column)?;
+            let text = format!("{}\n{}\n", header.join(","), rows.join("\n"));
+            let table = tinydem::plot::Table::parse(&text, "the table")?;
+            let y: Vec<&str> = self.column.iter().map(String::as_str).collect();
+            crate::plot::draw(&table, "time", &y, self.style, &path)?;
         }
         Ok(())
     }
@@ -325,42 +331,4 @@ impl Table {
         }
         row
     }
-}
-
-/// Plots `column` of the table (`header`, CSV `rows`) against time into the PNG `path`.
-fn plot(header: &[&str], rows: &[String], path: &Path, column: &str) -> Result<()> {
-    let Some(c) = header.iter().position(|h| *h == column) else {
-        anyhow::bail!(
-            "--column {column}: not a column of this table ({})",
-            header.join(", ")
-        );
-    };
-    let points: Vec<(f64, f64)> = rows
-        .iter()
-        .map(|r| {
-            let v: Vec<&str> = r.split(',').collect();
-            (
-                v[1].parse().unwrap_or(f64::NAN),
-                v[c].parse().unwrap_or(f64::NAN),
-            )
-        })
-        .collect();
-    let unit = match column {
-        "time" => " [s]",
-        "kinetic_energy" => " [J]",
-        "large_mean_height" | "tagged_mean_height" => " [m]",
-        c if c.starts_with("repose_") => " [°]",
-        "coordination" => " [contacts per particle]",
-        _ => "",
-    };
-    let y = format!("{column}{unit}");
-    let axes = tinydem::plot::Axes {
-        x: "time [s]",
-        y: &y,
-    };
-    tinydem::plot::line_plot(&points, 800, 500, &axes)?
-        .save(path)
-        .with_context(|| format!("cannot write {}", path.display()))?;
-    eprintln!("plot of {column} against time in {}", path.display());
-    Ok(())
 }

@@ -3,6 +3,7 @@
 
 mod analyze;
 mod bench;
+mod plot;
 mod render;
 mod run;
 
@@ -52,6 +53,9 @@ enum Command {
     Analyze(analyze::AnalyzeArgs),
     /// Draw a frame (CSV) as a PNG picture, or every frame of an output directory.
     Render(render::RenderArgs),
+    /// Draw columns of a CSV table (log.csv, walls.csv, analyze --csv) against one of them,
+    /// as SVG or PNG: a legend, units, log axes.
+    Plot(plot::PlotArgs),
     /// The dense-packing benchmark of the paper's Section 5: timed steps in settled
     /// packings; each size and thread count runs in its own process.
     Bench(bench::BenchArgs),
@@ -197,6 +201,19 @@ fn execute(
         Some(Command::Bench(args)) => args.execute(world, first),
         Some(Command::Render(args)) => args.execute(),
         Some(Command::Analyze(args)) => args.execute(),
+        Some(Command::Plot(args)) => args.execute(),
         Some(Command::Check(args)) => args.execute(),
+    }
+}
+
+/// `--size WIDTHxHEIGHT`.
+pub(crate) fn size(text: &str) -> Result<(u32, u32), String> {
+    let parse = |t: &str| t.trim().parse::<u32>().ok();
+    match text
+        .split_once(['x', 'X'])
+        .map(|(w, h)| (parse(w), parse(h)))
+    {
+        Some((Some(w), Some(h))) => Ok((w, h)),
+        _ => Err(format!("{text:?} is no WIDTHxHEIGHT, e.g. 1600x1200")),
     }
 }

@@ -22,7 +22,7 @@ pub struct RenderArgs {
     #[arg(long)]
     mesh: Vec<PathBuf>,
     /// The picture's size in pixels, WIDTHxHEIGHT (or --width, --height).
-    #[arg(long, value_name = "WIDTHxHEIGHT", value_parser = size, conflicts_with_all = ["width", "height"])]
+    #[arg(long, value_name = "WIDTHxHEIGHT", value_parser = crate::size, conflicts_with_all = ["width", "height"])]
     size: Option<(u32, u32)>,
     #[arg(long, default_value_t = 1600)]
     width: u32,
@@ -115,16 +115,4 @@ fn fixed(range: Option<Vec<f64>>, bounds: Option<Vec<f64>>) -> Result<Fixed> {
         );
     }
     Ok(fixed)
-}
-
-/// `--size WIDTHxHEIGHT`.
-fn size(text: &str) -> Result<(u32, u32), String> {
-    let parse = |t: &str| t.trim().parse::<u32>().ok();
-    match text
-        .split_once(['x', 'X'])
-        .map(|(w, h)| (parse(w), parse(h)))
-    {
-        Some((Some(w), Some(h))) => Ok((w, h)),
-        _ => Err(format!("{text:?} is no WIDTHxHEIGHT, e.g. 1600x1200")),
-    }
 }
