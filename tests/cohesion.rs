@@ -26,6 +26,7 @@ fn grain(x: DVec3) -> Particle {
         w: DVec3::ZERO,
         tag: 0,
         material: 0,
+        fixed: false,
     }
 }
 

@@ -24,6 +24,7 @@ fn at_rest(x: DVec3, v: DVec3) -> Particle {
         w: DVec3::ZERO,
         tag: 0,
         material: 0,
+        fixed: false,
     }
 }
 

@@ -120,6 +120,7 @@ fn the_kinetic_stress_of_a_gas_is_its_momentum_flux() {
                 w: DVec3::ZERO,
                 tag: 0,
                 material: 0,
+                fixed: false,
             }
         })
         .collect();

@@ -30,6 +30,7 @@ fn grain(x: DVec3, v: DVec3, material: u16) -> Particle {
         w: DVec3::ZERO,
         tag: 0,
         material,
+        fixed: false,
     }
 }
 

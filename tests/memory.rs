@@ -29,6 +29,7 @@ fn pair(speed: f64) -> Simulation {
         w: DVec3::ZERO,
         tag: 0,
         material: 0,
+        fixed: false,
     };
     // Two pairs of neighbours (listed, so not "lonely": each pair's lists are rebuilt every
     // half skin of travel), 1 mm apart within a pair.

@@ -153,6 +153,46 @@ fn a_tumbling_drum_on_1_to_3_processes_writes_the_same_bytes() {
     same_output(&path, &[2, 3]);
 }
 
+/// A bed falling onto a floor of fixed grains (`[[fixed]]`): the flags go to the processes
+/// that own the grains, and the frames carry them, the same on any process count.
+#[test]
+fn a_fixed_floor_on_1_to_3_processes_writes_the_same_bytes() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut csv = String::from("x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz\n");
+    for k in 0..200 {
+        let (i, j, l) = (k % 10, (k / 10) % 10, k / 100);
+        let z = if l == 0 {
+            0.0
+        } else {
+            0.012 + 0.002 * (k % 3) as f64
+        };
+        let x = 0.01 * (i as f64 - 4.5) + if l == 0 { 0.0 } else { 0.003 };
+        let y = 0.01 * (j as f64 - 4.5);
+        csv += &format!("{x},{y},{z},0.005,0,0,0,1,0,0,0,0,0,0\n");
+    }
+    std::fs::write(dir.path().join("bed.csv"), csv).unwrap();
+    let path = dir.path().join("bed.toml");
+    std::fs::write(
+        &path,
+        "[geometry]\nradius_min = 0.004\nradius_max = 0.005\nmesh_radii = [0.0]\n\
+         [material]\nyoungs_modulus = 1e6\nrestitution = 0.3\n\
+         [simulation]\nmax_particles = 0\nspawn_attempts = 0\nframes = 6\nsteps_per_frame = 400\n\
+         [[fixed]]\nmin = [-1.0, -1.0, -0.001]\nmax = [1.0, 1.0, 0.001]\n\
+         [input]\nparticles = \"bed.csv\"\n",
+    )
+    .unwrap();
+    same_output(&path, &[2, 3]);
+    run(
+        2,
+        &["run", path.to_str().unwrap(), "-o", "two", "-q"],
+        dir.path(),
+    );
+    let last = std::fs::read_to_string(dir.path().join("two/particles000006.csv")).unwrap();
+    assert!(last.starts_with("x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz,fixed\n"));
+    let fixed = last.lines().filter(|l| l.ends_with(",1")).count();
+    assert_eq!(fixed, 100);
+}
+
 /// `[simulation] until`: a pour into a box that ends when it is still, and a silo that ends
 /// when its outlet has taken 20 grains, end at the same frame with the same bytes on any
 /// process count.

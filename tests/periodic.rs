@@ -20,6 +20,7 @@ fn grain(x: DVec3, v: DVec3, w: DVec3) -> Particle {
         w,
         tag: 0,
         material: 0,
+        fixed: false,
     }
 }
 

@@ -304,6 +304,7 @@ impl Simulation {
                 w: w[k],
                 tag,
                 material,
+                fixed: false,
             })
             .collect();
         let ids = self
@@ -316,16 +317,34 @@ impl Simulation {
     /// Removes the particles of `ids` (an array-like of ids), with the springs of their
     /// contacts; not counted as removed by an outlet.
     fn remove(&mut self, ids: PyArrayLike1<'_, i64, AllowTypeChange>) -> PyResult<()> {
-        let ids: Vec<u32> = ids
-            .as_array()
-            .iter()
-            .map(|&id| {
-                u32::try_from(id).map_err(|_| PyValueError::new_err(format!("ids: {id} is no id")))
-            })
-            .collect::<PyResult<_>>()?;
+        let ids = ids_of(ids)?;
         self.sim
             .remove_particles(&ids)
             .map_err(|e| PyValueError::new_err(format!("ids: {e:#}")))
+    }
+
+    /// Fixes the particles of `ids` (an array-like of ids): from the next step they stay
+    /// where they are, at rest, whatever acts on them (as particles in a `[[fixed]]` box).
+    fn freeze(&mut self, ids: PyArrayLike1<'_, i64, AllowTypeChange>) -> PyResult<()> {
+        let ids = ids_of(ids)?;
+        self.sim
+            .fix_particles(&ids, true)
+            .map_err(|e| PyValueError::new_err(format!("ids: {e:#}")))
+    }
+
+    /// Lets the particles of `ids` move again (from rest).
+    fn unfreeze(&mut self, ids: PyArrayLike1<'_, i64, AllowTypeChange>) -> PyResult<()> {
+        let ids = ids_of(ids)?;
+        self.sim
+            .fix_particles(&ids, false)
+            .map_err(|e| PyValueError::new_err(format!("ids: {e:#}")))
+    }
+
+    /// Whether each particle is fixed, (N,) booleans, in id order.
+    #[getter]
+    fn fixed<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
+        let p = &self.sim.particles;
+        Array1::from_iter(self.order().into_iter().map(|i| p.fixed[i])).into_pyarray(py)
     }
 
     /// Velocities [m/s], (N, 3), in id order.
@@ -421,6 +440,7 @@ impl Simulation {
         let extra = Extra {
             tag: self.sim.has_tags(),
             ids: self.sim.frames_carry_ids(),
+            fixed: self.sim.has_fixed(),
         };
         let dir = path.parent().filter(|d| !d.as_os_str().is_empty());
         let name = path
@@ -763,4 +783,14 @@ fn _tinydem(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(_internal_panic, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
+}
+
+/// Particle ids from Python: whole numbers from 0 to 2^32 - 1.
+fn ids_of(ids: PyArrayLike1<'_, i64, AllowTypeChange>) -> PyResult<Vec<u32>> {
+    ids.as_array()
+        .iter()
+        .map(|&id| {
+            u32::try_from(id).map_err(|_| PyValueError::new_err(format!("ids: {id} is no id")))
+        })
+        .collect()
 }

@@ -284,6 +284,36 @@ def test_add_and_remove_give_the_run_that_had_them_from_the_start(study, tmp_pat
         added.remove([99999])
 
 
+def test_freeze_gives_the_run_of_a_fixed_box(study, tmp_path):
+    """Particles frozen from Python before stepping: the bits of the CLI's run of the same
+    particles with a [[fixed]] box around them; they stay put, and unfreeze lets go."""
+    _, out = study
+    (tmp_path / "start.csv").write_bytes((out / "particles000004.csv").read_bytes())
+    frame = tinydem.read_frame(out / "particles000004.csv")
+    low = float(np.median(frame["z"]))
+    start = f'spawn_attempts = 0\n[input]\nparticles = "start.csv"\n'
+    box = f"[[fixed]]\nmin = [-1.0, -1.0, -1.0]\nmax = [1.0, 1.0, {low!r}]\n"
+    scenario(tmp_path, start + box).rename(tmp_path / "boxed.toml")
+    boxed = Path(tinydem.run(tmp_path / "boxed.toml", output=tmp_path / "boxed"))
+    scenario(tmp_path, start).rename(tmp_path / "free.toml")
+    sim = tinydem.Simulation(tmp_path / "free.toml")
+    held = sim.ids[sim.positions[:, 2] <= low]
+    assert 0 < len(held) < len(sim)
+    sim.freeze(held.tolist())
+    assert list(sim.ids[sim.fixed]) == list(held)
+    before = sim.positions[sim.fixed]
+    sim.step(FRAMES * STEPS_PER_FRAME)
+    sim.write_frame(tmp_path / "frozen.csv")
+    last = boxed / f"particles{FRAMES:06d}.csv"
+    assert (tmp_path / "frozen.csv").read_bytes() == last.read_bytes()
+    assert np.array_equal(sim.positions[sim.fixed], before)
+    assert not sim.velocities[sim.fixed].any()
+    sim.unfreeze(held)
+    assert not sim.fixed.any()
+    with pytest.raises(ValueError, match="ids: there is no particle 99999"):
+        sim.freeze([99999])
+
+
 def test_errors_name_python_arguments(study, tmp_path):
     s, _ = study
     tinydem.run(s, output=tmp_path / "out")

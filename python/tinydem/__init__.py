@@ -44,6 +44,7 @@ WHOLE_COLUMNS = frozenset(
         "tag",
         "id",
         "material",
+        "fixed",
         "frame",
         "step",
         "particles",
@@ -75,7 +76,7 @@ def read_table(path: PathLike) -> Dict[str, np.ndarray]:
 def read_frame(path: PathLike) -> Dict[str, np.ndarray]:
     """Reads a frame ``particlesNNNNNN.csv`` as a dict of numpy arrays by column: ``x``,
     ``y``, ``z``, ``R``, ``vx`` ... ``wz`` (float64) and, where the frame has them, ``tag``,
-    ``id``, ``material`` (int64). Rows are particles in id order."""
+    ``id``, ``material``, ``fixed`` (int64). Rows are particles in id order."""
     return read_table(path)
 
 

@@ -54,6 +54,13 @@ class Simulation:
         """Adds particles with the next ids, which it returns."""
     def remove(self, ids: npt.ArrayLike) -> None:
         """Removes the particles of these ids."""
+    def freeze(self, ids: npt.ArrayLike) -> None:
+        """Fixes the particles of these ids: they stay where they are, at rest."""
+    def unfreeze(self, ids: npt.ArrayLike) -> None:
+        """Lets the particles of these ids move again."""
+    @property
+    def fixed(self) -> npt.NDArray[np.bool_]:
+        """(N,) whether each particle is fixed."""
     @property
     def velocities(self) -> npt.NDArray[np.float64]:
         """(N, 3) velocities [m/s]; settable with an (N, 3) array."""

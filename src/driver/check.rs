@@ -193,6 +193,13 @@ fn bound_lines(s: &Scenario, sim: &Simulation) -> String {
             o.min, o.max
         );
     }
+    for (k, b) in s.fixed.iter().enumerate() {
+        let held = (sim.particles.x.iter()).filter(|x| b.contains(**x)).count();
+        bounds += &format!(
+            "fixed {k:<17}{} .. {} (holds the {held} initial particles in it in place)\n",
+            b.min, b.max
+        );
+    }
     bounds += &spawn_lines(s, sim.spawner.box_off);
     if s.wall_forces {
         bounds += &format!(

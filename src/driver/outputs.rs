@@ -29,6 +29,7 @@ impl<'a> Frames<'a> {
             extra: Extra {
                 tag: sim.has_tags(),
                 ids: sim.frames_carry_ids(),
+                fixed: sim.has_fixed(),
             },
             frame_time: sim.scenario.simulation.steps_per_frame as f64
                 * sim.scenario.simulation.timestep,

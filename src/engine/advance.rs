@@ -5,6 +5,7 @@ use super::*;
 
 /// Stage 5 (Section 2.3): advance each particle of `p` by `dt` under gravity `g` and the
 /// force and torque its contacts added to its load (Eqs. 1-2), which it uses up (zeroes).
+/// A fixed particle keeps its place and orientation, at rest; its load is dropped.
 /// Returns whether some particle's new state is not finite (for stage 6, so that it needs
 /// no pass of its own).
 #[inline(never)] // a stage of its own in profiles
@@ -17,7 +18,7 @@ pub(super) fn run(
     let scales = &model.scales;
     let densities = &model.densities;
     let uniform = densities.len() == 1;
-    let material = &p.material;
+    let (material, fixed) = (&p.material, &p.fixed);
     (
         p.x.par_chunks_mut(WIDTH),
         p.v.par_chunks_mut(WIDTH),
@@ -25,11 +26,12 @@ pub(super) fn run(
         p.w.par_chunks_mut(WIDTH),
         p.radius.par_chunks(WIDTH),
         material.par_chunks(WIDTH),
+        fixed.par_chunks(WIDTH),
         loads.par_chunks_mut(WIDTH),
     )
         .into_par_iter()
         .with_min_len(MIN_PARALLEL_LEN.div_ceil(WIDTH))
-        .map(|(x, v, q, w, radius, material, load)| {
+        .map(|(x, v, q, w, radius, material, fixed, load)| {
             // `WIDTH` particles at a time in lanes; a short last group repeats its last
             // particle in the spare lanes. The loads are used up (zeroed for the next
             // step).
@@ -72,11 +74,35 @@ pub(super) fn run(
                 Group::scatter_quat(new.q),
                 Group::scatter_vec(new.w),
             );
-            x.copy_from_slice(&new_x[..n]);
-            v.copy_from_slice(&new_v[..n]);
-            q.copy_from_slice(&new_q[..n]);
-            w.copy_from_slice(&new_w[..n]);
+            if fixed.contains(&true) {
+                hold(fixed, (x, v, q, w), (&new_x, &new_v, &new_q, &new_w));
+            } else {
+                x.copy_from_slice(&new_x[..n]);
+                v.copy_from_slice(&new_v[..n]);
+                q.copy_from_slice(&new_q[..n]);
+                w.copy_from_slice(&new_w[..n]);
+            }
             (0..n).any(|l| !(x[l].is_finite() && v[l].is_finite() && w[l].is_finite()))
         })
         .reduce(|| false, |a, b| a || b)
+}
+
+/// The new states of a group with fixed particles: those stay where they are, at rest.
+fn hold(
+    fixed: &[bool],
+    (x, v, q, w): (&mut [DVec3], &mut [DVec3], &mut [glam::DQuat], &mut [DVec3]),
+    new: (
+        &[DVec3; WIDTH],
+        &[DVec3; WIDTH],
+        &[glam::DQuat; WIDTH],
+        &[DVec3; WIDTH],
+    ),
+) {
+    for (l, &held) in fixed.iter().enumerate() {
+        if held {
+            (v[l], w[l]) = (DVec3::ZERO, DVec3::ZERO);
+        } else {
+            (x[l], v[l], q[l], w[l]) = (new.0[l], new.1[l], new.2[l], new.3[l]);
+        }
+    }
 }

@@ -34,16 +34,7 @@ impl Simulation {
     /// contacts; the others keep theirs. Not counted as outflow.
     pub fn remove_particles(&mut self, ids: &[u32]) -> Result<()> {
         self.refuse_split("remove particles")?;
-        let at: rustc_hash::FxHashMap<u32, u32> = (self.particles.id.iter().enumerate())
-            .map(|(k, &id)| (id, k as u32))
-            .collect();
-        let mut gone = Vec::with_capacity(ids.len());
-        for id in ids {
-            match at.get(id) {
-                Some(&k) => gone.push(k),
-                None => bail!("there is no particle {id}"),
-            }
-        }
+        let mut gone = self.stored_at(ids)?;
         gone.sort_unstable();
         gone.dedup();
         self.neighbours.rebuild_without(
@@ -54,6 +45,33 @@ impl Simulation {
         );
         self.built();
         Ok(())
+    }
+
+    /// Fixes the particles of `ids` (each must be present): from the next step they stay
+    /// where they are, at rest; or, with `fixed` false, lets them move again.
+    pub fn fix_particles(&mut self, ids: &[u32], fixed: bool) -> Result<()> {
+        self.refuse_split("fix particles")?;
+        for k in self.stored_at(ids)? {
+            let k = k as usize;
+            self.particles.fixed[k] = fixed;
+            if fixed {
+                (self.particles.v[k], self.particles.w[k]) = (DVec3::ZERO, DVec3::ZERO);
+            }
+        }
+        Ok(())
+    }
+
+    /// The storage index of each particle of `ids` (each must be present).
+    fn stored_at(&self, ids: &[u32]) -> Result<Vec<u32>> {
+        let at: rustc_hash::FxHashMap<u32, u32> = (self.particles.id.iter().enumerate())
+            .map(|(k, &id)| (id, k as u32))
+            .collect();
+        ids.iter()
+            .map(|id| match at.get(id) {
+                Some(&k) => Ok(k),
+                None => bail!("there is no particle {id}"),
+            })
+            .collect()
     }
 
     fn refuse_split(&self, what: &str) -> Result<()> {

@@ -77,6 +77,11 @@ impl Simulation {
             || p.next_id as usize != self.particle_count()
     }
 
+    /// Whether frames carry a `fixed` column: the scenario fixes particles, or some are.
+    pub fn has_fixed(&self) -> bool {
+        !self.scenario.fixed.is_empty() || self.particles.fixed.contains(&true)
+    }
+
     /// Whether frames carry a tag column: the scenario tags particles, or they came tagged.
     pub fn has_tags(&self) -> bool {
         let tagged = self.particles.tagged();

@@ -243,6 +243,7 @@ impl Simulation {
             return Err(misfit("one anchor per particle".into()));
         }
         sim.particles = p;
+        Self::fix_within(&mut sim.particles, &sim.scenario.fixed);
         let servos = sim.carried_servos(&snapshot.mesh_files, &snapshot.servos);
         if !servos.is_empty() {
             notes.push(format!("{} servo(s) carried where they were", servos.len()));
@@ -352,8 +353,21 @@ impl Simulation {
             .collect()
     }
 
+    /// Fixes the particles whose centre lies in one of `boxes` (`[[fixed]]`).
+    fn fix_within(p: &mut Particles, boxes: &[crate::scenario::Region]) {
+        for (x, fixed) in p.x.iter().zip(&mut p.fixed) {
+            *fixed |= boxes.iter().any(|b| b.contains(*x));
+        }
+    }
+
     /// Sets up a simulation from a mesh and particles already in memory.
-    pub fn from_parts(scenario: Scenario, mesh: Mesh, particles: Particles) -> Result<Simulation> {
+    /// The particles in `[[fixed]]` boxes are fixed.
+    pub fn from_parts(
+        scenario: Scenario,
+        mesh: Mesh,
+        mut particles: Particles,
+    ) -> Result<Simulation> {
+        Self::fix_within(&mut particles, &scenario.fixed);
         let g = &scenario.geometry;
         let max_radius = g.radius_max.max(particles.max_radius());
         if particles.len() as u64 > u32::MAX as u64 / 2 {

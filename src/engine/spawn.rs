@@ -358,6 +358,7 @@ impl Spawner {
                 w: s.kinetics.initial_angular_velocity,
                 tag: 0,
                 material: source.material,
+                fixed: false,
             });
             inserted += 1;
         }

@@ -1,7 +1,8 @@
 //! Particle frames in the original program's CSV format:
 //! header `x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz`, one particle per line, full round-trip
 //! precision, files `particlesNNNNNN.csv`. Runs that tag particles add a column `tag`; runs
-//! that can remove particles (or have several materials) add `id` and `material` after it.
+//! that can remove particles (or have several materials) add `id` and `material` after it;
+//! runs with fixed particles `fixed` (1 for a fixed particle, 0 for one that moves) last.
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::path::{Path, PathBuf};
@@ -17,7 +18,7 @@ pub const COLUMNS: [&str; 14] = [
 ];
 
 /// Whole-number columns a frame may carry beyond the fourteen.
-pub const INT_COLUMNS: [&str; 3] = ["tag", "id", "material"];
+pub const INT_COLUMNS: [&str; 4] = ["tag", "id", "material", "fixed"];
 
 /// The file name of frame `k`.
 pub fn frame_name(k: u64) -> String {
@@ -31,6 +32,8 @@ pub struct Extra {
     pub tag: bool,
     /// `id` and `material`
     pub ids: bool,
+    /// `fixed` (also written whenever a particle is fixed)
+    pub fixed: bool,
 }
 
 /// Writes all particles as CSV text in id order, with the `extra` columns.
@@ -42,6 +45,10 @@ pub fn write_particles(out: &mut impl Write, p: &Particles, extra: Extra) -> std
     }
     if extra.ids {
         out.write_all(b",id,material")?;
+    }
+    let fixed = extra.fixed || p.fixed.contains(&true);
+    if fixed {
+        out.write_all(b",fixed")?;
     }
     out.write_all(b"\n")?;
     let mut buf = ryu::Buffer::new();
@@ -66,6 +73,9 @@ pub fn write_particles(out: &mut impl Write, p: &Particles, extra: Extra) -> std
             line.push_str(itoa::Buffer::new().format(id));
             line.push(',');
             line.push_str(itoa::Buffer::new().format(q.material));
+        }
+        if fixed {
+            line.push_str(if q.fixed { ",1" } else { ",0" });
         }
         line.push('\n');
         out.write_all(line.as_bytes())?;
@@ -186,8 +196,8 @@ fn contact(line: &str, file: &str, n: usize) -> Result<ContactRecord> {
 /// The columns of a particle CSV file, from its header.
 struct Header {
     columns: usize,
-    /// The column of each optional whole-number quantity: tag, id, material.
-    int_column: [Option<usize>; 3],
+    /// The column of each optional whole-number quantity: tag, id, material, fixed.
+    int_column: [Option<usize>; 4],
     /// The quantity (of the 14) each column holds.
     quantity_of_column: Vec<usize>,
 }
@@ -198,8 +208,8 @@ impl Header {
     fn parse(header: &str, file: &str) -> Result<Header> {
         let names: Vec<&str> = header.trim().split(',').map(str::trim).collect();
         let mut slot = [usize::MAX; 14];
-        // The optional whole-number columns: tag, id, material.
-        let mut int_column = [None; 3];
+        // The optional whole-number columns: tag, id, material, fixed.
+        let mut int_column = [None; 4];
         for (col, name) in names.iter().enumerate() {
             if let Some(k) = INT_COLUMNS.iter().position(|c| c == name) {
                 if int_column[k].is_some() {
@@ -242,12 +252,12 @@ impl Header {
 
     /// The values of row `line` (line `n` of `file`): the 14 quantities and the whole
     /// numbers.
-    fn row(&self, line: &str, n: usize, file: &str) -> Result<([f64; 14], [u32; 3])> {
+    fn row(&self, line: &str, n: usize, file: &str) -> Result<([f64; 14], [u32; 4])> {
         let (names, int_column, quantity_of_column) =
             (self.columns, &self.int_column, &self.quantity_of_column);
         let mut values = [0.0f64; 14];
         let mut count = 0;
-        let mut ints = [0u32; 3];
+        let mut ints = [0u32; 4];
         for (col, text) in line.split(',').enumerate() {
             count += 1;
             if col >= names {
@@ -289,9 +299,15 @@ impl Header {
 }
 
 /// The particle of a row's values `v` and whole numbers `ints` (line `n` of `file`).
-fn particle(v: [f64; 14], ints: [u32; 3], n: usize, file: &str) -> Result<Particle> {
+fn particle(v: [f64; 14], ints: [u32; 4], n: usize, file: &str) -> Result<Particle> {
     if v[3] <= 0.0 {
         bail!("{file}:{n}: radius R = {} must be > 0", v[3]);
+    }
+    if ints[3] > 1 {
+        bail!(
+            "{file}:{n}: fixed = {}: expected 1 (fixed) or 0 (moving)",
+            ints[3]
+        );
     }
     let q = DQuat::from_xyzw(v[8], v[9], v[10], v[7]);
     let norm = q.length();
@@ -311,6 +327,7 @@ fn particle(v: [f64; 14], ints: [u32; 3], n: usize, file: &str) -> Result<Partic
         tag: ints[0],
         material: u16::try_from(ints[2])
             .map_err(|_| anyhow::anyhow!("{file}:{n}: material {} is out of range", ints[2]))?,
+        fixed: ints[3] == 1,
     })
 }
 
@@ -486,6 +503,7 @@ mod tests {
             w: DVec3::new(1.0, 2.0, 3.0),
             tag: 42,
             material: 0,
+            fixed: false,
         }]
         .into_iter()
         .collect();
@@ -495,7 +513,7 @@ mod tests {
             &p,
             Extra {
                 tag: true,
-                ids: false,
+                ..Extra::default()
             },
         )
         .unwrap();
@@ -514,6 +532,7 @@ mod tests {
                 w: DVec3::ZERO,
                 tag: 0,
                 material: k as u16,
+                fixed: false,
             })
             .collect();
         // Ids with gaps (particles 1, 4 and 6 removed), stored out of id order.
@@ -521,8 +540,8 @@ mod tests {
         p.next_id = 8;
         let mut text = Vec::new();
         let extra = Extra {
-            tag: false,
             ids: true,
+            ..Extra::default()
         };
         write_particles(&mut text, &p, extra).unwrap();
         let text = String::from_utf8(text).unwrap();
@@ -533,6 +552,32 @@ mod tests {
         assert_eq!(back.next_id, 8);
         let twice = text.replace(",7,0\n", ",2,0\n");
         assert!(err(&twice).contains("particle id 2 appears twice"));
+    }
+
+    #[test]
+    fn fixed_particles_round_trip() {
+        let mut p: Particles = (0..3)
+            .map(|k| Particle {
+                x: DVec3::new(k as f64, 0.0, 0.0),
+                radius: 0.004,
+                fixed: k == 1,
+                ..Particle::default()
+            })
+            .collect();
+        let mut text = Vec::new();
+        write_particles(&mut text, &p, Extra::default()).unwrap();
+        let text = String::from_utf8(text).unwrap();
+        assert!(
+            text.lines().next().unwrap().ends_with(",wz,fixed"),
+            "{text}"
+        );
+        assert_eq!(read_particles(text.as_bytes(), "t").unwrap(), p);
+        assert!(err(&text.replace(",1\n", ",2\n")).contains("p.csv:3: fixed = 2: expected 1"));
+        // None fixed: no column, unless the run has fixed particles.
+        p.fixed = vec![false; 3];
+        let mut text = Vec::new();
+        write_particles(&mut text, &p, Extra::default()).unwrap();
+        assert!(!String::from_utf8(text).unwrap().contains("fixed"));
     }
 
     fn err(text: &str) -> String {

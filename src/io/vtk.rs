@@ -3,7 +3,8 @@
 //!
 //! Particles are points with one vertex cell each and the point arrays `radius`,
 //! `velocity`, `angular_velocity`, `orientation` (the quaternion q0, q1, q2, q3), `tag`,
-//! `id` and `material` (its index in the scenario's materials); the mesh is its faces
+//! `id`, `material` (its index in the scenario's materials) and `fixed` (1 if it is held,
+//! 0 if it moves); the mesh is its faces
 //! (vertex, line, triangle and quad cells) with the cell array `radius`.
 
 use std::io::Write;
@@ -239,6 +240,7 @@ pub fn write_particles(path: &Path, p: &Particles) -> Result<()> {
         n,
         by_id().map(|i| p.material[i] as u32),
     );
+    v.array(PointData, "fixed", 1, n, by_id().map(|i| p.fixed[i] as u8));
     v.vectors(Points, "points", n, by_id().map(|i| p.x[i]));
     v.array(Cells, "connectivity", 1, n, 0..n as i64);
     v.array(Cells, "offsets", 1, n, 1..=n as i64);

@@ -30,10 +30,13 @@ pub struct Particles {
     /// The index of each particle's material in `[[materials]]` (0: the first, or the one
     /// `[material]`).
     pub material: Vec<u16>,
+    /// Whether each particle is fixed: held in place and at rest, whatever acts on it
+    /// (`[[fixed]]` boxes, the `fixed` column, Python's `freeze`).
+    pub fixed: Vec<bool>,
 }
 
 /// One particle's state, as read from and written to CSV.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Particle {
     pub x: DVec3,
     pub radius: f64,
@@ -42,6 +45,7 @@ pub struct Particle {
     pub w: DVec3,
     pub tag: u32,
     pub material: u16,
+    pub fixed: bool,
 }
 
 impl Particles {
@@ -70,6 +74,7 @@ impl Particles {
         self.w.push(p.w);
         self.tag.push(p.tag);
         self.material.push(p.material);
+        self.fixed.push(p.fixed);
     }
 
     pub fn get(&self, i: usize) -> Particle {
@@ -81,6 +86,7 @@ impl Particles {
             w: self.w[i],
             tag: self.tag[i],
             material: self.material[i],
+            fixed: self.fixed[i],
         }
     }
 
@@ -107,6 +113,7 @@ impl Particles {
         gather(&mut self.w, order);
         gather(&mut self.tag, order);
         gather(&mut self.material, order);
+        gather(&mut self.fixed, order);
     }
 
     /// The storage indices in id order.

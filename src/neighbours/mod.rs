@@ -422,6 +422,7 @@ mod tests {
                 w: DVec3::ZERO,
                 tag: 0,
                 material: 0,
+                fixed: false,
             })
             .collect()
     }

@@ -313,6 +313,7 @@ pub(crate) fn put_particle(w: &mut Writer, id: u32, p: &Particle) {
     w.vec3(p.w);
     w.u32(p.tag);
     w.u16(p.material);
+    w.u8(p.fixed as u8);
 }
 
 pub(crate) fn get_particle(r: &mut Reader) -> (u32, Particle) {
@@ -325,6 +326,7 @@ pub(crate) fn get_particle(r: &mut Reader) -> (u32, Particle) {
         w: r.vec3(),
         tag: r.u32(),
         material: r.u16(),
+        fixed: r.u8() != 0,
     };
     (id, p)
 }

@@ -22,6 +22,8 @@
 //! [domain]     min, max, periodic = [bool, bool, bool]   (particles whose centre leaves
 //!              it through a side that is not periodic are removed)
 //! [[outlets]]  min, max   (particles whose centre enters one are removed; any number)
+//! [[fixed]]    min, max   (the particles whose centre lies in one when the run or stage
+//!              starts are held in place and at rest; any number)
 //! [[spawn]]    min, max, material, velocity, count, rate, start, stop, radius = {
 //!              distribution = "uniform" | "normal" | "lognormal" | "table", ... }
 //! [[materials]] name, density, youngs_modulus, poisson_ratio, restitution, friction_*
@@ -410,6 +412,8 @@ pub struct Scenario {
     pub lees_edwards: Option<(f64, usize, usize)>,
     /// Boxes that remove the particles whose centre enters them (`[[outlets]]`).
     pub outlets: Vec<Region>,
+    /// Boxes whose particles are fixed when the run or stage starts (`[[fixed]]`).
+    pub fixed: Vec<Region>,
     /// Insertion regions (`[[spawn]]`); when there are any, the `[geometry]` spawn box is not
     /// used.
     pub spawn: Vec<SpawnRegion>,

@@ -168,6 +168,8 @@ pub(super) struct RawScenario {
     #[serde(default)]
     pub(super) outlets: Vec<RawBox>,
     #[serde(default)]
+    pub(super) fixed: Vec<RawBox>,
+    #[serde(default)]
     pub(super) spawn: Vec<RawSpawn>,
     #[serde(default)]
     pub(super) geometry: RawGeometry,

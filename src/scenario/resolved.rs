@@ -168,7 +168,7 @@ impl Scenario {
         }
     }
 
-    /// `[[tags]]`, `[domain]` and `[[outlets]]`.
+    /// `[[tags]]`, `[domain]`, `[[outlets]]` and `[[fixed]]`.
     fn regions_toml(&self, o: &mut String) {
         for t in &self.tags {
             *o += "\n[[tags]]\n";
@@ -200,13 +200,11 @@ impl Scenario {
                 );
             }
         }
-        for b in &self.outlets {
-            let _ = writeln!(
-                o,
-                "\n[[outlets]]\nmin = {}\nmax = {}",
-                vec3(b.min),
-                vec3(b.max)
-            );
+        for (name, boxes) in [("outlets", &self.outlets), ("fixed", &self.fixed)] {
+            for b in boxes {
+                let (min, max) = (vec3(b.min), vec3(b.max));
+                let _ = writeln!(o, "\n[[{name}]]\nmin = {min}\nmax = {max}");
+            }
         }
     }
 

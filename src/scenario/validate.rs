@@ -196,6 +196,12 @@ impl Scenario {
             .enumerate()
             .map(|(k, b)| region(&format!("[[outlets]] #{}", k + 1), b, false))
             .collect::<Result<Vec<_>>>()?;
+        let fixed = raw
+            .fixed
+            .into_iter()
+            .enumerate()
+            .map(|(k, b)| region(&format!("[[fixed]] #{}", k + 1), b, false))
+            .collect::<Result<Vec<_>>>()?;
         let spawn = spawn(raw.spawn, &index, &kinetics, &geometry, &simulation, domain)?;
         Ok(Scenario {
             geometry,
@@ -210,6 +216,7 @@ impl Scenario {
             periodic,
             lees_edwards,
             outlets,
+            fixed,
             spawn,
             particles: raw.input.particles.map(|p| base.join(p)),
             output_dir: raw

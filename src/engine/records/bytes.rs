@@ -6,7 +6,7 @@
 //! (u64), step (u64), step of the last neighbour-list rebuild (u64), spawner word position
 //! (u128), pending radius flag (u8) and value (f64), the next particle id (u32), particle
 //! count (u64) and per particle, in storage order: its id (u32), 14 f64 (x, y, z, R, vx, vy,
-//! vz, q0..q3, wx, wy, wz), its tag (u32) and material (u16); whether the lists were built (u8) and if so
+//! vz, q0..q3, wx, wy, wz), its tag (u32), material (u16) and, from format 5, whether it is fixed (u8); whether the lists were built (u8) and if so
 //! each particle's position at the last rebuild (3 f64); the lonely particles of the last
 //! rebuild: count (u64) and per entry storage index (u32) and allowance (f64); then the particle-pair and particle-face histories: count (u64) and per
 //! entry the ids (lower, higher) or the id and face (u32, u32) and the springs u_s, u_r (3 f64
@@ -29,7 +29,7 @@ use crate::model::servo::State;
 use crate::model::springs::Springs;
 
 const MAGIC: &[u8; 12] = b"TINYDEM CKPT";
-const VERSION: u32 = 4;
+const VERSION: u32 = 5;
 /// The oldest version this program reads.
 const OLDEST: u32 = 2;
 
@@ -99,6 +99,7 @@ pub fn encode_into(out: &mut Vec<u8>, snapshot: &Snapshot, fingerprint: u64) {
         );
         out.extend_from_slice(&q.tag.to_le_bytes());
         out.extend_from_slice(&q.material.to_le_bytes());
+        out.push(q.fixed as u8);
     }
     let built = snapshot.anchors.len() == p.len() && !p.is_empty();
     out.push(built as u8);
@@ -271,7 +272,7 @@ pub fn decode(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<Snapsho
     let pending = r.f64()?;
     let next_id = r.u32()?;
     let v3 = version >= 3;
-    let (particles, anchors) = r.particles(v3, next_id)?;
+    let (particles, anchors) = r.particles(version, next_id)?;
     let lonely = r.lonely(particles.len())?;
     let pair_history = r.history()?;
     let face_history = r.history()?;
@@ -352,11 +353,13 @@ struct Rest {
 }
 
 impl Cursor<'_> {
-    /// The particles (material indices from format 3 on), checked, with their ids below
-    /// `next_id`; and their anchors, if the lists were built.
-    fn particles(&mut self, v3: bool, next_id: u32) -> Result<(Particles, Vec<DVec3>)> {
+    /// The particles of a checkpoint of format `version` (material indices from format 3
+    /// on, fixed from 5), checked, with their ids below `next_id`; and their anchors, if the
+    /// lists were built.
+    fn particles(&mut self, version: u32, next_id: u32) -> Result<(Particles, Vec<DVec3>)> {
         let r = self;
-        let n = r.count(4 + 14 * 8 + 4 + if v3 { 2 } else { 0 })?;
+        let (v3, v5) = (version >= 3, version >= 5);
+        let n = r.count(4 + 14 * 8 + 4 + 2 * v3 as usize + v5 as usize)?;
         let mut particles = Particles::default();
         let mut ids = Vec::with_capacity(n);
         for _ in 0..n {
@@ -368,6 +371,7 @@ impl Cursor<'_> {
             let w = r.vec3()?;
             let tag = r.u32()?;
             let material = if v3 { r.u16()? } else { 0 };
+            let fixed = v5 && r.u8()? != 0;
             particles.push(Particle {
                 x,
                 radius,
@@ -376,6 +380,7 @@ impl Cursor<'_> {
                 w,
                 tag,
                 material,
+                fixed,
             });
         }
         let anchors = match r.u8()? {

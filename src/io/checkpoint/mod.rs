@@ -110,6 +110,7 @@ mod tests {
             w: DVec3::new(1.0, 2.0, 3.0),
             tag: 7,
             material: 0,
+            fixed: false,
         });
         let s = Springs {
             u_s: DVec3::new(1e-5, 2e-6, 0.0),
@@ -194,8 +195,27 @@ mod tests {
 
     #[test]
     fn round_trip_is_exact() {
-        let s = snapshot();
+        let mut s = snapshot();
         assert_eq!(decode(&encode(&s, 7), Some(7)).unwrap(), s);
+        s.particles.fixed[0] = true;
+        assert_eq!(decode(&encode(&s, 7), Some(7)).unwrap(), s);
+    }
+
+    /// A snapshot's bytes with format `version` for `bytes` of the newest format whose
+    /// byte ranges `cut` (start, end) are left out.
+    fn older(bytes: &[u8], version: u32, cut: &[(usize, usize)]) -> Vec<u8> {
+        let body = &bytes[..bytes.len() - 4];
+        let mut old = Vec::new();
+        let mut from = 0;
+        for &(start, end) in cut {
+            old.extend_from_slice(&body[from..start]);
+            from = end;
+        }
+        old.extend_from_slice(&body[from..]);
+        old[12..16].copy_from_slice(&version.to_le_bytes());
+        let crc = crc32fast::hash(&old);
+        old.extend_from_slice(&crc.to_le_bytes());
+        old
     }
 
     #[test]
@@ -206,28 +226,28 @@ mod tests {
         (s.scenario, s.mesh_files) = (String::new(), Vec::new());
         (s.spawner.regions, s.servos) = (Vec::new(), Vec::new());
         s.spawner.box_off = false;
-        let v4 = encode(&s, 7);
-        let body = &v4[..v4.len() - 4];
+        let v5 = encode(&s, 7);
+        let n = v5.len() - 4;
         // The one particle's record starts at byte 77 (after the header and the count); its
-        // material is the last 2 of its 122 bytes; the counts of removals, loads, scenario,
-        // mesh files, spawn regions, the spawn box's flag and servos end the body.
-        let mut v2 = [&body[..77 + 120], &body[77 + 122..body.len() - 65]].concat();
-        v2[12..16].copy_from_slice(&2u32.to_le_bytes());
-        let crc = crc32fast::hash(&v2);
-        v2.extend_from_slice(&crc.to_le_bytes());
+        // material and fixed flag are the last 3 of its 123 bytes; the counts of removals,
+        // loads, scenario, mesh files, spawn regions, the spawn box's flag and servos end the
+        // body.
+        let v2 = older(&v5, 2, &[(77 + 120, 77 + 123), (n - 65, n)]);
         assert_eq!(decode(&v2, Some(7)).unwrap(), s);
     }
 
     #[test]
-    fn version_3_is_read_without_servos() {
+    fn versions_3_and_4_are_read() {
         let mut s = snapshot();
-        (s.servos, s.spawner.box_off) = (Vec::new(), false);
-        let v4 = encode(&s, 7);
+        let v5 = encode(&s, 7);
+        // Format 4 has no fixed flag (the last byte of the particle's record).
+        let v4 = older(&v5, 4, &[(77 + 122, 77 + 123)]);
+        assert_eq!(decode(&v4, Some(7)).unwrap(), s);
         // Format 3 ends before the spawn box's flag and the count of servos.
-        let mut v3 = v4[..v4.len() - 4 - 9].to_vec();
-        v3[12..16].copy_from_slice(&3u32.to_le_bytes());
-        let crc = crc32fast::hash(&v3);
-        v3.extend_from_slice(&crc.to_le_bytes());
+        (s.servos, s.spawner.box_off) = (Vec::new(), false);
+        let v5 = encode(&s, 7);
+        let n = v5.len() - 4;
+        let v3 = older(&v5, 3, &[(77 + 122, 77 + 123), (n - 9, n)]);
         assert_eq!(decode(&v3, Some(7)).unwrap(), s);
     }
 

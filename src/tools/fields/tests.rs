@@ -53,6 +53,7 @@ fn particle(x: DVec3, v: DVec3, radius: f64) -> Particle {
         w: DVec3::ZERO,
         tag: 0,
         material: 0,
+        fixed: false,
     }
 }
 

@@ -566,15 +566,24 @@ fn write_gif(path: &Path, images: Vec<RgbImage>) -> Result<()> {
     let mut enc = image::codecs::gif::GifEncoder::new_with_speed(file, 10);
     enc.set_repeat(image::codecs::gif::Repeat::Infinite)?;
     for img in images {
-        let rgba = image::DynamicImage::ImageRgb8(img).to_rgba8();
         enc.encode_frame(image::Frame::from_parts(
-            rgba,
+            dithered(img),
             0,
             0,
             image::Delay::from_numer_denom_ms(1000 / FPS, 1),
         ))?;
     }
     Ok(())
+}
+
+/// A picture in a GIF's 256 colours without bands across the shading of the spheres: a
+/// palette fitted to it (NeuQuant) and Floyd-Steinberg dithering (the encoder then keeps
+/// those colours as they are).
+fn dithered(img: RgbImage) -> image::RgbaImage {
+    let mut rgba = image::DynamicImage::ImageRgb8(img).to_rgba8();
+    let palette = color_quant::NeuQuant::new(5, 256, rgba.as_raw());
+    image::imageops::dither(&mut rgba, &palette);
+    rgba
 }
 
 /// Writes the pictures as an H.264 MP4 (MPEG-4 part 2 where ffmpeg lacks H.264) by piping
@@ -629,135 +638,4 @@ fn write_movie(path: &Path, images: &[RgbImage]) -> Result<()> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::model::particles::Particle;
-    use glam::DQuat;
-
-    #[test]
-    fn servos_are_placed_where_the_log_has_them() {
-        let dir = tempfile::tempdir().unwrap();
-        let header = crate::io::output::LOG_HEADER;
-        let zeros = "0,".repeat(8);
-        let log = format!(
-            "{header},mesh2_position,mesh2_load,mesh4_position,mesh4_load\n\
-             0,0,0.0,{zeros}0.0,0.0,0.0,0.0\n\
-             3,300,0.1,{zeros}0.0125,2.5,-0.5,0.0\n"
-        );
-        std::fs::write(dir.path().join(crate::io::output::LOG), log).unwrap();
-        let at = servo_positions(dir.path());
-        assert_eq!(at[&3], vec![(2, 0.0125), (4, -0.5)]);
-        assert_eq!(at[&0], vec![(2, 0.0), (4, 0.0)]);
-        // A run without servos, or without a log: none.
-        std::fs::write(
-            dir.path().join(crate::io::output::LOG),
-            format!("{header}\n"),
-        )
-        .unwrap();
-        assert!(servo_positions(dir.path()).is_empty());
-        assert!(servo_positions(&dir.path().join("none")).is_empty());
-    }
-
-    #[test]
-    fn a_sphere_is_drawn_in_the_middle() {
-        let style = Style {
-            width: 320,
-            height: 240,
-            color: ColorBy::Speed,
-            view: View::Iso,
-            scale_bar: true,
-        };
-        let img = render(&one(DVec3::ZERO, DVec3::ZERO), &Mesh::default(), &style).unwrap();
-        assert_eq!(img.dimensions(), (320, 240));
-        // The scene is left of the colour bar and below the line of the time stamp.
-        assert_ne!(*img.get_pixel(139, 127), BACKGROUND);
-        assert_eq!(*img.get_pixel(0, 0), BACKGROUND);
-        assert!(
-            render(
-                &one(DVec3::ZERO, DVec3::ZERO),
-                &Mesh::default(),
-                &Style { width: 10, ..style }
-            )
-            .is_err()
-        );
-    }
-
-    fn one(x: DVec3, v: DVec3) -> Particles {
-        [Particle {
-            x,
-            radius: 1.0,
-            v,
-            q: DQuat::IDENTITY,
-            w: DVec3::ZERO,
-            tag: 0,
-            material: 0,
-        }]
-        .into_iter()
-        .collect()
-    }
-
-    /// In one layout the view and the colour bar stay put: a slow particle that moved has
-    /// its speed's colour on the bar of the fast one, the bar and the frame do not change.
-    #[test]
-    fn one_layout_keeps_the_view_and_the_colours() {
-        let style = Style {
-            width: 400,
-            height: 300,
-            color: ColorBy::Speed,
-            view: View::Front,
-            scale_bar: false,
-        };
-        let a = one(DVec3::ZERO, DVec3::new(4.0, 0.0, 0.0));
-        let b = one(DVec3::new(5.0, 0.0, 0.0), DVec3::new(1.0, 0.0, 0.0));
-        let mut layout = Layout::of(&a, &Mesh::default(), &style);
-        layout.include(&b, &Mesh::default(), &style);
-        assert_eq!(layout.range(), (0.0, 4.0));
-        let ia = render_in(&a, &Mesh::default(), &style, &layout, Some(0.0)).unwrap();
-        let ib = render_in(&b, &Mesh::default(), &style, &layout, Some(0.0)).unwrap();
-        // The colour bar and its labels (right of the scene) are the same pixels.
-        for y in 0..300 {
-            for x in 362..400 {
-                assert_eq!(ia.get_pixel(x, y), ib.get_pixel(x, y), "({x}, {y})");
-            }
-        }
-        // The particles are where they are, not each re-centred: a left of b.
-        let centre_x = |img: &RgbImage| {
-            let xs: Vec<u32> = (0..300)
-                .flat_map(|x| (20..300).map(move |y| (x, y)))
-                .filter(|&(x, y)| *img.get_pixel(x, y) != BACKGROUND)
-                .map(|(x, _)| x)
-                .collect();
-            xs.iter().sum::<u32>() as f64 / xs.len() as f64
-        };
-        assert!(centre_x(&ia) + 100.0 < centre_x(&ib));
-        // A fixed range and box replace the fitted ones.
-        layout.fix(
-            &Fixed {
-                bounds: Some((DVec3::splat(-10.0), DVec3::splat(10.0))),
-                range: Some((0.0, 10.0)),
-            },
-            &style,
-        );
-        assert_eq!(layout.range(), (0.0, 10.0));
-        assert_eq!(layout.bounds().0.x, -10.0);
-    }
-
-    #[test]
-    fn categories_get_a_legend_with_names() {
-        let style = Style {
-            width: 400,
-            height: 300,
-            color: ColorBy::Material,
-            view: View::Front,
-            scale_bar: false,
-        };
-        let mut p = one(DVec3::ZERO, DVec3::ZERO);
-        p.material[0] = 1;
-        let mut layout = Layout::of(&p, &Mesh::default(), &style);
-        layout.material_names = vec!["glass".into(), "steel".into()];
-        assert_eq!(layout.label(ColorBy::Material, 1), "1 steel");
-        let img = render_in(&p, &Mesh::default(), &style, &layout, None).unwrap();
-        let swatch = rgb(category_colour(1));
-        assert!(img.pixels().filter(|&&c| c == swatch).count() >= 64);
-    }
-}
+mod tests;

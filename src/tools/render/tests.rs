@@ -1,0 +1,226 @@
+//! Tests of the pictures: layout, colours, depth, animations.
+
+use super::*;
+use crate::model::particles::Particle;
+use glam::DQuat;
+
+#[test]
+fn servos_are_placed_where_the_log_has_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let header = crate::io::output::LOG_HEADER;
+    let zeros = "0,".repeat(8);
+    let log = format!(
+        "{header},mesh2_position,mesh2_load,mesh4_position,mesh4_load\n\
+         0,0,0.0,{zeros}0.0,0.0,0.0,0.0\n\
+         3,300,0.1,{zeros}0.0125,2.5,-0.5,0.0\n"
+    );
+    std::fs::write(dir.path().join(crate::io::output::LOG), log).unwrap();
+    let at = servo_positions(dir.path());
+    assert_eq!(at[&3], vec![(2, 0.0125), (4, -0.5)]);
+    assert_eq!(at[&0], vec![(2, 0.0), (4, 0.0)]);
+    // A run without servos, or without a log: none.
+    std::fs::write(
+        dir.path().join(crate::io::output::LOG),
+        format!("{header}\n"),
+    )
+    .unwrap();
+    assert!(servo_positions(dir.path()).is_empty());
+    assert!(servo_positions(&dir.path().join("none")).is_empty());
+}
+
+#[test]
+fn a_sphere_is_drawn_in_the_middle() {
+    let style = Style {
+        width: 320,
+        height: 240,
+        color: ColorBy::Speed,
+        view: View::Iso,
+        scale_bar: true,
+    };
+    let img = render(&one(DVec3::ZERO, DVec3::ZERO), &Mesh::default(), &style).unwrap();
+    assert_eq!(img.dimensions(), (320, 240));
+    // The scene is left of the colour bar and below the line of the time stamp.
+    assert_ne!(*img.get_pixel(139, 127), BACKGROUND);
+    assert_eq!(*img.get_pixel(0, 0), BACKGROUND);
+    assert!(
+        render(
+            &one(DVec3::ZERO, DVec3::ZERO),
+            &Mesh::default(),
+            &Style { width: 10, ..style }
+        )
+        .is_err()
+    );
+}
+
+fn one(x: DVec3, v: DVec3) -> Particles {
+    [Particle {
+        x,
+        radius: 1.0,
+        v,
+        q: DQuat::IDENTITY,
+        w: DVec3::ZERO,
+        tag: 0,
+        material: 0,
+        fixed: false,
+    }]
+    .into_iter()
+    .collect()
+}
+
+/// In one layout the view and the colour bar stay put: a slow particle that moved has
+/// its speed's colour on the bar of the fast one, the bar and the frame do not change.
+#[test]
+fn one_layout_keeps_the_view_and_the_colours() {
+    let style = Style {
+        width: 400,
+        height: 300,
+        color: ColorBy::Speed,
+        view: View::Front,
+        scale_bar: false,
+    };
+    let a = one(DVec3::ZERO, DVec3::new(4.0, 0.0, 0.0));
+    let b = one(DVec3::new(5.0, 0.0, 0.0), DVec3::new(1.0, 0.0, 0.0));
+    let mut layout = Layout::of(&a, &Mesh::default(), &style);
+    layout.include(&b, &Mesh::default(), &style);
+    assert_eq!(layout.range(), (0.0, 4.0));
+    let ia = render_in(&a, &Mesh::default(), &style, &layout, Some(0.0)).unwrap();
+    let ib = render_in(&b, &Mesh::default(), &style, &layout, Some(0.0)).unwrap();
+    // The colour bar and its labels (right of the scene) are the same pixels.
+    for y in 0..300 {
+        for x in 362..400 {
+            assert_eq!(ia.get_pixel(x, y), ib.get_pixel(x, y), "({x}, {y})");
+        }
+    }
+    // The particles are where they are, not each re-centred: a left of b.
+    let centre_x = |img: &RgbImage| {
+        let xs: Vec<u32> = (0..300)
+            .flat_map(|x| (20..300).map(move |y| (x, y)))
+            .filter(|&(x, y)| *img.get_pixel(x, y) != BACKGROUND)
+            .map(|(x, _)| x)
+            .collect();
+        xs.iter().sum::<u32>() as f64 / xs.len() as f64
+    };
+    assert!(centre_x(&ia) + 100.0 < centre_x(&ib));
+    // A fixed range and box replace the fitted ones.
+    layout.fix(
+        &Fixed {
+            bounds: Some((DVec3::splat(-10.0), DVec3::splat(10.0))),
+            range: Some((0.0, 10.0)),
+        },
+        &style,
+    );
+    assert_eq!(layout.range(), (0.0, 10.0));
+    assert_eq!(layout.bounds().0.x, -10.0);
+}
+
+#[test]
+fn categories_get_a_legend_with_names() {
+    let style = Style {
+        width: 400,
+        height: 300,
+        color: ColorBy::Material,
+        view: View::Front,
+        scale_bar: false,
+    };
+    let mut p = one(DVec3::ZERO, DVec3::ZERO);
+    p.material[0] = 1;
+    let mut layout = Layout::of(&p, &Mesh::default(), &style);
+    layout.material_names = vec!["glass".into(), "steel".into()];
+    assert_eq!(layout.label(ColorBy::Material, 1), "1 steel");
+    let img = render_in(&p, &Mesh::default(), &style, &layout, None).unwrap();
+    let swatch = rgb(category_colour(1));
+    assert!(img.pixels().filter(|&&c| c == swatch).count() >= 64);
+}
+
+/// Two unit spheres side by side (x = 0 and 3) and mesh edges along z = 0, behind them
+/// (y = 2) or in front (y = -2), seen from the front (-y); the face's other edges run down
+/// and out of the view (not under the title of the colour bar).
+fn spheres_and_an_edge(y: f64) -> (RgbImage, RgbImage) {
+    let style = Style {
+        width: 400,
+        height: 300,
+        color: ColorBy::Speed,
+        view: View::Front,
+        scale_bar: false,
+    };
+    let mut p = one(DVec3::ZERO, DVec3::ZERO);
+    p.push(one(DVec3::new(3.0, 0.0, 0.0), DVec3::ZERO).get(0));
+    let off = format!("OFF\n3 1 0\n-3 {y} 0\n6 {y} 0\n1.5 {y} -5\n3 0 1 2\n");
+    let mesh = Mesh::parse_off(&off, "t.off", &[0.0]).unwrap();
+    let plain = render(&p, &Mesh::default(), &style).unwrap();
+    (plain, render(&p, &mesh, &style).unwrap())
+}
+
+/// The pixels where the second picture differs from the first, and of those the ones where
+/// the first shows a sphere.
+fn drawn_over(plain: &RgbImage, with: &RgbImage) -> (usize, usize) {
+    let drawn: Vec<(u32, u32)> = (plain.enumerate_pixels())
+        .filter(|(x, y, c)| with.get_pixel(*x, *y) != *c)
+        .map(|(x, y, _)| (x, y))
+        .collect();
+    let over = drawn
+        .iter()
+        .filter(|(x, y)| *plain.get_pixel(*x, *y) != BACKGROUND)
+        .count();
+    (drawn.len(), over)
+}
+
+#[test]
+fn edges_behind_a_sphere_are_hidden_and_in_front_drawn() {
+    let (plain, behind) = spheres_and_an_edge(2.0);
+    let (drawn, over) = drawn_over(&plain, &behind);
+    // The edge shows between and beside the spheres, never across them.
+    assert!(drawn > 40, "{drawn}");
+    assert_eq!(over, 0);
+    let (plain, front) = spheres_and_an_edge(-2.0);
+    let (drawn, over) = drawn_over(&plain, &front);
+    assert!(drawn > 40 && over > 40, "{drawn} {over}");
+}
+
+#[test]
+fn gif_frames_are_dithered_without_bands() {
+    // A colour map along y shaded from dark to light along x, as on many spheres.
+    let img = RgbImage::from_fn(256, 64, |x, y| {
+        let s = y as f64 / 63.0;
+        let hue = [0.27 + 0.7 * s, 0.0 + 0.9 * s.sqrt(), 0.33 + 0.3 * (1.0 - s)];
+        let shade = 0.35 + 0.65 * x as f64 / 255.0;
+        Rgb(hue.map(|c| (255.0 * c * shade).round() as u8))
+    });
+    let out = dithered(img.clone());
+    let colours: std::collections::HashSet<[u8; 4]> = out.pixels().map(|p| p.0).collect();
+    assert!(colours.len() <= 256, "{}", colours.len());
+    // The 8 x 8 blocks keep their mean colours, on average within a level or two: no bands.
+    let block_error = |f: &dyn Fn(u32, u32) -> [u8; 3]| {
+        let mut total = 0.0f64;
+        for (bx, by) in (0..32).flat_map(|bx| (0..8).map(move |by| (bx, by))) {
+            for c in 0..3 {
+                let (mut a, mut b) = (0.0, 0.0);
+                for (x, y) in (0..8).flat_map(|i| (0..8).map(move |j| (8 * bx + i, 8 * by + j))) {
+                    a += img.get_pixel(x, y).0[c] as f64;
+                    b += f(x, y)[c] as f64;
+                }
+                total += (a - b).abs() / 64.0;
+            }
+        }
+        total / (32.0 * 8.0 * 3.0)
+    };
+    let smooth = block_error(&|x, y| {
+        let p = out.get_pixel(x, y).0;
+        [p[0], p[1], p[2]]
+    });
+    // The nearest palette colour of each pixel alone makes steps (bands).
+    let palette = color_quant::NeuQuant::new(
+        1,
+        256,
+        image::DynamicImage::ImageRgb8(img.clone())
+            .to_rgba8()
+            .as_raw(),
+    );
+    let banded = block_error(&|x, y| {
+        let p = img.get_pixel(x, y).0;
+        let mut q = [p[0], p[1], p[2], 255];
+        palette.map_pixel(&mut q);
+        [q[0], q[1], q[2]]
+    });
+    assert!(smooth < 1.2 && banded > 1.5 * smooth, "{smooth} {banded}");
+}
