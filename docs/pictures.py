@@ -86,6 +86,12 @@ def picture(src, target, **kw):
 def hourglass():
     out = run("hourglass", EXAMPLES / "a_hourglass" / "scenario.toml")
     picture(frame(out, 100), DOCS / "hourglass.png", color="height", scale_bar=True)
+    target = DOCS / "hourglass_energy.svg"
+    subprocess.run(
+        [str(BINARY), "plot", str(out / "log.csv"), "-y", "kinetic_energy,rotational_energy",
+         "--log-y", "-o", str(target)],
+        check=True,
+    )
 
 
 def b():

@@ -67,17 +67,22 @@ fn one(x: DVec3, v: DVec3) -> Particles {
     .collect()
 }
 
+/// A 400 x 300 picture from the front, coloured by `color`.
+fn front(color: ColorBy) -> Style {
+    Style {
+        width: 400,
+        height: 300,
+        color,
+        view: View::Front,
+        scale_bar: false,
+    }
+}
+
 /// In one layout the view and the colour bar stay put: a slow particle that moved has
 /// its speed's colour on the bar of the fast one, the bar and the frame do not change.
 #[test]
 fn one_layout_keeps_the_view_and_the_colours() {
-    let style = Style {
-        width: 400,
-        height: 300,
-        color: ColorBy::Speed,
-        view: View::Front,
-        scale_bar: false,
-    };
+    let style = front(ColorBy::Speed);
     let a = one(DVec3::ZERO, DVec3::new(4.0, 0.0, 0.0));
     let b = one(DVec3::new(5.0, 0.0, 0.0), DVec3::new(1.0, 0.0, 0.0));
     let mut layout = Layout::of(&a, &Mesh::default(), &style);
@@ -115,13 +120,7 @@ fn one_layout_keeps_the_view_and_the_colours() {
 
 #[test]
 fn categories_get_a_legend_with_names() {
-    let style = Style {
-        width: 400,
-        height: 300,
-        color: ColorBy::Material,
-        view: View::Front,
-        scale_bar: false,
-    };
+    let style = front(ColorBy::Material);
     let mut p = one(DVec3::ZERO, DVec3::ZERO);
     p.material[0] = 1;
     let mut layout = Layout::of(&p, &Mesh::default(), &style);
@@ -136,13 +135,7 @@ fn categories_get_a_legend_with_names() {
 /// (y = 2) or in front (y = -2), seen from the front (-y); the face's other edges run down
 /// and out of the view (not under the title of the colour bar).
 fn spheres_and_an_edge(y: f64) -> (RgbImage, RgbImage) {
-    let style = Style {
-        width: 400,
-        height: 300,
-        color: ColorBy::Speed,
-        view: View::Front,
-        scale_bar: false,
-    };
+    let style = front(ColorBy::Speed);
     let mut p = one(DVec3::ZERO, DVec3::ZERO);
     p.push(one(DVec3::new(3.0, 0.0, 0.0), DVec3::ZERO).get(0));
     let off = format!("OFF\n3 1 0\n-3 {y} 0\n6 {y} 0\n1.5 {y} -5\n3 0 1 2\n");
