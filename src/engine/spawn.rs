@@ -2,7 +2,7 @@
 //! regions with a count, a rate, a time window, a material, a velocity and a distribution of
 //! radii.
 
-use glam::{DQuat, DVec3};
+use glam::DVec3;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rustc_hash::FxHashMap;
@@ -226,7 +226,6 @@ impl Spawner {
         t: f64,
         present: f64,
     ) -> usize {
-        let g = &s.geometry;
         let max = s.simulation.max_particles;
         let attempts = s.simulation.spawn_attempts;
         if attempts == 0 || particles.next_id as u64 >= max || (s.spawn.is_empty() && self.box_off)
@@ -234,32 +233,7 @@ impl Spawner {
             return 0;
         }
         if s.spawn.is_empty() {
-            let uniform = RadiusDistribution::Uniform {
-                min: g.radius_min,
-                max: g.radius_max,
-            };
-            let source = Source {
-                region: Region {
-                    min: g.spawn_min,
-                    max: g.spawn_max,
-                },
-                radius: &uniform,
-                velocity: s.kinetics.initial_velocity,
-                material: 0,
-            };
-            let mut pending = self.pending_radius;
-            let n = self.insert(
-                s,
-                &source,
-                attempts,
-                u64::MAX,
-                &mut pending,
-                (particles, present),
-                faces,
-                face_grid,
-            );
-            self.pending_radius = pending;
-            return n as usize;
+            return self.spawn_in_box(s, particles, faces, face_grid, present);
         }
         self.regions.resize(s.spawn.len(), RegionState::default());
         let dt = s.simulation.timestep;
@@ -297,6 +271,45 @@ impl Spawner {
             added += n as usize;
         }
         added
+    }
+
+    /// Spawns in the `[geometry]` spawn box (a scenario without `[[spawn]]` regions): radii
+    /// uniform in [R_min, R_max], material 0.
+    fn spawn_in_box(
+        &mut self,
+        s: &Scenario,
+        particles: &mut Particles,
+        faces: &[Face],
+        face_grid: &CellGrid,
+        present: f64,
+    ) -> usize {
+        let (g, attempts) = (&s.geometry, s.simulation.spawn_attempts);
+        let uniform = RadiusDistribution::Uniform {
+            min: g.radius_min,
+            max: g.radius_max,
+        };
+        let source = Source {
+            region: Region {
+                min: g.spawn_min,
+                max: g.spawn_max,
+            },
+            radius: &uniform,
+            velocity: s.kinetics.initial_velocity,
+            material: 0,
+        };
+        let mut pending = self.pending_radius;
+        let n = self.insert(
+            s,
+            &source,
+            attempts,
+            u64::MAX,
+            &mut pending,
+            (particles, present),
+            faces,
+            face_grid,
+        );
+        self.pending_radius = pending;
+        n as usize
     }
 
     /// Up to `attempts` attempts to insert at most `budget` particles from `source`
@@ -354,11 +367,9 @@ impl Spawner {
                 x,
                 radius,
                 v: source.velocity,
-                q: DQuat::IDENTITY,
                 w: s.kinetics.initial_angular_velocity,
-                tag: 0,
                 material: source.material,
-                fixed: false,
+                ..Particle::default() // unrotated, untagged, free
             });
             inserted += 1;
         }

@@ -1,5 +1,6 @@
-//! The model: lanes of particles, exact sums, particles, springs, the contact law (Sec. 2.2 of the paper), materials and their mixing, integration and rigid motion. Imports nothing of the crate above it.
+//! The model: lanes of particles, exact sums, particles, springs, the contact law (Sec. 2.2 of the paper), materials and their mixing, integration and rigid motion, clumps (mass properties) and rigid-body rotation. Imports nothing of the crate above it.
 
+pub mod clump;
 pub mod contact;
 pub mod exact;
 pub mod integrate;
@@ -7,5 +8,6 @@ pub mod lanes;
 pub mod materials;
 pub mod motion;
 pub mod particles;
+pub mod rigid;
 pub mod servo;
 pub mod springs;
