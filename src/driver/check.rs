@@ -15,7 +15,7 @@ use crate::io::checkpoint;
 use crate::io::output::{OUTLETS, WALLS};
 use crate::model::contact::{ContactLaw, damping_factor};
 use crate::model::integrate::Inertia;
-use crate::scenario::{FrictionSprings, MeshInput, Scenario, Target};
+use crate::scenario::{FrictionSprings, MassSource, MeshInput, Scenario, Target};
 
 /// The derived quantities `tinydem check` prints.
 pub fn describe(s: &Scenario, out: &Path) -> Result<String> {
@@ -46,7 +46,7 @@ fn describe_start(s: &Scenario, out: &Path, sim: Simulation) -> Result<String> {
     let size = OutputEstimate::of(s, max_n, sim.walls.mesh.faces.len());
     let meshes = mesh_lines(s, &sim) + &servo_lines(s, &sim);
     let bounds = bound_lines(s, &sim);
-    let materials = material_lines(s);
+    let materials = material_lines(s) + &clump_lines(s);
     let default_dt = s.eq50_timestep();
     let until = until_line(s);
     Ok(format!(
@@ -317,6 +317,32 @@ fn radius_words(r: &crate::scenario::RadiusDistribution) -> String {
 }
 
 /// The materials and the coefficients of each pair of them (where named).
+/// Each clump template: its spheres, mass, principal moments and how they were found.
+fn clump_lines(s: &Scenario) -> String {
+    let mut lines = String::new();
+    for (k, c) in s.clumps.iter().enumerate() {
+        let how = match c.source {
+            MassSource::Computed { error } => {
+                format!("of the union, overlaps once: ray quadrature, error ~{error:.1e}")
+            }
+            MassSource::Given => "given".into(),
+        };
+        lines += &format!(
+            "{:<23}{k} \"{}\": {} spheres, bounding radius {:.6e} m, mass {:.6e} kg, principal \
+             moments {:.6e} {:.6e} {:.6e} kg m^2 ({how}); not yet spawned (issue 28)\n",
+            if k == 0 { "clumps" } else { "" },
+            c.name,
+            c.spheres.len(),
+            c.bounding_radius,
+            c.mass,
+            c.inertia.x,
+            c.inertia.y,
+            c.inertia.z
+        );
+    }
+    lines
+}
+
 fn material_lines(s: &Scenario) -> String {
     let mut materials = String::new();
     if s.materials.len() > 1 || s.materials[0].name != "default" {

@@ -26,6 +26,8 @@
 //!              starts are held in place and at rest; any number)
 //! [[spawn]]    min, max, material, velocity, count, rate, start, stop, radius = {
 //!              distribution = "uniform" | "normal" | "lognormal" | "table", ... }
+//! [[clumps]]  name, spheres = [[x, y, z, r], ...] | file, material, mass, inertia
+//!              (rigid clumps of spheres; not yet spawned)
 //! [[materials]] name, density, youngs_modulus, poisson_ratio, restitution, friction_*
 //! [[interactions]] materials = [a, b], restitution, friction_*
 //! [input]      particles
@@ -45,11 +47,13 @@ pub use crate::model::materials::{FrictionSprings, Material, PairCoefficients};
 use crate::model::motion::Motion;
 pub use crate::model::servo::{Servo, Target};
 
+mod clumps;
 mod meshes;
 mod raw;
 mod resolved;
 mod spawn;
 mod validate;
+pub use clumps::{ClumpTemplate, MassSource};
 pub use resolved::changes;
 
 /// The geometry of the paper's default hourglass (Fig. 5A), embedded so that `tinydem`
@@ -414,6 +418,8 @@ pub struct Scenario {
     pub outlets: Vec<Region>,
     /// Boxes whose particles are fixed when the run or stage starts (`[[fixed]]`).
     pub fixed: Vec<Region>,
+    /// Templates of rigid clumps of spheres (`[[clumps]]`), with their mass properties.
+    pub clumps: Vec<ClumpTemplate>,
     /// Insertion regions (`[[spawn]]`); when there are any, the `[geometry]` spawn box is not
     /// used.
     pub spawn: Vec<SpawnRegion>,

@@ -153,6 +153,18 @@ pub(super) struct RawBox {
     pub(super) max: [f64; 3],
 }
 
+/// `[[clumps]]`: a template of rigidly joined spheres.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawClump {
+    pub(super) name: String,
+    pub(super) spheres: Option<Vec<[f64; 4]>>,
+    pub(super) file: Option<PathBuf>,
+    pub(super) material: Option<String>,
+    pub(super) mass: Option<f64>,
+    pub(super) inertia: Option<[f64; 3]>,
+}
+
 #[derive(Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawScenario {
@@ -171,6 +183,8 @@ pub(super) struct RawScenario {
     pub(super) fixed: Vec<RawBox>,
     #[serde(default)]
     pub(super) spawn: Vec<RawSpawn>,
+    #[serde(default)]
+    pub(super) clumps: Vec<RawClump>,
     #[serde(default)]
     pub(super) geometry: RawGeometry,
     #[serde(default)]

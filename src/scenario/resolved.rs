@@ -21,6 +21,7 @@ impl Scenario {
         self.meshes_toml(&mut o);
         self.regions_toml(&mut o);
         self.spawn_toml(&mut o);
+        self.clumps_toml(&mut o);
         self.output_toml(&mut o);
         o
     }
@@ -231,6 +232,24 @@ impl Scenario {
                 let _ = writeln!(o, "stop = {}", num(r.stop));
             }
             let _ = writeln!(o, "radius = {}", radius(&r.radius));
+        }
+    }
+
+    fn clumps_toml(&self, o: &mut String) {
+        for c in &self.clumps {
+            let spheres: Vec<String> = (c.given.iter())
+                .map(|s| list(&[s.centre.x, s.centre.y, s.centre.z, s.radius]))
+                .collect();
+            let _ = writeln!(
+                o,
+                "\n[[clumps]]\nname = {}\nspheres = [{}]\nmaterial = {}",
+                text(&c.name),
+                spheres.join(", "),
+                self.material_name(c.material)
+            );
+            if c.source == super::MassSource::Given {
+                let _ = writeln!(o, "mass = {}\ninertia = {}", num(c.mass), vec3(c.inertia));
+            }
         }
     }
 

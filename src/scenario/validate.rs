@@ -203,7 +203,9 @@ impl Scenario {
             .map(|(k, b)| region(&format!("[[fixed]] #{}", k + 1), b, false))
             .collect::<Result<Vec<_>>>()?;
         let spawn = spawn(raw.spawn, &index, &kinetics, &geometry, &simulation, domain)?;
+        let clumps = super::clumps::clumps(raw.clumps, base, &geometry, &materials, &index)?;
         Ok(Scenario {
+            clumps,
             geometry,
             material,
             materials,
