@@ -94,16 +94,27 @@ def hourglass():
     )
 
 
+def off_bounds(path):
+    """The box around the vertices of an OFF mesh: the view of a picture that shows all of
+    it (render fits the view to the particles unless given bounds)."""
+    lines = [l for l in Path(path).read_text().splitlines() if l.strip() and not l.startswith("#")]
+    n = int(lines[1].split()[0])
+    v = np.array([[float(t) for t in l.split()[:3]] for l in lines[2:2 + n]])
+    return tuple(v.min(axis=0)), tuple(v.max(axis=0))
+
+
 def b():
     out = run("b", EXAMPLES / "b_mixture" / "scenario.toml")
     picture(frame(out, 30), DOCS / "b_mixture.png", color="tag", view="front",
-            width=400, height=600, scale_bar=True)
+            width=400, height=600, scale_bar=True,
+            bounds=off_bounds(EXAMPLES / "b_mixture" / "separator.off"))
 
 
 def c():
     out = run("c", EXAMPLES / "c_marble_run" / "scenario.toml")
     picture(frame(out, frame_at(out, 7.6)), DOCS / "c_marble_run.png", width=640,
-            height=540, scale_bar=True)
+            height=540, scale_bar=True,
+            bounds=off_bounds(EXAMPLES / "c_marble_run" / "course.off"))
 
 
 def d():
