@@ -37,13 +37,7 @@ impl Simulation {
         let mut gone = self.stored_at(ids)?;
         gone.sort_unstable();
         gone.dedup();
-        self.neighbours.rebuild_without(
-            &mut self.particles,
-            &gone,
-            &self.walls.mesh.faces,
-            &self.face_grid,
-        );
-        self.built();
+        self.drop_stored(&gone);
         Ok(())
     }
 
@@ -59,6 +53,18 @@ impl Simulation {
             }
         }
         Ok(())
+    }
+
+    /// Removes the particles stored at `gone` (ascending, each once) and the springs of
+    /// their contacts, and makes the lists anew for the others.
+    pub(super) fn drop_stored(&mut self, gone: &[u32]) {
+        self.neighbours.rebuild_without(
+            &mut self.particles,
+            gone,
+            &self.walls.mesh.faces,
+            &self.face_grid,
+        );
+        self.built();
     }
 
     /// The storage index of each particle of `ids` (each must be present).

@@ -58,13 +58,7 @@ impl Simulation {
             out.mass += Inertia::mass_with(p.radius[i as usize], material.mass_per_r3);
         }
         let gone: Vec<u32> = gone.into_iter().map(|(i, _)| i).collect();
-        self.neighbours.rebuild_without(
-            &mut self.particles,
-            &gone,
-            &self.walls.mesh.faces,
-            &self.face_grid,
-        );
-        self.built();
+        self.drop_stored(&gone);
     }
 
     /// Whether frames name each particle's id and material: particles can be removed (or
