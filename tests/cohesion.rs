@@ -27,6 +27,7 @@ fn grain(x: DVec3) -> Particle {
         tag: 0,
         material: 0,
         fixed: false,
+        body: None,
     }
 }
 

@@ -25,6 +25,7 @@ fn at_rest(x: DVec3, v: DVec3) -> Particle {
         tag: 0,
         material: 0,
         fixed: false,
+        body: None,
     }
 }
 

@@ -121,6 +121,7 @@ fn the_kinetic_stress_of_a_gas_is_its_momentum_flux() {
                 tag: 0,
                 material: 0,
                 fixed: false,
+                body: None,
             }
         })
         .collect();

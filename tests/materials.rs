@@ -31,6 +31,7 @@ fn grain(x: DVec3, v: DVec3, material: u16) -> Particle {
         tag: 0,
         material,
         fixed: false,
+        body: None,
     }
 }
 

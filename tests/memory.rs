@@ -30,6 +30,7 @@ fn pair(speed: f64) -> Simulation {
         tag: 0,
         material: 0,
         fixed: false,
+        body: None,
     };
     // Two pairs of neighbours (listed, so not "lonely": each pair's lists are rebuilt every
     // half skin of travel), 1 mm apart within a pair.

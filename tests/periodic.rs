@@ -21,6 +21,7 @@ fn grain(x: DVec3, v: DVec3, w: DVec3) -> Particle {
         tag: 0,
         material: 0,
         fixed: false,
+        body: None,
     }
 }
 

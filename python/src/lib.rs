@@ -305,6 +305,7 @@ impl Simulation {
                 tag,
                 material,
                 fixed: false,
+                body: None,
             })
             .collect();
         let ids = self
@@ -441,6 +442,7 @@ impl Simulation {
             tag: self.sim.has_tags(),
             ids: self.sim.frames_carry_ids(),
             fixed: self.sim.has_fixed(),
+            clump: !self.sim.scenario.clumps.is_empty(),
         };
         let dir = path.parent().filter(|d| !d.as_os_str().is_empty());
         let name = path

@@ -272,22 +272,33 @@ fn spawn_lines(s: &Scenario, box_off: bool) -> String {
     }
     let mut lines = String::new();
     for (k, r) in s.spawn.iter().enumerate() {
+        let what = if r.clump.is_some() {
+            "clumps"
+        } else {
+            "particles"
+        };
         let amount = match (r.count, r.rate) {
-            (Some(n), Some(q)) => format!("{n} particles at {q}/s"),
-            (Some(n), None) => format!("{n} particles"),
-            (None, Some(q)) => format!("{q} particles/s"),
-            (None, None) => "particles".to_string(),
+            (Some(n), Some(q)) => format!("{n} {what} at {q}/s"),
+            (Some(n), None) => format!("{n} {what}"),
+            (None, Some(q)) => format!("{q} {what}/s"),
+            (None, None) => what.to_string(),
+        };
+        let made_of = match r.clump {
+            Some(c) => format!(
+                "clump \"{}\" scaled by {} to {}, oriented at random",
+                s.clumps[c.template as usize].name, c.scale.0, c.scale.1
+            ),
+            None => format!("R {}", radius_words(&r.radius)),
         };
         let window = match (r.start, r.stop) {
             (a, b) if a == 0.0 && b == f64::INFINITY => String::new(),
             (a, b) => format!(", from t = {a} to {b} s"),
         };
         lines += &format!(
-            "{:<23}{} .. {}: {amount}{window}, R {}\n",
+            "{:<23}{} .. {}: {amount}{window}, {made_of}\n",
             format!("spawn region {}", k + 1),
             r.region.min,
             r.region.max,
-            radius_words(&r.radius)
         );
     }
     lines + &format!("                       in all at most {most} particles (max_particles)\n")
@@ -329,7 +340,7 @@ fn clump_lines(s: &Scenario) -> String {
         };
         lines += &format!(
             "{:<23}{k} \"{}\": {} spheres, bounding radius {:.6e} m, mass {:.6e} kg, principal \
-             moments {:.6e} {:.6e} {:.6e} kg m^2 ({how}); not yet spawned (issue 28)\n",
+             moments {:.6e} {:.6e} {:.6e} kg m^2 ({how})\n",
             if k == 0 { "clumps" } else { "" },
             c.name,
             c.spheres.len(),

@@ -30,6 +30,7 @@ impl<'a> Frames<'a> {
                 tag: sim.has_tags(),
                 ids: sim.frames_carry_ids(),
                 fixed: sim.has_fixed(),
+                clump: !sim.scenario.clumps.is_empty(),
             },
             frame_time: sim.scenario.simulation.steps_per_frame as f64
                 * sim.scenario.simulation.timestep,

@@ -5,7 +5,8 @@ use super::*;
 
 /// Stage 5 (Section 2.3): advance each particle of `p` by `dt` under gravity `g` and the
 /// force and torque its contacts added to its load (Eqs. 1-2), which it uses up (zeroes).
-/// A fixed particle keeps its place and orientation, at rest; its load is dropped.
+/// A fixed particle keeps its place and orientation, at rest; its load is dropped. A
+/// sphere of a rigid body keeps the state stage 5a gave it.
 /// Returns whether some particle's new state is not finite (for stage 6, so that it needs
 /// no pass of its own).
 #[inline(never)] // a stage of its own in profiles
@@ -18,7 +19,7 @@ pub(super) fn run(
     let scales = &model.scales;
     let densities = &model.densities;
     let uniform = densities.len() == 1;
-    let (material, fixed) = (&p.material, &p.fixed);
+    let (material, fixed, member) = (&p.material, &p.fixed, &p.body);
     (
         p.x.par_chunks_mut(WIDTH),
         p.v.par_chunks_mut(WIDTH),
@@ -26,12 +27,12 @@ pub(super) fn run(
         p.w.par_chunks_mut(WIDTH),
         p.radius.par_chunks(WIDTH),
         material.par_chunks(WIDTH),
-        fixed.par_chunks(WIDTH),
+        (fixed.par_chunks(WIDTH), member.par_chunks(WIDTH)),
         loads.par_chunks_mut(WIDTH),
     )
         .into_par_iter()
         .with_min_len(MIN_PARALLEL_LEN.div_ceil(WIDTH))
-        .map(|(x, v, q, w, radius, material, fixed, load)| {
+        .map(|(x, v, q, w, radius, material, (fixed, member), load)| {
             // `WIDTH` particles at a time in lanes; a short last group repeats its last
             // particle in the spare lanes. The loads are used up (zeroed for the next
             // step).
@@ -74,8 +75,14 @@ pub(super) fn run(
                 Group::scatter_quat(new.q),
                 Group::scatter_vec(new.w),
             );
-            if fixed.contains(&true) {
-                hold(fixed, (x, v, q, w), (&new_x, &new_v, &new_q, &new_w));
+            if fixed.contains(&true) || member.iter().any(Option::is_some) {
+                let held = |l: usize| match (fixed[l], member[l]) {
+                    (_, Some(_)) => Held::Member,
+                    (true, None) => Held::Fixed,
+                    (false, None) => Held::Free,
+                };
+                let held: Vec<Held> = (0..n).map(held).collect();
+                hold(&held, (x, v, q, w), (&new_x, &new_v, &new_q, &new_w));
             } else {
                 x.copy_from_slice(&new_x[..n]);
                 v.copy_from_slice(&new_v[..n]);
@@ -87,9 +94,20 @@ pub(super) fn run(
         .reduce(|| false, |a, b| a || b)
 }
 
-/// The new states of a group with fixed particles: those stay where they are, at rest.
+/// What the integration does with a particle.
+#[derive(Clone, Copy, PartialEq)]
+enum Held {
+    Free,
+    /// Fixed: stays where it is, at rest.
+    Fixed,
+    /// A sphere of a rigid body: moved by stage 5a.
+    Member,
+}
+
+/// The new states of a group with fixed particles or spheres of bodies: fixed ones stay
+/// where they are, at rest, the spheres of bodies as they are.
 fn hold(
-    fixed: &[bool],
+    held: &[Held],
     (x, v, q, w): (&mut [DVec3], &mut [DVec3], &mut [glam::DQuat], &mut [DVec3]),
     new: (
         &[DVec3; WIDTH],
@@ -98,11 +116,11 @@ fn hold(
         &[DVec3; WIDTH],
     ),
 ) {
-    for (l, &held) in fixed.iter().enumerate() {
-        if held {
-            (v[l], w[l]) = (DVec3::ZERO, DVec3::ZERO);
-        } else {
-            (x[l], v[l], q[l], w[l]) = (new.0[l], new.1[l], new.2[l], new.3[l]);
+    for (l, &held) in held.iter().enumerate() {
+        match held {
+            Held::Fixed => (v[l], w[l]) = (DVec3::ZERO, DVec3::ZERO),
+            Held::Member => {}
+            Held::Free => (x[l], v[l], q[l], w[l]) = (new.0[l], new.1[l], new.2[l], new.3[l]),
         }
     }
 }

@@ -30,11 +30,46 @@ impl Simulation {
         Ok((first..self.particles.next_id).collect())
     }
 
+    /// Adds a clump of `[[clumps]]` template `template`, its lengths scaled by `scale`, with
+    /// its centre of mass at `x`, orientation `q` (body to world), velocity `v` and angular
+    /// velocity `w`; returns the id of its first sphere (the body's id). Overlaps are not
+    /// checked; the lists take it in at the next step.
+    pub fn add_clump(
+        &mut self,
+        template: usize,
+        scale: f64,
+        (x, q, v, w): (DVec3, glam::DQuat, DVec3, DVec3),
+    ) -> Result<u32> {
+        self.refuse_split("add clumps")?;
+        let Some(t) = self.scenario.clumps.get(template) else {
+            bail!(
+                "there is no clump template {template} ({} in [[clumps]])",
+                self.scenario.clumps.len()
+            );
+        };
+        if !(scale > 0.0 && scale.is_finite()) {
+            bail!("scale = {scale} must be finite and > 0");
+        }
+        let first = self.particles.next_id;
+        let motion = (x, q.normalize(), v, w);
+        spawn::place_clump(&mut self.particles, (t, template as u16), scale, motion);
+        self.particles_moved();
+        Ok(first)
+    }
+
     /// Removes the particles of `ids` (each must be present) and the springs of their
     /// contacts; the others keep theirs. Not counted as outflow.
     pub fn remove_particles(&mut self, ids: &[u32]) -> Result<()> {
         self.refuse_split("remove particles")?;
         let mut gone = self.stored_at(ids)?;
+        // A sphere of a clump takes its whole body with it.
+        let p = &self.particles;
+        for k in gone.clone() {
+            if let Some(b) = p.body[k as usize] {
+                let b = p.bodies.index_of(b).expect("a listed body");
+                gone.extend_from_slice(p.bodies.members(b));
+            }
+        }
         gone.sort_unstable();
         gone.dedup();
         self.drop_stored(&gone);
@@ -47,6 +82,12 @@ impl Simulation {
         self.refuse_split("fix particles")?;
         for k in self.stored_at(ids)? {
             let k = k as usize;
+            if self.particles.body[k].is_some() {
+                bail!(
+                    "particle {} is a sphere of a clump: clumps cannot be fixed (yet)",
+                    self.particles.id[k]
+                );
+            }
             self.particles.fixed[k] = fixed;
             if fixed {
                 (self.particles.v[k], self.particles.w[k]) = (DVec3::ZERO, DVec3::ZERO);

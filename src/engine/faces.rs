@@ -337,6 +337,7 @@ impl FaceStage<'_> {
                 Coefficients::gather(std::array::from_fn(|l| self.law.with_wall(m[l], f[l]))),
             )
         };
+        let mass = body_masses(self.p, &i, mass);
         let mut lanes = gather_springs(store, e);
         let force = self
             .law

@@ -29,6 +29,7 @@ use crate::neighbours::{
 use crate::parallel::domain::Domain;
 
 mod advance;
+mod bodies;
 mod checks;
 mod edit;
 mod faces;
@@ -70,13 +71,33 @@ pub(crate) struct Model {
 }
 
 impl Model {
-    /// The mass of particle `k` of `p`.
+    /// The mass of particle `k` of `p` (of its body, for a sphere of a rigid body).
     fn mass(&self, p: &Particles, k: usize) -> f64 {
+        if let Some(b) = p.body[k] {
+            return p.bodies.mass_of(b);
+        }
         Inertia::mass_with(
             p.radius[k],
             self.densities[p.material[k] as usize].mass_per_r3,
         )
     }
+}
+
+/// The masses `m` of the particles `idx` of `p` in lanes, with those of the spheres of
+/// rigid bodies replaced by their body's: a clump's sphere enters the contact law with the
+/// clump's mass.
+#[inline(always)]
+fn body_masses(p: &Particles, idx: &[usize; WIDTH], m: Group) -> Group {
+    if p.bodies.is_empty() {
+        return m;
+    }
+    let mut m = m.scatter();
+    for (l, &k) in idx.iter().enumerate() {
+        if let Some(b) = p.body[k] {
+            m[l] = p.bodies.mass_of(b);
+        }
+    }
+    Group::gather(m)
 }
 
 /// What the contact stages of a step find beside the loads, for the stability check: the
@@ -188,6 +209,7 @@ pub enum Stage {
     Neighbours,
     ParticleContacts,
     MeshContacts,
+    Bodies,
     Integrate,
     Tag,
     Exchange,
@@ -196,12 +218,13 @@ pub enum Stage {
 }
 
 impl Stage {
-    pub const ALL: [Stage; 10] = [
+    pub const ALL: [Stage; 11] = [
         Stage::MoveMeshes,
         Stage::Spawn,
         Stage::Neighbours,
         Stage::ParticleContacts,
         Stage::MeshContacts,
+        Stage::Bodies,
         Stage::Integrate,
         Stage::Tag,
         Stage::Exchange,
@@ -216,6 +239,7 @@ impl Stage {
             Stage::Neighbours => "neighbour lists",
             Stage::ParticleContacts => "particle contacts",
             Stage::MeshContacts => "mesh contacts",
+            Stage::Bodies => "rigid bodies",
             Stage::Integrate => "integrate",
             Stage::Tag => "tag",
             Stage::Exchange => "exchange",
@@ -503,7 +527,10 @@ impl Simulation {
             self.scenario.simulation.timestep,
             self.scenario.kinetics.gravity,
         );
-        let non_finite = advance::run(&self.model, (dt, g), &mut self.particles, &mut self.loads);
+        let bodies_non_finite = bodies::run(&self.model, (dt, g), &mut self.particles, &self.loads);
+        let t = self.stage_times.add(Stage::Bodies, t);
+        let non_finite = advance::run(&self.model, (dt, g), &mut self.particles, &mut self.loads)
+            | bodies_non_finite;
         let t = self.stage_times.add(Stage::Integrate, t);
         regions::tag(&self.scenario.tags, &mut self.particles);
         let t = self.stage_times.add(Stage::Tag, t);

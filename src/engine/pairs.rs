@@ -183,6 +183,17 @@ impl PairStage<'_> {
         }
     }
 
+    /// The masses of the particles `idx` (of radii `radius`) in lanes: a sphere of a rigid
+    /// body enters the law with the body's mass.
+    #[inline(always)]
+    fn masses(&self, idx: &[usize; WIDTH], radius: Group) -> Group {
+        body_masses(
+            self.p,
+            idx,
+            Inertia::mass_with(radius, self.mass_per_r3(idx)),
+        )
+    }
+
     /// One slab of the pair list: its touching pairs, then the law for `WIDTH` of them at a
     /// time, added to the loads of the slab's particles and of the `next` slab's.
     #[inline]
@@ -275,9 +286,9 @@ impl PairStage<'_> {
         let mut lanes = gather_springs(store, c);
         let other = Other::Particle {
             r: body_j.radius,
-            m: Inertia::mass_with(body_j.radius, self.mass_per_r3(&j)),
+            m: self.masses(&j, body_j.radius),
         };
-        let m_i = Inertia::mass_with(body_i.radius, self.mass_per_r3(&i));
+        let m_i = self.masses(&i, body_i.radius);
         let coef = if self.uniform {
             self.one_pair
         } else {

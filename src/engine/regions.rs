@@ -32,12 +32,16 @@ impl Simulation {
             return self.remove_split(fate);
         }
         let p = &self.particles;
-        let gone: Vec<(u32, u32)> =
-            p.x.par_iter()
-                .enumerate()
-                .with_min_len(4 * MIN_PARALLEL_LEN)
-                .filter_map(|(i, x)| fate(*x).map(|f| (i as u32, f)))
-                .collect();
+        // A rigid body goes whole, where its centre of mass goes.
+        let centre = |i: usize| match p.body[i] {
+            Some(b) => p.bodies.list[p.bodies.index_of(b).expect("a listed body")].x,
+            None => p.x[i],
+        };
+        let gone: Vec<(u32, u32)> = (0..p.len())
+            .into_par_iter()
+            .with_min_len(4 * MIN_PARALLEL_LEN)
+            .filter_map(|i| fate(centre(i)).map(|f| (i as u32, f)))
+            .collect();
         if gone.is_empty() {
             return;
         }
@@ -48,14 +52,22 @@ impl Simulation {
             .collect();
         by_id.sort_unstable();
         let densities = &self.model.densities;
-        for &(_, i, f) in &by_id {
+        for &(id, i, f) in &by_id {
             let out = match self.removed.outlets.get_mut(f as usize) {
                 Some(o) => o,
                 None => &mut self.removed.domain,
             };
+            let mass = match p.body[i as usize] {
+                // A body counts once, by its first sphere, with its mass.
+                Some(b) if id != b.first() => continue,
+                Some(b) => p.bodies.mass_of(b),
+                None => {
+                    let material = densities[p.material[i as usize] as usize];
+                    Inertia::mass_with(p.radius[i as usize], material.mass_per_r3)
+                }
+            };
             out.count += 1;
-            let material = densities[p.material[i as usize] as usize];
-            out.mass += Inertia::mass_with(p.radius[i as usize], material.mass_per_r3);
+            out.mass += mass;
         }
         let gone: Vec<u32> = gone.into_iter().map(|(i, _)| i).collect();
         self.drop_stored(&gone);
@@ -68,6 +80,7 @@ impl Simulation {
         let p = &self.particles;
         self.scenario.removes()
             || self.scenario.materials.len() > 1
+            || !self.scenario.clumps.is_empty()
             || p.next_id as usize != self.particle_count()
     }
 

@@ -140,8 +140,9 @@ impl Simulation {
     /// the contacts of the last step and the deepest of them relative to the smaller radius.
     pub fn thermo(&self) -> Thermo {
         let p = &self.particles;
+        // A grain each: a plain sphere, or a rigid body (counted once, by its first sphere).
         let mut energies: Vec<(u32, f64, f64)> = (0..p.len())
-            .filter(|&k| self.own(k))
+            .filter(|&k| self.own(k) && p.body[k].is_none())
             .map(|k| {
                 let m = Inertia::mass_with(
                     p.radius[k],
@@ -155,6 +156,10 @@ impl Simulation {
                 )
             })
             .collect();
+        energies.extend(p.bodies.list.iter().map(|b| {
+            let (t, r) = b.kinetic_energy();
+            (b.id.first(), t, r)
+        }));
         if let Some(d) = &self.domain {
             // Over all processes, still in id order.
             use crate::parallel::comm::{Reader, Writer};

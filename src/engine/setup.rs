@@ -354,9 +354,10 @@ impl Simulation {
     }
 
     /// Fixes the particles whose centre lies in one of `boxes` (`[[fixed]]`).
+    /// (Clumps are not fixed: they move as bodies.)
     fn fix_within(p: &mut Particles, boxes: &[crate::scenario::Region]) {
-        for (x, fixed) in p.x.iter().zip(&mut p.fixed) {
-            *fixed |= boxes.iter().any(|b| b.contains(*x));
+        for ((x, fixed), body) in p.x.iter().zip(&mut p.fixed).zip(&p.body) {
+            *fixed |= body.is_none() && boxes.iter().any(|b| b.contains(*x));
         }
     }
 

@@ -8,9 +8,12 @@ use rand_chacha::ChaCha8Rng;
 use rustc_hash::FxHashMap;
 
 use crate::geometry::mesh::Face;
+use crate::model::bodies::{Body, BodyId};
 use crate::model::particles::{Particle, Particles};
 use crate::neighbours::{CellGrid, Periodic, cell_of, key};
-use crate::scenario::{RadiusDistribution, Region, Scenario, SpawnRegion};
+use crate::scenario::{
+    ClumpTemplate, RadiusDistribution, Region, Scenario, SpawnClump, SpawnRegion,
+};
 
 /// Draws spawn attempts from a seeded random stream, so the same seed gives the same run.
 #[derive(Clone, Debug)]
@@ -127,6 +130,8 @@ struct Source<'a> {
     radius: &'a RadiusDistribution,
     velocity: DVec3,
     material: u16,
+    /// Clumps instead of spheres.
+    clump: Option<SpawnClump>,
 }
 
 impl Spawner {
@@ -252,9 +257,16 @@ impl Spawner {
                 radius: &r.radius,
                 velocity: r.velocity,
                 material: r.material,
+                clump: r.clump,
             };
             let mut pending = state.pending_radius;
-            let n = self.insert(
+            let insert = if r.clump.is_some() {
+                Spawner::insert_clumps
+            } else {
+                Spawner::insert
+            };
+            let n = insert(
+                self,
                 s,
                 &source,
                 attempts,
@@ -296,6 +308,7 @@ impl Spawner {
             radius: &uniform,
             velocity: s.kinetics.initial_velocity,
             material: 0,
+            clump: None,
         };
         let mut pending = self.pending_radius;
         let n = self.insert(
@@ -375,6 +388,136 @@ impl Spawner {
         }
         inserted
     }
+}
+
+impl Spawner {
+    /// As [`Spawner::insert`], for a region that inserts clumps: each attempt draws a scale
+    /// (`pending` carries a failed attempt's over), an orientation uniform over rotations
+    /// and a centre, and is rejected if any of the clump's spheres would overlap a particle
+    /// or a face. A clump of one sphere is inserted as a plain sphere. Returns how many
+    /// clumps it inserted.
+    #[allow(clippy::too_many_arguments)]
+    fn insert_clumps(
+        &mut self,
+        s: &Scenario,
+        source: &Source,
+        attempts: u64,
+        budget: u64,
+        pending: &mut Option<f64>,
+        (particles, present): (&mut Particles, f64),
+        faces: &[Face],
+        face_grid: &CellGrid,
+    ) -> u64 {
+        let clump = source.clump.expect("a clump region");
+        let t = &s.clumps[clump.template as usize];
+        let max = s.simulation.max_particles;
+        let h = 2.0
+            * s.geometry
+                .radius_max
+                .max(particles.max_radius())
+                .max(present);
+        let reach = t.bounding_radius * clump.scale.1;
+        let near = Region {
+            min: source.region.min - DVec3::splat(reach),
+            max: source.region.max + DVec3::splat(reach),
+        };
+        let mut crowd = Crowd::of(particles, &near, h, self.periodic);
+        let (lo, hi) = (source.region.min, source.region.max);
+        let mut inserted = 0;
+        for _ in 0..attempts {
+            if particles.next_id as u64 + t.spheres.len() as u64 > max || inserted >= budget {
+                break;
+            }
+            let scale = match *pending {
+                Some(f) => f,
+                None => uniform(&mut self.rng, clump.scale.0, clump.scale.1),
+            };
+            let q = uniform_rotation(&mut self.rng);
+            let x = DVec3::new(
+                uniform(&mut self.rng, lo.x, hi.x),
+                uniform(&mut self.rng, lo.y, hi.y),
+                uniform(&mut self.rng, lo.z, hi.z),
+            );
+            let spheres: Vec<(DVec3, f64)> = (t.spheres.iter())
+                .map(|sp| (x + q * (sp.centre * scale), sp.radius * scale))
+                .collect();
+            let free = spheres.iter().all(|&(at, radius)| {
+                crowd.free(particles, at, radius)
+                    && face_grid.at(at).iter().all(|&f| {
+                        let face = &faces[f as usize];
+                        let reach = radius + face.radius;
+                        face.separation(at).length_squared() >= reach * reach
+                    })
+            });
+            if !free {
+                *pending = Some(scale);
+                continue;
+            }
+            *pending = None;
+            let first = particles.len();
+            for (k, &(at, _)) in spheres.iter().enumerate() {
+                crowd.add(at, first + k);
+            }
+            let motion = (x, q, source.velocity, s.kinetics.initial_angular_velocity);
+            place_clump(particles, (t, clump.template), scale, motion);
+            inserted += 1;
+        }
+        inserted
+    }
+}
+
+/// Adds a clump of template `t` (its index `template`) scaled by `scale`, with its centre of
+/// mass at `x`, orientation `q`, velocity `v` and angular velocity `w` (`motion`): a rigid
+/// body of its spheres, or a plain sphere for a template of one sphere (which moves as a
+/// body of it would).
+pub(crate) fn place_clump(
+    particles: &mut Particles,
+    (t, template): (&ClumpTemplate, u16),
+    scale: f64,
+    (x, q, v, w): (DVec3, glam::DQuat, DVec3, DVec3),
+) {
+    let sphere = Particle {
+        v,
+        w,
+        q,
+        material: t.material,
+        ..Particle::default()
+    };
+    if let [one] = t.spheres[..] {
+        let (at, radius) = (x + q * (one.centre * scale), one.radius * scale);
+        particles.push(Particle {
+            x: at,
+            radius,
+            ..sphere
+        });
+        return;
+    }
+    let radii: Vec<f64> = t.spheres.iter().map(|s| s.radius * scale).collect();
+    let body = Body {
+        id: BodyId::new(0), // set by push_body
+        template,
+        scale,
+        x,
+        v,
+        q,
+        w,
+        mass: t.mass * scale.powi(3),
+        inertia: t.inertia * scale.powi(5),
+        offsets: t.spheres.iter().map(|sp| sp.centre * scale).collect(),
+        bounding_radius: t.bounding_radius * scale,
+    };
+    particles.push_body(body, &radii, sphere);
+}
+
+/// A rotation uniform over all rotations (Shoemake's subgroup algorithm, 1992).
+fn uniform_rotation(rng: &mut ChaCha8Rng) -> glam::DQuat {
+    let (u1, u2, u3) = (
+        uniform(rng, 0.0, 1.0),
+        uniform(rng, 0.0, std::f64::consts::TAU),
+        uniform(rng, 0.0, std::f64::consts::TAU),
+    );
+    let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
+    glam::DQuat::from_xyzw(a * u2.sin(), a * u2.cos(), b * u3.sin(), b * u3.cos()).normalize()
 }
 
 /// The particles a sphere spawned in a region could touch, binned in cells of edge `h`

@@ -160,6 +160,14 @@ impl Simulation {
     /// same simulation (all its particles, as made or restored), keeps its share and the
     /// ghosts it needs, and from then on steps together with the others.
     pub fn split(mut self, comm: Box<dyn Comm>) -> Result<Simulation> {
+        if !self.particles.bodies.is_empty()
+            || self.scenario.spawn.iter().any(|r| r.clump.is_some())
+        {
+            bail!(
+                "clumps cannot yet be run over several processes (issue 28): run with one \
+                 process (threads use every core of a machine)"
+            );
+        }
         let (rank, size) = (comm.rank(), comm.size());
         let owned = self
             .particles

@@ -18,7 +18,9 @@ pub const COLUMNS: [&str; 14] = [
 ];
 
 /// Whole-number columns a frame may carry beyond the fourteen.
-pub const INT_COLUMNS: [&str; 4] = ["tag", "id", "material", "fixed"];
+/// The optional whole-number columns; `clump` (a clump's template index, -1 for a plain
+/// sphere) is read as its value + 1.
+pub const INT_COLUMNS: [&str; 5] = ["tag", "id", "material", "fixed", "clump"];
 
 /// The file name of frame `k`.
 pub fn frame_name(k: u64) -> String {
@@ -34,6 +36,8 @@ pub struct Extra {
     pub ids: bool,
     /// `fixed` (also written whenever a particle is fixed)
     pub fixed: bool,
+    /// `clump` (the scenario has clumps): a row per rigid body, `R` its bounding radius
+    pub clump: bool,
 }
 
 /// Writes all particles as CSV text in id order, with the `extra` columns.
@@ -50,9 +54,23 @@ pub fn write_particles(out: &mut impl Write, p: &Particles, extra: Extra) -> std
     if fixed {
         out.write_all(b",fixed")?;
     }
+    let clump = extra.clump || !p.bodies.is_empty();
+    if clump {
+        out.write_all(b",clump")?;
+    }
     out.write_all(b"\n")?;
     let mut buf = ryu::Buffer::new();
-    for (id, q) in p.iter_by_id() {
+    for (id, mut q) in p.iter_by_id() {
+        // A rigid body: one row, by its first sphere, with the body's motion.
+        let mut template = -1;
+        if let Some(b) = q.body {
+            if id != b.first() {
+                continue;
+            }
+            let body = &p.bodies.list[p.bodies.index_of(b).expect("a listed body")];
+            (q.x, q.radius, q.v, q.q, q.w) = (body.x, body.bounding_radius, body.v, body.q, body.w);
+            template = body.template as i64;
+        }
         line.clear();
         let values = [
             q.x.x, q.x.y, q.x.z, q.radius, q.v.x, q.v.y, q.v.z, q.q.w, q.q.x, q.q.y, q.q.z, q.w.x,
@@ -76,6 +94,10 @@ pub fn write_particles(out: &mut impl Write, p: &Particles, extra: Extra) -> std
         }
         if fixed {
             line.push_str(if q.fixed { ",1" } else { ",0" });
+        }
+        if clump {
+            line.push(',');
+            line.push_str(itoa::Buffer::new().format(template));
         }
         line.push('\n');
         out.write_all(line.as_bytes())?;
@@ -197,7 +219,7 @@ fn contact(line: &str, file: &str, n: usize) -> Result<ContactRecord> {
 struct Header {
     columns: usize,
     /// The column of each optional whole-number quantity: tag, id, material, fixed.
-    int_column: [Option<usize>; 4],
+    int_column: [Option<usize>; 5],
     /// The quantity (of the 14) each column holds.
     quantity_of_column: Vec<usize>,
 }
@@ -209,7 +231,7 @@ impl Header {
         let names: Vec<&str> = header.trim().split(',').map(str::trim).collect();
         let mut slot = [usize::MAX; 14];
         // The optional whole-number columns: tag, id, material, fixed.
-        let mut int_column = [None; 4];
+        let mut int_column = [None; 5];
         for (col, name) in names.iter().enumerate() {
             if let Some(k) = INT_COLUMNS.iter().position(|c| c == name) {
                 if int_column[k].is_some() {
@@ -252,12 +274,12 @@ impl Header {
 
     /// The values of row `line` (line `n` of `file`): the 14 quantities and the whole
     /// numbers.
-    fn row(&self, line: &str, n: usize, file: &str) -> Result<([f64; 14], [u32; 4])> {
+    fn row(&self, line: &str, n: usize, file: &str) -> Result<([f64; 14], [u32; 5])> {
         let (names, int_column, quantity_of_column) =
             (self.columns, &self.int_column, &self.quantity_of_column);
         let mut values = [0.0f64; 14];
         let mut count = 0;
-        let mut ints = [0u32; 4];
+        let mut ints = [0u32; 5];
         for (col, text) in line.split(',').enumerate() {
             count += 1;
             if col >= names {
@@ -265,11 +287,19 @@ impl Header {
             }
             let text = text.trim();
             if let Some(k) = int_column.iter().position(|&c| c == Some(col)) {
-                ints[k] = text.parse().map_err(|_| {
+                let parsed = if k == 4 {
+                    text.parse::<i64>()
+                        .ok()
+                        .and_then(|c| u32::try_from(c + 1).ok())
+                } else {
+                    text.parse().ok()
+                };
+                ints[k] = parsed.ok_or_else(|| {
                     anyhow::anyhow!(
-                        "{file}:{n}: column {} ('{}'): expected a whole number >= 0, found '{text}'",
+                        "{file}:{n}: column {} ('{}'): expected a whole number >= {}, found '{text}'",
                         col + 1,
-                        INT_COLUMNS[k]
+                        INT_COLUMNS[k],
+                        if k == 4 { -1 } else { 0 }
                     )
                 })?;
                 continue;
@@ -299,7 +329,7 @@ impl Header {
 }
 
 /// The particle of a row's values `v` and whole numbers `ints` (line `n` of `file`).
-fn particle(v: [f64; 14], ints: [u32; 4], n: usize, file: &str) -> Result<Particle> {
+fn particle(v: [f64; 14], ints: [u32; 5], n: usize, file: &str) -> Result<Particle> {
     if v[3] <= 0.0 {
         bail!("{file}:{n}: radius R = {} must be > 0", v[3]);
     }
@@ -328,6 +358,7 @@ fn particle(v: [f64; 14], ints: [u32; 4], n: usize, file: &str) -> Result<Partic
         material: u16::try_from(ints[2])
             .map_err(|_| anyhow::anyhow!("{file}:{n}: material {} is out of range", ints[2]))?,
         fixed: ints[3] == 1,
+        body: None,
     })
 }
 
@@ -504,6 +535,7 @@ mod tests {
             tag: 42,
             material: 0,
             fixed: false,
+            body: None,
         }]
         .into_iter()
         .collect();
@@ -533,6 +565,7 @@ mod tests {
                 tag: 0,
                 material: k as u16,
                 fixed: false,
+                body: None,
             })
             .collect();
         // Ids with gaps (particles 1, 4 and 6 removed), stored out of id order.

@@ -1,5 +1,6 @@
 //! The model: lanes of particles, exact sums, particles, springs, the contact law (Sec. 2.2 of the paper), materials and their mixing, integration and rigid motion, clumps (mass properties) and rigid-body rotation. Imports nothing of the crate above it.
 
+pub mod bodies;
 pub mod clump;
 pub mod contact;
 pub mod exact;

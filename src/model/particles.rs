@@ -7,6 +7,8 @@
 
 use glam::{DQuat, DVec3};
 
+use crate::model::bodies::{Bodies, Body, BodyId};
+
 /// The state of every particle.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Particles {
@@ -33,6 +35,11 @@ pub struct Particles {
     /// Whether each particle is fixed: held in place and at rest, whatever acts on it
     /// (`[[fixed]]` boxes, the `fixed` column, Python's `freeze`).
     pub fixed: Vec<bool>,
+    /// The rigid body (clump) each particle is a sphere of, if any: its state is the
+    /// body's, which `bodies` holds.
+    pub body: Vec<Option<BodyId>>,
+    /// The rigid bodies (clumps) of several particles.
+    pub bodies: Bodies,
 }
 
 /// One particle's state, as read from and written to CSV.
@@ -46,6 +53,7 @@ pub struct Particle {
     pub tag: u32,
     pub material: u16,
     pub fixed: bool,
+    pub body: Option<BodyId>,
 }
 
 impl Particles {
@@ -75,6 +83,28 @@ impl Particles {
         self.tag.push(p.tag);
         self.material.push(p.material);
         self.fixed.push(p.fixed);
+        self.body.push(p.body);
+    }
+
+    /// Adds a rigid body with its spheres (of `radii`, in the order of its offsets; the
+    /// rest of their state from `sphere`), which take the next ids (the first of them the
+    /// body's id) and the body's motion.
+    pub fn push_body(&mut self, mut body: Body, radii: &[f64], sphere: Particle) {
+        body.id = BodyId::new(self.next_id);
+        let first = self.len();
+        for (k, &radius) in radii.iter().enumerate() {
+            let (x, v) = body.sphere_state(k);
+            self.push(Particle {
+                x,
+                radius,
+                v,
+                q: body.q,
+                w: body.w,
+                body: Some(body.id),
+                ..sphere
+            });
+        }
+        self.bodies.push(body, first);
     }
 
     pub fn get(&self, i: usize) -> Particle {
@@ -87,6 +117,7 @@ impl Particles {
             tag: self.tag[i],
             material: self.material[i],
             fixed: self.fixed[i],
+            body: self.body[i],
         }
     }
 
@@ -114,6 +145,10 @@ impl Particles {
         gather(&mut self.tag, order);
         gather(&mut self.material, order);
         gather(&mut self.fixed, order);
+        gather(&mut self.body, order);
+        if !self.bodies.is_empty() {
+            self.bodies.locate(&self.id, &self.body);
+        }
     }
 
     /// The storage indices in id order.

@@ -179,9 +179,13 @@ impl Neighbours {
         let n = x.len();
         let skin = self.skin;
         let grid = CellGrid::of_points(x, layout.h);
+        let body = &particles.body;
+        let clumps = !particles.bodies.is_empty();
+        // The spheres of one rigid body are no pair.
         let close = |i: u32, j: u32| {
             let reach = radius[i as usize] + radius[j as usize] + skin;
             (x[i as usize] - x[j as usize]).length_squared() < reach * reach
+                && !(clumps && one_body(body, i, j))
         };
         let in_cell_order = layout.uniform && {
             let inv_h = 1.0 / layout.h;
@@ -240,6 +244,7 @@ impl Neighbours {
                                         if i < j
                                             && (x[i as usize] - image).length_squared()
                                                 < reach * reach
+                                            && !one_body(&particles.body, i, j)
                                         {
                                             out.push((i, j, s, crossing));
                                         }
@@ -273,6 +278,13 @@ impl Neighbours {
         let pieces = pieces_of(&start, FACE_PIECE);
         self.wrapped = ContactList::with_springs(start, partner, pieces, &history.pairs);
     }
+}
+
+/// Whether particles `i` and `j` are spheres of one rigid body.
+#[inline(always)]
+fn one_body(body: &[Option<crate::model::bodies::BodyId>], i: u32, j: u32) -> bool {
+    let a = body[i as usize];
+    a.is_some() && a == body[j as usize]
 }
 
 /// The pair list of particles stored in cell order: per cell, each particle's partners are

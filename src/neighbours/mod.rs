@@ -441,6 +441,7 @@ mod tests {
                 tag: 0,
                 material: 0,
                 fixed: false,
+                body: None,
             })
             .collect()
     }

@@ -327,6 +327,7 @@ pub(crate) fn get_particle(r: &mut Reader) -> (u32, Particle) {
         tag: r.u32(),
         material: r.u16(),
         fixed: r.u8() != 0,
+        body: None, // clumps are refused in split runs (for now)
     };
     (id, p)
 }

@@ -6,8 +6,8 @@ use std::path::Path;
 use anyhow::{Context, Result, bail};
 use glam::DVec3;
 
-use super::raw::RawClump;
-use super::{Geometry, MaterialSpec};
+use super::raw::{RawClump, RawScale};
+use super::{Geometry, MaterialSpec, SpawnClump};
 use crate::model::clump::{Moments, Sphere};
 
 /// A clump template, ready for the step.
@@ -78,6 +78,52 @@ pub(super) fn clumps(
         templates.push(template);
     }
     Ok(templates)
+}
+
+/// The clumps of a `[[spawn]]` region (`key`): template `name` of `templates`, scaled by
+/// `scale` (a factor or a uniform range; 1 by default), its scaled radii within
+/// [R_min, R_max] = `radii`.
+pub(super) fn spawned(
+    key: &str,
+    name: &str,
+    scale: Option<RawScale>,
+    templates: &[ClumpTemplate],
+    (lo, hi): (f64, f64),
+) -> Result<SpawnClump> {
+    let Some(template) = templates.iter().position(|t| t.name == name) else {
+        let names: Vec<&str> = templates.iter().map(|t| t.name.as_str()).collect();
+        bail!(
+            "{key} clump = \"{name}\" is not among [[clumps]] ({})",
+            names.join(", ")
+        );
+    };
+    let (min, max) = match scale {
+        None => (1.0, 1.0),
+        Some(RawScale::Factor(s)) => (s, s),
+        Some(RawScale::Uniform { min, max }) => (min, max),
+    };
+    if !(min > 0.0 && min.is_finite() && max.is_finite() && max >= min) {
+        bail!("{key} scale: expected a factor > 0 or {{ min, max }} with 0 < min <= max");
+    }
+    let t = &templates[template];
+    let smallest = t
+        .spheres
+        .iter()
+        .map(|s| s.radius)
+        .fold(f64::INFINITY, f64::min);
+    let largest = t.spheres.iter().map(|s| s.radius).fold(0.0, f64::max);
+    if smallest * min < lo * (1.0 - 1e-12) || largest * max > hi * (1.0 + 1e-12) {
+        bail!(
+            "{key} scale {min}..{max} makes spheres of clump \"{name}\" from {} to {}, outside \
+             [geometry] radius_min..radius_max = {lo}..{hi}",
+            smallest * min,
+            largest * max
+        );
+    }
+    Ok(SpawnClump {
+        template: template as u16,
+        scale: (min, max),
+    })
 }
 
 fn sphere(x: f64, y: f64, z: f64, r: f64) -> Sphere {

@@ -365,6 +365,17 @@ pub struct SpawnRegion {
     pub start: f64,
     pub stop: f64,
     pub radius: RadiusDistribution,
+    /// What it inserts: spheres of `radius` and `material`, or clumps of a template.
+    pub clump: Option<SpawnClump>,
+}
+
+/// The clumps a `[[spawn]]` region inserts (`clump = "name"`): the template's index in
+/// `[[clumps]]` and the range of the factor its lengths are scaled by (uniform; 1 by
+/// default). The orientation is uniform over rotations.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpawnClump {
+    pub template: u16,
+    pub scale: (f64, f64),
 }
 
 /// A box that labels the particles whose centre enters it (`[[tags]]`).

@@ -102,6 +102,16 @@ pub(super) struct RawSpawn {
     pub(super) start: Option<f64>,
     pub(super) stop: Option<f64>,
     pub(super) radius: Option<RawRadius>,
+    pub(super) clump: Option<String>,
+    pub(super) scale: Option<RawScale>,
+}
+
+/// A `[[spawn]]` region's `scale` of its clumps: a factor, or uniform in `min`..`max`.
+#[derive(Deserialize)]
+#[serde(untagged, deny_unknown_fields)]
+pub(super) enum RawScale {
+    Factor(f64),
+    Uniform { min: f64, max: f64 },
 }
 
 #[derive(Deserialize)]

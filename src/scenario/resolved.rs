@@ -218,7 +218,11 @@ impl Scenario {
                 vec3(r.region.max),
                 vec3(r.velocity)
             );
-            if self.uses_materials() {
+            if let Some(c) = r.clump {
+                let name = text(&self.clumps[c.template as usize].name);
+                let (min, max) = (num(c.scale.0), num(c.scale.1));
+                let _ = writeln!(o, "clump = {name}\nscale = {{ min = {min}, max = {max} }}");
+            } else if self.uses_materials() {
                 let _ = writeln!(o, "material = {}", self.material_name(r.material));
             }
             if let Some(n) = r.count {
@@ -231,7 +235,9 @@ impl Scenario {
             if r.stop.is_finite() {
                 let _ = writeln!(o, "stop = {}", num(r.stop));
             }
-            let _ = writeln!(o, "radius = {}", radius(&r.radius));
+            if r.clump.is_none() {
+                let _ = writeln!(o, "radius = {}", radius(&r.radius));
+            }
         }
     }
 

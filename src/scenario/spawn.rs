@@ -13,6 +13,7 @@ use super::*;
 pub(super) fn spawn(
     raw: Vec<RawSpawn>,
     index: &dyn Fn(&str, &str) -> Result<u16>,
+    clumps: &[ClumpTemplate],
     kinetics: &Kinetics,
     geometry: &Geometry,
     simulation: &SimulationTable,
@@ -27,6 +28,7 @@ pub(super) fn spawn(
                 &format!("[[spawn]] #{}", k + 1),
                 r,
                 &index,
+                clumps,
                 kinetics.initial_velocity,
                 (radius_min, radius_max),
             )
@@ -86,6 +88,7 @@ fn spawn_region(
     key: &str,
     r: RawSpawn,
     index: &dyn Fn(&str, &str) -> Result<u16>,
+    clumps: &[ClumpTemplate],
     velocity: DVec3,
     radii: (f64, f64),
 ) -> Result<SpawnRegion> {
@@ -98,6 +101,21 @@ fn spawn_region(
         },
         false,
     )?;
+    let clump = match &r.clump {
+        Some(name) => {
+            if r.radius.is_some() || r.material.is_some() {
+                bail!(
+                    "{key} clump = \"{name}\" takes its spheres and material from [[clumps]]: \
+                     leave out radius and material"
+                );
+            }
+            Some(super::clumps::spawned(key, name, r.scale, clumps, radii)?)
+        }
+        None if r.scale.is_some() => {
+            bail!("{key} scale applies to clumps: it needs clump = \"name\"")
+        }
+        None => None,
+    };
     let material = match &r.material {
         Some(name) => index(&k("material"), name)?,
         None => 0,
@@ -136,6 +154,7 @@ fn spawn_region(
         start,
         stop,
         radius,
+        clump,
     })
 }
 

@@ -148,6 +148,13 @@ fn friction_springs(value: Option<String>) -> Result<FrictionSprings> {
     }
 }
 
+/// The boxes of `[[name]]` entries (`[[outlets]]`, `[[fixed]]`), validated.
+fn boxes(name: &str, raw: Vec<RawBox>) -> Result<Vec<Region>> {
+    (raw.into_iter().enumerate())
+        .map(|(k, b)| region(&format!("[[{name}]] #{}", k + 1), b, false))
+        .collect()
+}
+
 impl Scenario {
     /// Parses and validates scenario text; `path` names the file in messages and anchors
     /// relative paths.
@@ -190,20 +197,24 @@ impl Scenario {
             Some(le) => Some(lees_edwards(le, periodic)?),
         };
         let domain = domain(raw.domain, &simulation, radius_max, periodic)?;
-        let outlets = raw
-            .outlets
-            .into_iter()
-            .enumerate()
-            .map(|(k, b)| region(&format!("[[outlets]] #{}", k + 1), b, false))
-            .collect::<Result<Vec<_>>>()?;
-        let fixed = raw
-            .fixed
-            .into_iter()
-            .enumerate()
-            .map(|(k, b)| region(&format!("[[fixed]] #{}", k + 1), b, false))
-            .collect::<Result<Vec<_>>>()?;
-        let spawn = spawn(raw.spawn, &index, &kinetics, &geometry, &simulation, domain)?;
+        let outlets = boxes("outlets", raw.outlets)?;
+        let fixed = boxes("fixed", raw.fixed)?;
         let clumps = super::clumps::clumps(raw.clumps, base, &geometry, &materials, &index)?;
+        let spawn = spawn(
+            raw.spawn,
+            &index,
+            &clumps,
+            &kinetics,
+            &geometry,
+            &simulation,
+            domain,
+        )?;
+        if periodic.contains(&true) && spawn.iter().any(|r| r.clump.is_some()) {
+            bail!(
+                "[[spawn]] clump: clumps in a periodic domain are not supported yet (issue 28); \
+                 use walls or an open [domain]"
+            );
+        }
         Ok(Scenario {
             clumps,
             geometry,

@@ -32,6 +32,7 @@ pub fn sphere(radius: f64, x: DVec3, v: DVec3, w: DVec3) -> Particle {
         tag: 0,
         material: 0,
         fixed: false,
+        body: None,
     }
 }
 

@@ -12,8 +12,11 @@
 //! entry the ids (lower, higher) or the id and face (u32, u32) and the springs u_s, u_r (3 f64
 //! each), u_t (f64); from format 3 the removed particles, wall sums, scenario, mesh files and
 //! spawn regions (`Cursor::rest`); from format 4 whether the spawn box is off (u8) and the servos' states (count, and per servo its
-//! mesh file (u32), position, speed, position at the last rebuild and last load (4 f64)); last a CRC-32
-//! of everything before it.
+//! mesh file (u32), position, speed, position at the last rebuild and last load (4 f64)); from
+//! format 6 the rigid bodies (clumps): count (u64) and per body the id of its first sphere
+//! (u32; its spheres are the particles of the next ids), template (u16), scale, x, v,
+//! q0..q3, w, mass, principal moments, bounding radius (19 f64) and its spheres' offsets
+//! (count u32, 3 f64 each); last a CRC-32 of everything before it.
 //!
 //! The storage order and the positions of the last rebuild let a resumed run rebuild the
 //! very lists the interrupted one had; its results depend on them (the order in which
@@ -24,12 +27,13 @@ use glam::{DQuat, DVec3};
 
 use super::{Outflow, Removed, Snapshot, Wrench};
 use crate::engine::spawn::{RegionState, SpawnerState};
+use crate::model::bodies::{Body, BodyId};
 use crate::model::particles::{Particle, Particles};
 use crate::model::servo::State;
 use crate::model::springs::Springs;
 
 const MAGIC: &[u8; 12] = b"TINYDEM CKPT";
-const VERSION: u32 = 5;
+const VERSION: u32 = 6;
 /// The oldest version this program reads.
 const OLDEST: u32 = 2;
 
@@ -149,8 +153,46 @@ pub fn encode_into(out: &mut Vec<u8>, snapshot: &Snapshot, fingerprint: u64) {
         out.extend_from_slice(&file.to_le_bytes());
         put_f64s(out, &[s.position, s.speed, s.built, s.load]);
     }
+    put_bodies(out, &p.bodies.list);
     let crc = crc32fast::hash(&out[start..]);
     out.extend_from_slice(&crc.to_le_bytes());
+}
+
+fn put_bodies(out: &mut Vec<u8>, bodies: &[Body]) {
+    out.extend_from_slice(&(bodies.len() as u64).to_le_bytes());
+    for b in bodies {
+        out.extend_from_slice(&b.id.first().to_le_bytes());
+        out.extend_from_slice(&b.template.to_le_bytes());
+        let (x, v, q, w, i) = (b.x, b.v, b.q, b.w, b.inertia);
+        put_f64s(
+            out,
+            &[
+                b.scale,
+                x.x,
+                x.y,
+                x.z,
+                v.x,
+                v.y,
+                v.z,
+                q.w,
+                q.x,
+                q.y,
+                q.z,
+                w.x,
+                w.y,
+                w.z,
+                b.mass,
+                i.x,
+                i.y,
+                i.z,
+                b.bounding_radius,
+            ],
+        );
+        out.extend_from_slice(&(b.offsets.len() as u32).to_le_bytes());
+        for o in &b.offsets {
+            put_f64s(out, &[o.x, o.y, o.z]);
+        }
+    }
 }
 
 /// A cursor over the checkpoint bytes that reports truncation clearly.
@@ -282,6 +324,11 @@ pub fn decode(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<Snapsho
         box_off = r.u8()? != 0;
         rest.servos = r.servos(rest.mesh_files.len())?;
     }
+    let mut particles = particles;
+    if version >= 6 {
+        let bodies = r.bodies()?;
+        join_bodies(&mut particles, bodies)?;
+    }
     if r.at != r.bytes.len() {
         bail!(
             "corrupt checkpoint: {} unexpected bytes at the end",
@@ -381,6 +428,7 @@ impl Cursor<'_> {
                 tag,
                 material,
                 fixed,
+                body: None,
             });
         }
         let anchors = match r.u8()? {
@@ -395,6 +443,45 @@ impl Cursor<'_> {
         }
         (particles.id, particles.next_id) = (ids, next_id);
         Ok((particles, anchors))
+    }
+
+    /// The rigid bodies (format 6), finite, ascending by id.
+    fn bodies(&mut self) -> Result<Vec<Body>> {
+        let r = self;
+        let count = r.count(4 + 2 + 19 * 8 + 4)?;
+        let mut bodies = Vec::with_capacity(count);
+        for _ in 0..count {
+            let id = r.u32()?;
+            let template = r.u16()?;
+            let f: Vec<f64> = (0..19).map(|_| r.f64()).collect::<Result<_>>()?;
+            let n = r.u32()? as usize;
+            if n > (r.bytes.len() - r.at) / 24 || n < 2 || id.checked_add(n as u32).is_none() {
+                bail!("corrupt checkpoint: a body of {n} spheres");
+            }
+            let offsets = (0..n).map(|_| r.vec3()).collect::<Result<Vec<_>>>()?;
+            let v3 = |k: usize| DVec3::new(f[k], f[k + 1], f[k + 2]);
+            let body = Body {
+                id: BodyId::new(id),
+                template,
+                scale: f[0],
+                x: v3(1),
+                v: v3(4),
+                q: DQuat::from_xyzw(f[8], f[9], f[10], f[7]),
+                w: v3(11),
+                mass: f[14],
+                inertia: v3(15),
+                offsets,
+                bounding_radius: f[18],
+            };
+            let finite =
+                f.iter().all(|x| x.is_finite()) && body.offsets.iter().all(|o| o.is_finite());
+            if !finite || body.mass <= 0.0 || bodies.last().is_some_and(|b: &Body| b.id >= body.id)
+            {
+                bail!("corrupt checkpoint: body {id} not finite, massless or out of order");
+            }
+            bodies.push(body);
+        }
+        Ok(bodies)
     }
 
     /// The lonely particles of the last rebuild (storage indices below `n`, ascending) with
@@ -488,4 +575,31 @@ impl Cursor<'_> {
             .collect::<Result<_>>()?;
         Ok(rest)
     }
+}
+
+/// Gives `particles` their `bodies`: body b's spheres are the particles of ids b, b + 1, ...;
+/// each must be present.
+fn join_bodies(particles: &mut Particles, bodies: Vec<Body>) -> Result<()> {
+    let mut at = rustc_hash::FxHashMap::default();
+    for (k, &id) in particles.id.iter().enumerate() {
+        at.insert(id, k);
+    }
+    for b in &bodies {
+        for id in b.id.first()..b.id.first() + b.offsets.len() as u32 {
+            let Some(&k) = at.get(&id) else {
+                bail!(
+                    "corrupt checkpoint: sphere {id} of body {} is missing",
+                    b.id.first()
+                );
+            };
+            if particles.body[k].is_some() {
+                bail!("corrupt checkpoint: particle {id} is in two bodies");
+            }
+            particles.body[k] = Some(b.id);
+        }
+    }
+    particles.bodies.list = bodies;
+    let (id, body) = (particles.id.clone(), particles.body.clone());
+    particles.bodies.locate(&id, &body);
+    Ok(())
 }

@@ -111,6 +111,7 @@ mod tests {
             tag: 7,
             material: 0,
             fixed: false,
+            body: None,
         });
         let s = Springs {
             u_s: DVec3::new(1e-5, 2e-6, 0.0),
@@ -226,28 +227,32 @@ mod tests {
         (s.scenario, s.mesh_files) = (String::new(), Vec::new());
         (s.spawner.regions, s.servos) = (Vec::new(), Vec::new());
         s.spawner.box_off = false;
-        let v5 = encode(&s, 7);
-        let n = v5.len() - 4;
+        let v6 = encode(&s, 7);
+        let n = v6.len() - 4;
         // The one particle's record starts at byte 77 (after the header and the count); its
         // material and fixed flag are the last 3 of its 123 bytes; the counts of removals,
-        // loads, scenario, mesh files, spawn regions, the spawn box's flag and servos end the
-        // body.
-        let v2 = older(&v5, 2, &[(77 + 120, 77 + 123), (n - 65, n)]);
+        // loads, scenario, mesh files, spawn regions, the spawn box's flag, servos and bodies
+        // end the body.
+        let v2 = older(&v6, 2, &[(77 + 120, 77 + 123), (n - 73, n)]);
         assert_eq!(decode(&v2, Some(7)).unwrap(), s);
     }
 
     #[test]
-    fn versions_3_and_4_are_read() {
+    fn versions_3_to_5_are_read() {
         let mut s = snapshot();
-        let v5 = encode(&s, 7);
-        // Format 4 has no fixed flag (the last byte of the particle's record).
-        let v4 = older(&v5, 4, &[(77 + 122, 77 + 123)]);
+        let v6 = encode(&s, 7);
+        let n = v6.len() - 4;
+        // Format 5 has no bodies (their count ends format 6).
+        let v5 = older(&v6, 5, &[(n - 8, n)]);
+        assert_eq!(decode(&v5, Some(7)).unwrap(), s);
+        // Format 4 has no fixed flag either (the last byte of the particle's record).
+        let v4 = older(&v6, 4, &[(77 + 122, 77 + 123), (n - 8, n)]);
         assert_eq!(decode(&v4, Some(7)).unwrap(), s);
         // Format 3 ends before the spawn box's flag and the count of servos.
         (s.servos, s.spawner.box_off) = (Vec::new(), false);
-        let v5 = encode(&s, 7);
-        let n = v5.len() - 4;
-        let v3 = older(&v5, 3, &[(77 + 122, 77 + 123), (n - 9, n)]);
+        let v6 = encode(&s, 7);
+        let n = v6.len() - 4;
+        let v3 = older(&v6, 3, &[(77 + 122, 77 + 123), (n - 17, n)]);
         assert_eq!(decode(&v3, Some(7)).unwrap(), s);
     }
 

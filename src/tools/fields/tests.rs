@@ -54,6 +54,7 @@ fn particle(x: DVec3, v: DVec3, radius: f64) -> Particle {
         tag: 0,
         material: 0,
         fixed: false,
+        body: None,
     }
 }
 

@@ -62,6 +62,7 @@ fn one(x: DVec3, v: DVec3) -> Particles {
         tag: 0,
         material: 0,
         fixed: false,
+        body: None,
     }]
     .into_iter()
     .collect()

@@ -1,0 +1,74 @@
+//! Stage 5a of the step: the rigid bodies (clumps). Each body sums the loads of its
+//! spheres about its centre of mass, moves as one rigid body, and puts its spheres where
+//! its motion takes them; stage 5 then leaves those spheres alone.
+
+use super::*;
+use crate::model::bodies::Body;
+use crate::model::rigid;
+use glam::DQuat;
+
+/// Stage 5a: advance every body of `p` by `dt` under gravity `g` and the loads of its
+/// spheres (which stage 5 zeroes with the others), and set its spheres' states. The sum
+/// over a body's spheres runs in their id order, and each sphere's load is an exact sum,
+/// so a body's motion does not depend on the thread count or the storage order. Returns
+/// whether some body's new state is not finite.
+///
+/// Translation is the spheres' semi-implicit Euler (v += Δt (F/M + g), x += Δt v); rotation
+/// is `rigid::step` (the torque kicks the angular momentum, then the splitting of Dullweber,
+/// Leimkuhler & McLachlan turns the body freely, gyroscopic term included). Drag acts on
+/// each sphere as on a free one (Eqs. 3-4, at the sphere's velocity).
+#[inline(never)] // a stage of its own in profiles
+pub(super) fn run(model: &Model, (dt, g): (f64, DVec3), p: &mut Particles, loads: &[Load]) -> bool {
+    if p.bodies.is_empty() {
+        return false;
+    }
+    let moved: Vec<(DVec3, DVec3, DQuat, DVec3)> = (0..p.bodies.len())
+        .into_par_iter()
+        .with_min_len(64)
+        .map(|b| {
+            let body = &p.bodies.list[b];
+            let (f, tau) = wrench(model, p, body, p.bodies.members(b), loads);
+            let v = body.v + (f / body.mass + g) * dt;
+            let (q, w) = rigid::step(body.q, body.w, tau, body.inertia, dt);
+            (body.x + v * dt, v, q, w)
+        })
+        .collect();
+    let mut non_finite = false;
+    for (b, (x, v, q, w)) in moved.into_iter().enumerate() {
+        non_finite |= !(x.is_finite() && v.is_finite() && w.is_finite());
+        let body = &mut p.bodies.list[b];
+        (body.x, body.v, body.q, body.w) = (x, v, q, w);
+        let body = &p.bodies.list[b];
+        for (k, &i) in p.bodies.members(b).iter().enumerate() {
+            let i = i as usize;
+            (p.x[i], p.v[i]) = body.sphere_state(k);
+            (p.q[i], p.w[i]) = (q, w);
+        }
+    }
+    non_finite
+}
+
+/// The force and the torque about the centre of mass on `body` (its spheres stored at
+/// `members`): its spheres' loads and drag, in their id order.
+fn wrench(
+    model: &Model,
+    p: &Particles,
+    body: &Body,
+    members: &[u32],
+    loads: &[Load],
+) -> (DVec3, DVec3) {
+    let (mut f, mut tau) = (DVec3::ZERO, DVec3::ZERO);
+    for (k, &i) in members.iter().enumerate() {
+        let i = i as usize;
+        let load = loads[i].value(&model.scales.lanes);
+        let d = model.densities[p.material[i] as usize];
+        let r = p.radius[i];
+        // Eqs. (3)-(4) for the sphere alone: m c = (4/3 π ρ R³) drag / R², and I γ.
+        let m_c = d.mass_per_r3 * d.drag * r;
+        let f_k = DVec3::new(load[0], load[1], load[2]) - p.v[i] * m_c;
+        let tau_k = DVec3::new(load[3], load[4], load[5]) - p.w[i] * (4.0 / 3.0 * m_c * r * r);
+        f += f_k;
+        tau += tau_k + (body.q * body.offsets[k]).cross(f_k);
+    }
+    (f, tau)
+}

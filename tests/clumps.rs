@@ -1,0 +1,299 @@
+//! Clumps of rigidly joined spheres (issue 28) in the step: a dumbbell at rest on a plane
+//! and on an incline, collisions that conserve momentum and angular momentum, a clump of
+//! one sphere as that sphere, bodies removed whole, checkpoints and thread counts.
+
+mod common;
+
+use glam::{DQuat, DVec3};
+use tinydem::particles::Particles;
+use tinydem::records::Partner;
+use tinydem::simulation::Simulation;
+
+const R: f64 = 0.005;
+const G: f64 = 9.81;
+/// The dumbbell: two spheres of radius R, 1.4 R apart (along the body's x axis).
+const DIMER: &str =
+    "[[clumps]]\nname = \"dimer\"\nspheres = [[0.0, 0.0, 0.0, 0.005], [0.007, 0.0, 0.0, 0.005]]\n";
+
+/// A scenario without spawning, gravity `g`, friction `mu`, with `extra` TOML lines.
+fn text(g: DVec3, mu: f64, extra: &str) -> String {
+    format!(
+        "[geometry]\nradius_min = {R}\nradius_max = {R}\nmesh_radii = [0.0]\n\
+         [material]\ndensity = 1000.0\nyoungs_modulus = 1e6\npoisson_ratio = 0.3\n\
+         restitution = 0.3\nfriction_sliding = {mu}\nfriction_rolling = 0.0\n\
+         [kinetics]\ngravity = [{}, {}, {}]\n\
+         [simulation]\nmax_particles = 0\nspawn_attempts = 0\n{DIMER}{extra}",
+        g.x, g.y, g.z
+    )
+}
+
+fn sim(text: &str) -> Simulation {
+    Simulation::new(common::scenario(text)).unwrap()
+}
+
+fn run_for(s: &mut Simulation, seconds: f64) {
+    let steps = (seconds / s.scenario.simulation.timestep) as u64;
+    for _ in 0..steps {
+        s.step().unwrap();
+    }
+}
+
+const PLANE: &str = "[[meshes]]\nshape = { type = \"plane\", point = [0.0, 0.0, 0.0], normal = [0.0, 0.0, 1.0], size = 1.0 }\n";
+
+#[test]
+fn a_dumbbell_dropped_flat_rests_on_both_spheres_each_carrying_half_its_weight() {
+    let mut s = sim(&text(DVec3::new(0.0, 0.0, -G), 0.5, PLANE));
+    let motion = (
+        DVec3::new(0.0, 0.0, R + 0.002),
+        DQuat::IDENTITY,
+        DVec3::ZERO,
+        DVec3::ZERO,
+    );
+    let id = s.add_clump(0, 1.0, motion).unwrap();
+    assert_eq!(id, 0);
+    assert_eq!(s.particles.len(), 2);
+    run_for(&mut s, 0.5);
+    let body = &s.particles.bodies.list[0];
+    assert!(
+        body.v.length() < 1e-6 && body.w.length() < 1e-4,
+        "still moving: {} {}",
+        body.v,
+        body.w
+    );
+    let weight = body.mass * G;
+    let contacts = s.contact_network();
+    assert_eq!(contacts.len(), 2, "{contacts:?}");
+    for c in &contacts {
+        assert!(matches!(c.with, Partner::Face(_)));
+        let share = c.f_n.z / weight;
+        assert!(
+            (share - 0.5).abs() < 1e-3,
+            "sphere {} carries {share} of the weight",
+            c.id
+        );
+    }
+    // Flat: both spheres at the same height, the body's axis horizontal.
+    let (a, b) = (s.particles.x[0], s.particles.x[1]);
+    assert!((a.z - b.z).abs() < 1e-9, "{a} {b}");
+    // The body's mass is that of the union (overlaps once), less than two spheres'.
+    let sphere = 4.0 / 3.0 * std::f64::consts::PI * R.powi(3) * 1000.0;
+    let lens = std::f64::consts::PI / 12.0 * (4.0 * R + 0.007) * (2.0 * R - 0.007).powi(2);
+    let union = 2.0 * sphere - 1000.0 * lens;
+    assert!(
+        (body.mass / union - 1.0).abs() < 1e-3,
+        "{} vs {union}",
+        body.mass
+    );
+}
+
+/// A dumbbell lying along the slope of a plane inclined by `angle` under friction 0.5
+/// (friction angle 26.6 deg): how far it slid in 0.3 s.
+fn slide_on_incline(angle: f64) -> f64 {
+    let g = DVec3::new(G * angle.sin(), 0.0, -G * angle.cos());
+    let mut s = sim(&text(g, 0.5, PLANE));
+    let motion = (
+        DVec3::new(0.0, 0.0, R),
+        DQuat::IDENTITY,
+        DVec3::ZERO,
+        DVec3::ZERO,
+    );
+    s.add_clump(0, 1.0, motion).unwrap();
+    run_for(&mut s, 0.05); // settle
+    let start = s.particles.bodies.list[0].x;
+    run_for(&mut s, 0.3);
+    (s.particles.bodies.list[0].x - start).x
+}
+
+#[test]
+fn a_dumbbell_on_an_incline_stays_below_the_friction_angle_and_slides_above() {
+    let below = slide_on_incline(20f64.to_radians());
+    assert!(below.abs() < 1e-5, "slid {below} m at 20 deg");
+    let above = slide_on_incline(35f64.to_radians());
+    // Sliding from the start at g (sin - mu cos) = 1.61 m/s^2: from t = 0.05 to 0.35 s.
+    let a = G * (35f64.to_radians().sin() - 0.5 * 35f64.to_radians().cos());
+    let expected = 0.5 * a * (0.35f64.powi(2) - 0.05f64.powi(2));
+    assert!(
+        (above / expected - 1.0).abs() < 0.05,
+        "slid {above} m at 35 deg, expected {expected}"
+    );
+}
+
+/// Total momentum and angular momentum about the origin of the bodies.
+fn momenta(p: &Particles) -> (DVec3, DVec3) {
+    p.bodies
+        .list
+        .iter()
+        .fold((DVec3::ZERO, DVec3::ZERO), |(m, l), b| {
+            let spin = b.q * (b.inertia * (b.q.inverse() * b.w));
+            (m + b.mass * b.v, l + b.x.cross(b.mass * b.v) + spin)
+        })
+}
+
+#[test]
+fn clump_collisions_conserve_momentum_and_angular_momentum() {
+    let extra = "[[clumps]]\nname = \"tri\"\nspheres = [[0.0, 0.0, 0.0, 0.005], [0.008, 0.0, 0.0, 0.005], [0.004, 0.0069282, 0.0, 0.005]]\n";
+    let mut s = sim(&text(DVec3::ZERO, 0.5, extra));
+    let turn = |a: f64| DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), a);
+    let bodies = [
+        (
+            0,
+            DVec3::new(0.0, 0.0, 0.0),
+            turn(0.3),
+            DVec3::new(0.5, 0.1, 0.0),
+            DVec3::new(0.0, 20.0, 5.0),
+        ),
+        (
+            1,
+            DVec3::new(0.03, 0.004, 0.002),
+            turn(1.3),
+            DVec3::new(-0.5, 0.0, 0.05),
+            DVec3::new(10.0, 0.0, -8.0),
+        ),
+        (
+            0,
+            DVec3::new(0.015, -0.03, 0.001),
+            turn(2.3),
+            DVec3::new(0.0, 0.6, 0.0),
+            DVec3::new(-5.0, 3.0, 30.0),
+        ),
+    ];
+    for (t, x, q, v, w) in bodies {
+        s.add_clump(t, 1.0, (x, q, v, w)).unwrap();
+    }
+    let (m0, l0) = momenta(&s.particles);
+    let mut touched = 0;
+    for _ in 0..4000 {
+        s.step().unwrap();
+        touched = touched.max(s.contact_count());
+    }
+    assert!(touched > 0, "the clumps never met");
+    let (m1, l1) = momenta(&s.particles);
+    assert!(
+        (m1 - m0).length() <= 1e-12 * m0.length(),
+        "momentum {m0} -> {m1}"
+    );
+    assert!(
+        (l1 - l0).length() <= 1e-12 * l0.length(),
+        "angular momentum {l0} -> {l1}"
+    );
+}
+
+#[test]
+fn a_clump_of_one_sphere_moves_as_that_sphere_bit_for_bit() {
+    let one = "[[clumps]]\nname = \"one\"\nspheres = [[0.001, 0.0, 0.0, 0.005]]\n";
+    let run = |clump: bool| {
+        let mut s = sim(&text(
+            DVec3::new(1.0, 0.0, -G),
+            0.5,
+            &format!("{PLANE}{one}"),
+        ));
+        let (x, v, w) = (
+            DVec3::new(0.0, 0.0, 0.008),
+            DVec3::new(0.2, 0.0, 0.0),
+            DVec3::new(0.0, 30.0, 0.0),
+        );
+        if clump {
+            s.add_clump(1, 1.0, (x, DQuat::IDENTITY, v, w)).unwrap();
+        } else {
+            s.add_particles(&[common::sphere(R, x, v, w)]).unwrap();
+        }
+        run_for(&mut s, 0.2);
+        s.particles
+    };
+    let (clump, sphere) = (run(true), run(false));
+    assert!(clump.bodies.is_empty());
+    assert_eq!(clump, sphere);
+}
+
+/// A box with 60 dimers and 40 triangles poured in, 1,500 steps.
+const POUR: &str = "[geometry]\nradius_min = 0.004\nradius_max = 0.006\n\
+[simulation]\nmax_particles = 1000\nframes = 3\nsteps_per_frame = 500\n\
+[output]\ncheckpoint_every = 1\n\
+[[meshes]]\nshape = { type = \"box\", min = [-0.03, -0.03, 0.0], max = [0.03, 0.03, 0.2], open = [\"+z\"] }\n\
+[[meshes]]\nshape = { type = \"plane\", point = [0.0, 0.0, 0.005], normal = [1.0, 0.0, 1.0], size = 0.02 }\n\
+[[clumps]]\nname = \"dimer\"\nspheres = [[0.0, 0.0, 0.0, 0.005], [0.007, 0.0, 0.0, 0.005]]\n\
+[[clumps]]\nname = \"tri\"\nspheres = [[0.0, 0.0, 0.0, 0.005], [0.008, 0.0, 0.0, 0.005], [0.004, 0.0069282, 0.0, 0.005]]\n\
+[[spawn]]\nmin = [-0.02, -0.02, 0.02]\nmax = [0.02, 0.02, 0.15]\nclump = \"dimer\"\nscale = { min = 0.9, max = 1.1 }\ncount = 60\n\
+[[spawn]]\nmin = [-0.02, -0.02, 0.02]\nmax = [0.02, 0.02, 0.15]\nclump = \"tri\"\ncount = 40\n\
+[[spawn]]\nmin = [-0.02, -0.02, 0.02]\nmax = [0.02, 0.02, 0.15]\ncount = 30\n";
+
+fn frames(dir: &std::path::Path) -> Vec<Vec<u8>> {
+    (0..=3)
+        .map(|k| std::fs::read(dir.join(format!("output/particles{k:06}.csv"))).unwrap())
+        .collect()
+}
+
+#[test]
+fn clump_runs_give_the_same_frames_on_one_and_two_threads() {
+    let t = tempfile::tempdir().unwrap();
+    std::fs::write(t.path().join("pour.toml"), POUR).unwrap();
+    let mut runs = Vec::new();
+    for threads in ["1", "2"] {
+        let out = common::tinydem(
+            &["run", "pour.toml", "--threads", threads, "--overwrite"],
+            t.path(),
+        );
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        runs.push(frames(t.path()));
+    }
+    assert_eq!(runs[0], runs[1]);
+    let last = String::from_utf8(runs[0][3].clone()).unwrap();
+    let rows: Vec<&str> = last.lines().collect();
+    assert!(rows[0].ends_with(",id,material,clump"), "{}", rows[0]);
+    let clumps: Vec<i64> = rows[1..]
+        .iter()
+        .map(|r| r.rsplit(',').next().unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(clumps.iter().filter(|&&c| c == 0).count(), 60);
+    assert_eq!(clumps.iter().filter(|&&c| c == 1).count(), 40);
+    assert_eq!(clumps.iter().filter(|&&c| c == -1).count(), 30);
+}
+
+#[test]
+fn a_snapshot_of_clumps_resumes_bit_for_bit() {
+    let mut a = Simulation::new(common::scenario(POUR)).unwrap();
+    for _ in 0..700 {
+        a.step().unwrap();
+    }
+    let bytes = tinydem::records::encode(&a.snapshot().unwrap(), 7);
+    let snapshot = tinydem::records::decode(&bytes, Some(7)).unwrap();
+    assert_eq!(snapshot.particles, a.particles);
+    let mut b = Simulation::restore(common::scenario(POUR), snapshot).unwrap();
+    for _ in 0..500 {
+        a.step().unwrap();
+        b.step().unwrap();
+    }
+    assert!(a.particles.bodies.len() == 100);
+    assert_eq!(a.particles, b.particles);
+}
+
+#[test]
+fn a_clump_whose_centre_enters_an_outlet_is_removed_whole() {
+    let outlet = "[[outlets]]\nmin = [-1.0, -1.0, -1.0]\nmax = [1.0, 1.0, -0.02]\n";
+    let mut s = sim(&text(DVec3::new(0.0, 0.0, -G), 0.5, outlet));
+    let down = DVec3::new(0.0, 0.0, -1.0);
+    s.add_clump(
+        0,
+        1.0,
+        (DVec3::ZERO, DQuat::from_rotation_y(1.2), down, DVec3::ZERO),
+    )
+    .unwrap();
+    s.add_particles(&[common::sphere(
+        R,
+        DVec3::new(0.1, 0.0, 0.0),
+        DVec3::ZERO,
+        DVec3::ZERO,
+    )])
+    .unwrap();
+    let mass = s.particles.bodies.list[0].mass;
+    run_for(&mut s, 0.05);
+    assert_eq!(s.particles.len(), 1);
+    assert!(s.particles.bodies.is_empty());
+    assert_eq!(s.removed.count(), 1);
+    assert_eq!(s.removed.outlets[0].mass, mass);
+    assert_eq!(s.thermo().particles, 1);
+}
