@@ -251,6 +251,22 @@ fn clump_runs_give_the_same_frames_on_one_and_two_threads() {
     assert_eq!(clumps.iter().filter(|&&c| c == 0).count(), 60);
     assert_eq!(clumps.iter().filter(|&&c| c == 1).count(), 40);
     assert_eq!(clumps.iter().filter(|&&c| c == -1).count(), 30);
+    // A frame read back as the input of a run is its first frame, to the byte.
+    std::fs::write(t.path().join("last.csv"), &runs[0][3]).unwrap();
+    let cut = POUR.find("[[spawn]]").unwrap();
+    let again = POUR[..cut]
+        .replace("max_particles = 1000", "max_particles = 0")
+        .replace("[output]\n", "[output]\ndir = \"again\"\n")
+        + "[input]\nparticles = \"last.csv\"\n";
+    std::fs::write(t.path().join("again.toml"), again).unwrap();
+    let out = common::tinydem(&["run", "again.toml"], t.path());
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let first = std::fs::read(t.path().join("again/particles000000.csv")).unwrap();
+    assert_eq!(String::from_utf8(first).unwrap(), last);
 }
 
 #[test]

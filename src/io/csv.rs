@@ -421,9 +421,26 @@ impl Limits {
 
 /// Reads particles in the CSV format of the frames, each within `limits` (a scenario's).
 pub fn load_particles_within(path: &Path, limits: &Limits) -> Result<Particles> {
+    Ok(load_grains_within(path, limits)?.0)
+}
+
+/// A particle file (a frame) with each row's `clump` column if it has one (the template's
+/// index, or `None` for a plain sphere).
+pub fn load_grains(path: &Path) -> Result<(Particles, Option<Vec<Option<u16>>>)> {
     let f = crate::io::files::open(path)
         .with_context(|| format!("cannot read particle file {}", path.display()))?;
-    read_particles_within(f, &path.display().to_string(), Some(limits))
+    read_grains(f, &path.display().to_string(), None)
+}
+
+/// As [`load_particles_within`], with each row's `clump` column if the file has one (the
+/// template's index, or `None` for a plain sphere).
+pub fn load_grains_within(
+    path: &Path,
+    limits: &Limits,
+) -> Result<(Particles, Option<Vec<Option<u16>>>)> {
+    let f = crate::io::files::open(path)
+        .with_context(|| format!("cannot read particle file {}", path.display()))?;
+    read_grains(f, &path.display().to_string(), Some(limits))
 }
 
 pub fn read_particles(input: impl Read, file: &str) -> Result<Particles> {
@@ -435,6 +452,15 @@ fn read_particles_within(
     file: &str,
     limits: Option<&Limits>,
 ) -> Result<Particles> {
+    Ok(read_grains(input, file, limits)?.0)
+}
+
+/// The particles of CSV text, and the `clump` column's values if it has one.
+fn read_grains(
+    input: impl Read,
+    file: &str,
+    limits: Option<&Limits>,
+) -> Result<(Particles, Option<Vec<Option<u16>>>)> {
     let mut lines = BufReader::with_capacity(1 << 16, input);
     let mut header = String::new();
     if lines
@@ -450,6 +476,7 @@ fn read_particles_within(
     let columns = Header::parse(&header, file)?;
     let mut particles = Particles::default();
     let mut ids = Vec::new();
+    let mut clumps = Vec::new();
     let mut reader = lines;
     let mut buf = String::new();
     let mut n = 1;
@@ -474,11 +501,17 @@ fn read_particles_within(
         if columns.int_column[1].is_some() {
             ids.push(ints[1]);
         }
+        if columns.int_column[4].is_some() {
+            let clump = ints[4].checked_sub(1).map(u16::try_from).transpose();
+            clumps.push(clump.map_err(|_| {
+                anyhow::anyhow!("{file}:{n}: clump {} is out of range", ints[4] - 1)
+            })?);
+        }
     }
     if columns.int_column[1].is_some() {
         keep_ids(&mut particles, ids, file)?;
     }
-    Ok(particles)
+    Ok((particles, columns.int_column[4].is_some().then_some(clumps)))
 }
 
 /// Reads a particle CSV file.

@@ -75,11 +75,63 @@ pub fn read(scenario: &Scenario) -> Result<Inputs> {
                 radius_min: g.radius_min,
                 radius_max: g.radius_max,
             };
-            csv::load_particles_within(path, &limits)?
+            match csv::load_grains_within(path, &limits)? {
+                (particles, None) => particles,
+                (rows, Some(clumps)) => with_clumps(scenario, rows, &clumps)
+                    .with_context(|| format!("particle file {}", path.display()))?,
+            }
         }
         None => Particles::default(),
     };
     Ok(Inputs { meshes, particles })
+}
+
+/// The particles of an input file's `rows` whose `clump` column names a template: those
+/// rows become clumps (x, v, q, w their body's; scaled by R over the template's bounding
+/// radius, so that a run's frame reads back as it was written), the others stay spheres.
+/// A clump of row id b takes the ids b, b + 1, ... for its spheres.
+pub fn with_clumps(s: &Scenario, rows: Particles, clumps: &[Option<u16>]) -> Result<Particles> {
+    let mut particles = Particles::default();
+    let mut taken = rustc_hash::FxHashSet::default();
+    for k in rows.id_order() {
+        let (id, row) = (&rows.id[k], rows.get(k));
+        particles.next_id = *id;
+        let first = particles.len();
+        match clumps[k] {
+            None => particles.push(row),
+            Some(t) => {
+                let Some(template) = s.clumps.get(t as usize) else {
+                    bail!(
+                        "row {}: clump {t}, but the scenario has {} [[clumps]]",
+                        k + 1,
+                        s.clumps.len()
+                    );
+                };
+                let scale = row.radius / template.bounding_radius;
+                let motion = (row.x, row.q, row.v, row.w);
+                crate::engine::spawn::place_clump(&mut particles, (template, t), scale, motion);
+                particles.tag[first..].fill(row.tag);
+                if let Some(body) = particles
+                    .bodies
+                    .list
+                    .last_mut()
+                    .filter(|b| b.id.first() == *id)
+                {
+                    body.bounding_radius = row.radius; // as written, to the bit
+                }
+            }
+        }
+        for id in *id..particles.next_id {
+            if !taken.insert(id) {
+                bail!(
+                    "row {}: id {id} is taken (a clump of row id b takes b, b + 1, ... for its spheres)",
+                    k + 1
+                );
+            }
+        }
+    }
+    particles.next_id = rows.next_id.max(taken.iter().max().map_or(0, |m| m + 1));
+    Ok(particles)
 }
 
 impl Simulation {

@@ -241,6 +241,12 @@ pub fn write_particles(path: &Path, p: &Particles) -> Result<()> {
         by_id().map(|i| p.material[i] as u32),
     );
     v.array(PointData, "fixed", 1, n, by_id().map(|i| p.fixed[i] as u8));
+    if !p.bodies.is_empty() {
+        // Every sphere of a clump is a point, with its body's id (its first sphere's): -1
+        // for a plain sphere.
+        let body = |i: usize| p.body[i].map_or(-1, |b| b.first() as i64);
+        v.array(PointData, "body", 1, n, by_id().map(body));
+    }
     v.vectors(Points, "points", n, by_id().map(|i| p.x[i]));
     v.array(Cells, "connectivity", 1, n, 0..n as i64);
     v.array(Cells, "offsets", 1, n, 1..=n as i64);

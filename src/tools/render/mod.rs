@@ -413,6 +413,19 @@ impl Source {
         })
     }
 
+    /// The particles of a frame: a clump's row (with the scenario's templates) as its
+    /// spheres.
+    fn particles_of(&self, frame: &Path) -> Result<Particles> {
+        let (p, clumps) = crate::io::csv::load_grains(frame)?;
+        match (clumps, &self.sim) {
+            (Some(c), Some(sim)) if !sim.scenario.clumps.is_empty() => {
+                crate::io::inputs::with_clumps(&sim.scenario, p, &c)
+                    .with_context(|| format!("frame {}", frame.display()))
+            }
+            _ => Ok(p),
+        }
+    }
+
     /// The time of a frame: from `frames.csv`, else from its number and the scenario.
     fn time_of(&self, frame: &Path) -> Option<f64> {
         let k = frame_number(frame)?;
@@ -481,7 +494,7 @@ pub fn render_path(
     // The layout of all frames, then the pictures in it.
     let mut layout = Layout::empty();
     for f in &frames {
-        let p = crate::io::csv::load_particles(f)?;
+        let p = source.particles_of(f)?;
         let t = source.time_of(f);
         layout.include(&p, &source.mesh_of(f, t), style);
     }
@@ -510,7 +523,7 @@ pub fn render_path(
     };
     let mut images = Vec::new();
     for f in &frames {
-        let p = crate::io::csv::load_particles(f)?;
+        let p = source.particles_of(f)?;
         let t = source.time_of(f);
         let img = render_in(&p, &source.mesh_of(f, t), style, &layout, t)?;
         let png = if path.is_dir() {
