@@ -50,6 +50,11 @@ impl Simulation {
         if !(scale > 0.0 && scale.is_finite()) {
             bail!("scale = {scale} must be finite and > 0");
         }
+        if !(q.length() > 0.0 && q.is_finite() && x.is_finite() && v.is_finite() && w.is_finite()) {
+            bail!(
+                "a clump's position, orientation and velocities must be finite, the orientation not zero"
+            );
+        }
         let first = self.particles.next_id;
         let motion = (x, q.normalize(), v, w);
         spawn::place_clump(&mut self.particles, (t, template as u16), scale, motion);
