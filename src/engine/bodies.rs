@@ -5,7 +5,6 @@
 use super::*;
 use crate::model::bodies::Body;
 use crate::model::rigid;
-use glam::DQuat;
 
 /// Stage 5a: advance every body of `p` by `dt` under gravity `g` and the loads of its
 /// spheres (which stage 5 zeroes with the others), and set its spheres' states. The sum
@@ -22,37 +21,57 @@ pub(super) fn run(model: &Model, (dt, g): (f64, DVec3), p: &mut Particles, loads
     if p.bodies.is_empty() {
         return false;
     }
-    let moved: Vec<(DVec3, DVec3, DQuat, DVec3)> = (0..p.bodies.len())
-        .into_par_iter()
+    let Particles {
+        bodies,
+        x,
+        v,
+        q,
+        w,
+        radius,
+        material,
+        ..
+    } = p;
+    let (list, members) = bodies.parts_mut();
+    let spheres = Spheres {
+        v,
+        w,
+        radius,
+        material,
+    };
+    list.par_iter_mut()
+        .enumerate()
         .with_min_len(64)
-        .map(|b| {
-            let body = &p.bodies.list[b];
-            let (f, tau) = wrench(model, p, body, p.bodies.members(b), loads);
-            let v = body.v + (f / body.mass + g) * dt;
-            let (q, w) = rigid::step(body.q, body.w, tau, body.inertia, dt);
-            (body.x + v * dt, v, q, w)
-        })
-        .collect();
+        .for_each(|(b, body)| {
+            let (f, tau) = wrench(model, &spheres, body, members.of(b), loads);
+            body.v += (f / body.mass + g) * dt;
+            body.x += body.v * dt;
+            (body.q, body.w) = rigid::step(body.q, body.w, tau, body.inertia, dt);
+        });
     let mut non_finite = false;
-    for (b, (x, v, q, w)) in moved.into_iter().enumerate() {
-        non_finite |= !(x.is_finite() && v.is_finite() && w.is_finite());
-        let body = &mut p.bodies.list[b];
-        (body.x, body.v, body.q, body.w) = (x, v, q, w);
-        let body = &p.bodies.list[b];
-        for (k, &i) in p.bodies.members(b).iter().enumerate() {
+    for (b, body) in list.iter().enumerate() {
+        non_finite |= !(body.x.is_finite() && body.v.is_finite() && body.w.is_finite());
+        for (k, &i) in members.of(b).iter().enumerate() {
             let i = i as usize;
-            (p.x[i], p.v[i]) = body.sphere_state(k);
-            (p.q[i], p.w[i]) = (q, w);
+            (x[i], v[i]) = body.sphere_state(k);
+            (q[i], w[i]) = (body.q, body.w);
         }
     }
     non_finite
+}
+
+/// What the wrench of a body reads of its spheres.
+struct Spheres<'a> {
+    v: &'a [DVec3],
+    w: &'a [DVec3],
+    radius: &'a [f64],
+    material: &'a [u16],
 }
 
 /// The force and the torque about the centre of mass on `body` (its spheres stored at
 /// `members`): its spheres' loads and drag, in their id order.
 fn wrench(
     model: &Model,
-    p: &Particles,
+    p: &Spheres,
     body: &Body,
     members: &[u32],
     loads: &[Load],

@@ -73,8 +73,8 @@ pub(crate) struct Model {
 impl Model {
     /// The mass of particle `k` of `p` (of its body, for a sphere of a rigid body).
     fn mass(&self, p: &Particles, k: usize) -> f64 {
-        if let Some(b) = p.body[k] {
-            return p.bodies.mass_of(b);
+        if p.body[k].is_some() {
+            return p.bodies.mass_at(k);
         }
         Inertia::mass_with(
             p.radius[k],
@@ -93,8 +93,8 @@ fn body_masses(p: &Particles, idx: &[usize; WIDTH], m: Group) -> Group {
     }
     let mut m = m.scatter();
     for (l, &k) in idx.iter().enumerate() {
-        if let Some(b) = p.body[k] {
-            m[l] = p.bodies.mass_of(b);
+        if p.body[k].is_some() {
+            m[l] = p.bodies.mass_at(k);
         }
     }
     Group::gather(m)

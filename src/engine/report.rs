@@ -91,11 +91,7 @@ impl Simulation {
     }
 
     fn mass_of(&self, k: usize) -> f64 {
-        let p = &self.particles;
-        Inertia::mass_with(
-            p.radius[k],
-            self.model.densities[p.material[k] as usize].mass_per_r3,
-        )
+        self.model.mass(&self.particles, k)
     }
 
     fn body_of(&self, k: usize) -> Body {

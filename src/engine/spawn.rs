@@ -510,7 +510,7 @@ pub(crate) fn place_clump(
 }
 
 /// A rotation uniform over all rotations (Shoemake's subgroup algorithm, 1992).
-fn uniform_rotation(rng: &mut ChaCha8Rng) -> glam::DQuat {
+pub(crate) fn uniform_rotation(rng: &mut ChaCha8Rng) -> glam::DQuat {
     let (u1, u2, u3) = (
         uniform(rng, 0.0, 1.0),
         uniform(rng, 0.0, std::f64::consts::TAU),

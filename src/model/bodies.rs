@@ -73,6 +73,9 @@ pub struct Bodies {
     /// Where body b's spheres are stored: `members[start[b]..start[b + 1]]`, in id order.
     start: Vec<u32>,
     members: Vec<u32>,
+    /// The mass of the body of the sphere stored at each index (for the contact law,
+    /// without a search), 0 for a plain sphere; up to the last sphere of a body.
+    mass_at: Vec<f64>,
 }
 
 impl Bodies {
@@ -89,6 +92,12 @@ impl Bodies {
         self.list.binary_search_by_key(&id, |b| b.id).ok()
     }
 
+    /// The mass of the body whose sphere is stored at `k` (which must be a body's sphere).
+    #[inline(always)]
+    pub fn mass_at(&self, k: usize) -> f64 {
+        self.mass_at[k]
+    }
+
     /// The mass of body `id` (which must exist).
     pub fn mass_of(&self, id: BodyId) -> f64 {
         self.list[self.index_of(id).expect("a listed body")].mass
@@ -97,6 +106,15 @@ impl Bodies {
     /// The storage indices of body b's spheres (b an index in `list`), in id order.
     pub fn members(&self, b: usize) -> &[u32] {
         &self.members[self.start[b] as usize..self.start[b + 1] as usize]
+    }
+
+    /// The bodies to change, and where each one's spheres are stored.
+    pub fn parts_mut(&mut self) -> (&mut [Body], Members<'_>) {
+        let members = Members {
+            start: &self.start,
+            members: &self.members,
+        };
+        (&mut self.list, members)
     }
 
     /// Finds every body's spheres in storage (ids `id`, bodies `body`), after particles
@@ -118,16 +136,27 @@ impl Bodies {
         self.list.retain(|_| keep.next().expect("one per body"));
         self.start = vec![0];
         self.members.clear();
-        for f in found.into_iter().filter(|f| f[0] != u32::MAX) {
+        self.mass_at.clear();
+        self.mass_at.resize(id.len(), 0.0);
+        for (f, body) in found
+            .into_iter()
+            .filter(|f| f[0] != u32::MAX)
+            .zip(&self.list)
+        {
             assert!(
                 f.iter().all(|&k| k != u32::MAX),
                 "a body lost some of its spheres"
             );
+            for &k in &f {
+                self.mass_at[k as usize] = body.mass;
+            }
             self.members.extend(f);
             self.start.push(self.members.len() as u32);
         }
         if self.list.is_empty() {
-            self.start.clear(); // as a table that never held a body
+            // As a table that never held a body.
+            self.start.clear();
+            self.mass_at.clear();
         }
     }
 
@@ -143,7 +172,23 @@ impl Bodies {
         let n = body.offsets.len();
         self.members.extend((first..first + n).map(|k| k as u32));
         self.start.push(self.members.len() as u32);
+        self.mass_at.resize(first, 0.0);
+        self.mass_at.resize(first + n, body.mass);
         self.list.push(body);
+    }
+}
+
+/// Where the spheres of each body are stored ([`Bodies::parts_mut`]).
+#[derive(Clone, Copy)]
+pub struct Members<'a> {
+    start: &'a [u32],
+    members: &'a [u32],
+}
+
+impl Members<'_> {
+    /// The storage indices of body b's spheres, in id order.
+    pub fn of(&self, b: usize) -> &[u32] {
+        &self.members[self.start[b] as usize..self.start[b + 1] as usize]
     }
 }
 

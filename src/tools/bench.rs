@@ -88,6 +88,81 @@ pub fn setup(n: usize) -> Result<Simulation> {
     Simulation::from_parts(scenario, mesh, particles)
 }
 
+/// The spheres of a clump of `k` spheres (1 to 4: a sphere, a dimer, a triangle, a
+/// tetrahedron) inside a grain of radius `a`, as `[[clumps]]` text.
+fn clump_template(k: usize, a: f64) -> Result<String> {
+    let (r, d, centres): (f64, f64, Vec<DVec3>) = match k {
+        1 => (1.0, 0.0, vec![DVec3::ZERO]),
+        2 => (0.6, 0.4, vec![DVec3::X, -DVec3::X]),
+        3 => {
+            let at = |t: f64| DVec3::new(t.cos(), t.sin(), 0.0);
+            (
+                0.58,
+                0.42,
+                (0..3)
+                    .map(|i| at(i as f64 * std::f64::consts::TAU / 3.0))
+                    .collect(),
+            )
+        }
+        4 => {
+            let v = [
+                [1.0, 1.0, 1.0],
+                [1.0, -1.0, -1.0],
+                [-1.0, 1.0, -1.0],
+                [-1.0, -1.0, 1.0],
+            ];
+            (
+                0.55,
+                0.45,
+                v.map(|c| DVec3::from_array(c).normalize()).to_vec(),
+            )
+        }
+        _ => bail!("--clumps {k}: clumps of 1 to 4 spheres"),
+    };
+    let spheres: Vec<String> = (centres.iter())
+        .map(|c| {
+            format!(
+                "[{}, {}, {}, {}]",
+                c.x * d * a,
+                c.y * d * a,
+                c.z * d * a,
+                r * a
+            )
+        })
+        .collect();
+    Ok(format!(
+        "[[clumps]]\nname = \"grain\"\nspheres = [{}]\n",
+        spheres.join(", ")
+    ))
+}
+
+/// The benchmark packing of `n` grains with each grain a clump of `k` spheres inside its
+/// sphere (scaled to its radius, oriented at random): the same places, time step and
+/// material; the clumps' spheres are smaller, so the packing settles further.
+pub fn setup_clumps(n: usize, k: usize) -> Result<Simulation> {
+    use rand::SeedableRng;
+    let spheres = setup(n)?;
+    let dt = spheres.scenario.simulation.timestep;
+    let a = 0.0045;
+    let text = SCENARIO.replace("radius_min = 0.004", "radius_min = 0.002")
+        + &format!("timestep = {dt}\n")
+        + &clump_template(k, a)?;
+    let scenario = Scenario::parse(&text, Path::new("bench"))?;
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
+    let mut particles = Particles::default();
+    let t = &scenario.clumps[0];
+    for p in spheres.particles.iter() {
+        let q = crate::engine::spawn::uniform_rotation(&mut rng);
+        let motion = (p.x, q, p.v, p.w);
+        crate::engine::spawn::place_clump(&mut particles, (t, 0), p.radius / a, motion);
+    }
+    let mesh = Mesh {
+        faces: spheres.walls.mesh.faces.clone(),
+        ..Mesh::default()
+    };
+    Simulation::from_parts(scenario, mesh, particles)
+}
+
 /// Figures of one benchmark configuration.
 #[derive(Clone, Debug)]
 pub struct Measurement {
@@ -136,17 +211,21 @@ pub fn default_steps(n: usize) -> u64 {
     (10_000_000 / n as u64).clamp(100, 5000)
 }
 
-/// Runs the benchmark for `n` particles on the current thread pool, split over the
+/// Runs the benchmark for `n` particles (grains: clumps of `clumps` spheres each, if given)
+/// on the current thread pool, split over the
 /// processes of `world` if given: a warm-up, then `repeats` timed segments of `steps`
 /// steps.
 pub fn measure(
-    n: usize,
+    (n, clumps): (usize, Option<usize>),
     steps: u64,
     repeats: usize,
     world: Option<Box<dyn crate::parallel::comm::Comm>>,
 ) -> Result<Measurement> {
     let rss_before = proc_status_bytes("VmRSS:");
-    let mut sim = setup(n)?;
+    let mut sim = match clumps {
+        None => setup(n)?,
+        Some(k) => setup_clumps(n, k)?,
+    };
     let ranks = world.as_ref().map_or(1, |w| w.size());
     if let Some(world) = world.filter(|w| w.size() > 1) {
         sim = sim.split(world)?;

@@ -27,6 +27,11 @@ pub struct BenchArgs {
     /// Timed segments per configuration; the median is reported.
     #[arg(long, default_value_t = 3)]
     repeats: usize,
+    /// Make each grain of the packing a clump of this many spheres (1 to 4: a sphere, a
+    /// dimer, a triangle, a tetrahedron inside the grain's sphere), to measure the cost
+    /// per body-step of clumps.
+    #[arg(long)]
+    clumps: Option<usize>,
     /// Run one configuration in this process (used by the benchmark itself).
     #[arg(long, hide = true)]
     pub single: bool,
@@ -43,7 +48,7 @@ impl BenchArgs {
         if self.single {
             let n = self.sizes[0];
             let steps = self.steps.unwrap_or(tinydem::bench::default_steps(n));
-            let m = tinydem::bench::measure(n, steps, self.repeats, world)?;
+            let m = tinydem::bench::measure((n, self.clumps), steps, self.repeats, world)?;
             if first {
                 println!("{}", m.row());
             }
@@ -86,6 +91,9 @@ impl BenchArgs {
                 cmd.args(["--repeats", &self.repeats.to_string()]);
                 if let Some(s) = self.steps {
                     cmd.args(["--steps", &s.to_string()]);
+                }
+                if let Some(k) = self.clumps {
+                    cmd.args(["--clumps", &k.to_string()]);
                 }
                 let out = cmd.output().context("cannot run the benchmark process")?;
                 if !out.status.success() {
