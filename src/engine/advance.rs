@@ -76,13 +76,13 @@ pub(super) fn run(
                 Group::scatter_vec(new.w),
             );
             if fixed.contains(&true) || member.iter().any(Option::is_some) {
-                let held = |l: usize| match (fixed[l], member[l]) {
-                    (_, Some(_)) => Held::Member,
-                    (true, None) => Held::Fixed,
-                    (false, None) => Held::Free,
-                };
-                let held: Vec<Held> = (0..n).map(held).collect();
-                hold(&held, (x, v, q, w), (&new_x, &new_v, &new_q, &new_w));
+                let held: [Held; WIDTH] = std::array::from_fn(|l| match (lane[l], l < n) {
+                    (_, false) => Held::Free, // a spare lane
+                    (k, true) if member[k].is_some() => Held::Member,
+                    (k, true) if fixed[k] => Held::Fixed,
+                    _ => Held::Free,
+                });
+                hold(&held[..n], (x, v, q, w), (&new_x, &new_v, &new_q, &new_w));
             } else {
                 x.copy_from_slice(&new_x[..n]);
                 v.copy_from_slice(&new_v[..n]);

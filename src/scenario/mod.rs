@@ -27,7 +27,7 @@
 //! [[spawn]]    min, max, material, velocity, count, rate, start, stop, radius = {
 //!              distribution = "uniform" | "normal" | "lognormal" | "table", ... }
 //! [[clumps]]  name, spheres = [[x, y, z, r], ...] | file, material, mass, inertia
-//!              (rigid clumps of spheres; not yet spawned)
+//!              (rigid clumps of spheres; spawned by [[spawn]] clump, scale)
 //! [[materials]] name, density, youngs_modulus, poisson_ratio, restitution, friction_*
 //! [[interactions]] materials = [a, b], restitution, friction_*
 //! [input]      particles
