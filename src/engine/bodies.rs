@@ -5,6 +5,7 @@
 use super::*;
 use crate::model::bodies::Body;
 use crate::model::rigid;
+use crate::neighbours::Periodic;
 
 /// Stage 5a: advance every body of `p` by `dt` under gravity `g` and the loads of its
 /// spheres (which stage 5 zeroes with the others), and set its spheres' states. The sum
@@ -17,7 +18,13 @@ use crate::model::rigid;
 /// Leimkuhler & McLachlan turns the body freely, gyroscopic term included). Drag acts on
 /// each sphere as on a free one (Eqs. 3-4, at the sphere's velocity).
 #[inline(never)] // a stage of its own in profiles
-pub(super) fn run(model: &Model, (dt, g): (f64, DVec3), p: &mut Particles, loads: &[Load]) -> bool {
+pub(super) fn run(
+    model: &Model,
+    (dt, g): (f64, DVec3),
+    periodic: Option<Periodic>,
+    p: &mut Particles,
+    loads: &[Load],
+) -> bool {
     if p.bodies.is_empty() {
         return false;
     }
@@ -52,11 +59,26 @@ pub(super) fn run(model: &Model, (dt, g): (f64, DVec3), p: &mut Particles, loads
         non_finite |= !(body.x.is_finite() && body.v.is_finite() && body.w.is_finite());
         for (k, &i) in members.of(b).iter().enumerate() {
             let i = i as usize;
-            (x[i], v[i]) = body.sphere_state(k);
+            let (at, velocity) = body.sphere_state(k);
+            (x[i], v[i]) = (at + image_of(periodic, x[i] - at), velocity);
             (q[i], w[i]) = (body.q, body.w);
         }
     }
     non_finite
+}
+
+/// The shift by whole periods along the periodic axes nearest `d`: which image of its
+/// place a sphere was at (a rebuild wraps each sphere into the box on its own), kept when
+/// the body places it anew. Zero without periodic axes (Lees-Edwards is refused).
+fn image_of(periodic: Option<Periodic>, d: DVec3) -> DVec3 {
+    let Some(p) = periodic else {
+        return DVec3::ZERO;
+    };
+    let mut shift = DVec3::ZERO;
+    for a in (0..3).filter(|&a| p.axes[a]) {
+        shift[a] = (d[a] / p.length[a]).round() * p.length[a];
+    }
+    shift
 }
 
 /// What the wrench of a body reads of its spheres.

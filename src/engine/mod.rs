@@ -367,8 +367,12 @@ impl std::fmt::Display for Unstable {
 
 impl std::error::Error for Unstable {}
 
-/// Fails unless every particle's material is one of the scenario's.
+/// Fails unless every particle's material is one of the scenario's (and there are no
+/// clumps in a Lees-Edwards domain).
 fn check_materials(p: &Particles, s: &Scenario) -> Result<()> {
+    if !p.bodies.is_empty() && s.lees_edwards.is_some() {
+        bail!("clumps in a Lees-Edwards domain are not supported yet (issue 28)");
+    }
     let n = s.materials.len();
     if let Some(k) = (0..p.len()).find(|&k| p.material[k] as usize >= n) {
         bail!(
@@ -496,6 +500,9 @@ impl Simulation {
             for (x, v) in p.x.iter_mut().zip(p.v.iter_mut()) {
                 (*x, *v) = periodic.wrap_state(*x, *v);
             }
+            for b in &mut p.bodies.list {
+                (b.x, b.v) = periodic.wrap_state(b.x, b.v);
+            }
         }
         std::borrow::Cow::Owned(p)
     }
@@ -527,7 +534,9 @@ impl Simulation {
             self.scenario.simulation.timestep,
             self.scenario.kinetics.gravity,
         );
-        let bodies_non_finite = bodies::run(&self.model, (dt, g), &mut self.particles, &self.loads);
+        let periodic = self.neighbours.periodic;
+        let bodies_non_finite =
+            bodies::run(&self.model, (dt, g), periodic, &mut self.particles, &self.loads);
         let t = self.stage_times.add(Stage::Bodies, t);
         let non_finite = advance::run(&self.model, (dt, g), &mut self.particles, &mut self.loads)
             | bodies_non_finite;

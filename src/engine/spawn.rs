@@ -364,12 +364,8 @@ impl Spawner {
                 uniform(&mut self.rng, lo.y, hi.y),
                 uniform(&mut self.rng, lo.z, hi.z),
             );
-            let free = crowd.free(particles, x, radius)
-                && face_grid.at(x).iter().all(|&f| {
-                    let face = &faces[f as usize];
-                    let reach = radius + face.radius;
-                    face.separation(x).length_squared() >= reach * reach
-                });
+            let free =
+                crowd.free(particles, x, radius) && clear_of_faces((faces, face_grid), x, radius);
             if !free {
                 *pending = Some(radius);
                 continue;
@@ -442,12 +438,7 @@ impl Spawner {
                 .map(|sp| (x + q * (sp.centre * scale), sp.radius * scale))
                 .collect();
             let free = spheres.iter().all(|&(at, radius)| {
-                crowd.free(particles, at, radius)
-                    && face_grid.at(at).iter().all(|&f| {
-                        let face = &faces[f as usize];
-                        let reach = radius + face.radius;
-                        face.separation(at).length_squared() >= reach * reach
-                    })
+                crowd.free(particles, at, radius) && clear_of_faces((faces, face_grid), at, radius)
             });
             if !free {
                 *pending = Some(scale);
@@ -507,6 +498,15 @@ pub(crate) fn place_clump(
         bounding_radius: t.bounding_radius * scale,
     };
     particles.push_body(body, &radii, sphere);
+}
+
+/// Whether a sphere at `x` of `radius` keeps clear of the `faces` (binned in `face_grid`).
+fn clear_of_faces((faces, face_grid): (&[Face], &CellGrid), x: DVec3, radius: f64) -> bool {
+    face_grid.at(x).iter().all(|&f| {
+        let face = &faces[f as usize];
+        let reach = radius + face.radius;
+        face.separation(x).length_squared() >= reach * reach
+    })
 }
 
 /// A rotation uniform over all rotations (Shoemake's subgroup algorithm, 1992).
