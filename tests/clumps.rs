@@ -251,6 +251,9 @@ fn clump_runs_give_the_same_frames_on_one_and_two_threads() {
     assert_eq!(clumps.iter().filter(|&&c| c == 0).count(), 60);
     assert_eq!(clumps.iter().filter(|&&c| c == 1).count(), 40);
     assert_eq!(clumps.iter().filter(|&&c| c == -1).count(), 30);
+    // analyze fits piles of clumps on their spheres (reads run.toml's templates).
+    let out = common::tinydem(&["analyze", "output", "--repose"], t.path());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     // A frame read back as the input of a run is its first frame, to the byte.
     std::fs::write(t.path().join("last.csv"), &runs[0][3]).unwrap();
     let cut = POUR.find("[[spawn]]").unwrap();
@@ -320,8 +323,14 @@ fn clumps_meeting_across_a_periodic_side_keep_their_shape_and_momenta() {
     let mut s = sim(&text(DVec3::ZERO, 0.5, domain));
     let tilt = DQuat::from_rotation_z(0.7);
     let (v, w) = (DVec3::new(0.8, 0.0, 0.0), DVec3::new(0.0, 5.0, -3.0));
-    s.add_clump(0, 1.0, (DVec3::new(0.03, 0.0, 0.0), tilt, v, w)).unwrap();
-    s.add_clump(0, 1.0, (DVec3::new(-0.035, 0.002, 0.0), tilt.inverse(), -v, -w)).unwrap();
+    s.add_clump(0, 1.0, (DVec3::new(0.03, 0.0, 0.0), tilt, v, w))
+        .unwrap();
+    s.add_clump(
+        0,
+        1.0,
+        (DVec3::new(-0.035, 0.002, 0.0), tilt.inverse(), -v, -w),
+    )
+    .unwrap();
     let (m0, l0) = momenta(&s.particles);
     let mut touched = 0;
     for _ in 0..3000 {
@@ -335,15 +344,26 @@ fn clumps_meeting_across_a_periodic_side_keep_their_shape_and_momenta() {
         for (k, &i) in p.bodies.members(b).iter().enumerate() {
             let d = p.x[i as usize] - body.sphere_state(k).0;
             let periods = d.x / 0.1;
-            assert!((periods - periods.round()).abs() < 1e-9 && d.y == 0.0 && d.z == 0.0, "{d}");
+            assert!(
+                (periods - periods.round()).abs() < 1e-9 && d.y == 0.0 && d.z == 0.0,
+                "{d}"
+            );
         }
     }
     // Momentum is kept; angular momentum about the origin is not defined across the side,
     // but the spin and the momentum along y and z are what they were at the start.
     let (m1, _) = momenta(p);
-    assert!((m1 - m0).length() <= 1e-12 * v.length() * p.bodies.list[0].mass, "{m0} -> {m1}");
+    assert!(
+        (m1 - m0).length() <= 1e-12 * v.length() * p.bodies.list[0].mass,
+        "{m0} -> {m1}"
+    );
     let _ = l0;
     // Frames put the bodies' centres back into the box.
     let out = s.particles_in_domain();
-    assert!(out.bodies.list.iter().all(|b| b.x.x >= -0.05 && b.x.x < 0.05));
+    assert!(
+        out.bodies
+            .list
+            .iter()
+            .all(|b| b.x.x >= -0.05 && b.x.x < 0.05)
+    );
 }

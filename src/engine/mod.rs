@@ -535,8 +535,13 @@ impl Simulation {
             self.scenario.kinetics.gravity,
         );
         let periodic = self.neighbours.periodic;
-        let bodies_non_finite =
-            bodies::run(&self.model, (dt, g), periodic, &mut self.particles, &self.loads);
+        let bodies_non_finite = bodies::run(
+            &self.model,
+            (dt, g),
+            periodic,
+            &mut self.particles,
+            &self.loads,
+        );
         let t = self.stage_times.add(Stage::Bodies, t);
         let non_finite = advance::run(&self.model, (dt, g), &mut self.particles, &mut self.loads)
             | bodies_non_finite;

@@ -189,8 +189,16 @@ impl AnalyzeArgs {
         let mut no_pile = Vec::new();
         let count = frames.len();
         for (k, path) in frames {
-            let p = tinydem::csv::load_particles(&path)?;
-            let row = table.row(k, &p, &mut no_pile);
+            let (p, clumps) = tinydem::csv::load_grains(&path)?;
+            // A pile of clumps is fitted on the clumps' spheres (its surface, and diameters
+            // of the spheres for the window).
+            let spheres = match clumps {
+                Some(c) if !s.clumps.is_empty() => {
+                    Some(tinydem::io::inputs::with_clumps(&s, p.clone(), &c)?)
+                }
+                _ => None,
+            };
+            let row = table.row(k, (&p, spheres.as_ref().unwrap_or(&p)), &mut no_pile);
             println!("{}", aligned(&row));
             rows.push(row.join(","));
         }
@@ -293,7 +301,13 @@ impl Table {
 
     /// The row of frame `k` with particles `p`; a frame with no pile to fit is added to
     /// `no_pile` with the reason.
-    fn row(&self, k: u64, p: &Particles, no_pile: &mut Vec<(u64, NoPile)>) -> Vec<String> {
+    /// `spheres`: the particles with clumps as their spheres (the pile's surface).
+    fn row(
+        &self,
+        k: u64,
+        (p, spheres): (&Particles, &Particles),
+        no_pile: &mut Vec<(u64, NoPile)>,
+    ) -> Vec<String> {
         let mut row = vec![
             k.to_string(),
             format!("{:.6e}", k as f64 * self.frame_time),
@@ -303,7 +317,7 @@ impl Table {
             format!("{:.4}", packing_fraction(p)),
         ];
         if let Some(w) = self.repose {
-            match angle_of_repose(p, w) {
+            match angle_of_repose(spheres, w) {
                 Ok(a) => row.extend(
                     [a.left.angle, a.left.error, a.right.angle, a.right.error]
                         .map(|v| format!("{v:.2}")),
