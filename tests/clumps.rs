@@ -253,7 +253,11 @@ fn clump_runs_give_the_same_frames_on_one_and_two_threads() {
     assert_eq!(clumps.iter().filter(|&&c| c == -1).count(), 30);
     // analyze fits piles of clumps on their spheres (reads run.toml's templates).
     let out = common::tinydem(&["analyze", "output", "--repose"], t.path());
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     // A frame read back as the input of a run is its first frame, to the byte.
     std::fs::write(t.path().join("last.csv"), &runs[0][3]).unwrap();
     let cut = POUR.find("[[spawn]]").unwrap();

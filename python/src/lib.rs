@@ -118,9 +118,22 @@ impl Simulation {
     }
 
     /// The rows of an (N, 3) array in id order, checked against the particle count.
-    fn rows(&self, name: &str, a: Vectors) -> PyResult<Vec<(usize, DVec3)>> {
-        let v = vectors(name, a, self.sim.particles.len())?;
-        Ok(self.order().into_iter().zip(v).collect())
+    /// The rows of `a` (in id order) for the particles' `now` values (storage order); a
+    /// sphere of a clump must keep its value, which the clump's motion sets.
+    fn rows(&self, name: &str, a: Vectors, now: &[DVec3]) -> PyResult<Vec<(usize, DVec3)>> {
+        let p = &self.sim.particles;
+        let v = vectors(name, a, p.len())?;
+        let rows: Vec<(usize, DVec3)> = self.order().into_iter().zip(v).collect();
+        let moved = |&(i, v): &(usize, DVec3)| p.body[i].is_some() && v != now[i];
+        if let Some((k, &(i, _))) = rows.iter().enumerate().find(|(_, r)| moved(r)) {
+            return Err(PyValueError::new_err(format!(
+                "{name}[{k}]: particle {} is a sphere of the clump {}, which moves as one body: \
+                 its spheres' {name} cannot be set (yet)",
+                p.id[i],
+                p.body[i].expect("a clump's").first()
+            )));
+        }
+        Ok(rows)
     }
 }
 
@@ -259,7 +272,7 @@ impl Simulation {
     /// anew at the next step.
     #[setter]
     fn set_positions(&mut self, x: Vectors) -> PyResult<()> {
-        for (i, x) in self.rows("positions", x)? {
+        for (i, x) in self.rows("positions", x, &self.sim.particles.x)? {
             self.sim.particles.x[i] = x;
         }
         self.sim.particles_moved();
@@ -402,7 +415,7 @@ impl Simulation {
 
     #[setter]
     fn set_velocities(&mut self, v: Vectors) -> PyResult<()> {
-        for (i, v) in self.rows("velocities", v)? {
+        for (i, v) in self.rows("velocities", v, &self.sim.particles.v)? {
             self.sim.particles.v[i] = v;
         }
         Ok(())
@@ -416,7 +429,7 @@ impl Simulation {
 
     #[setter]
     fn set_angular_velocities(&mut self, w: Vectors) -> PyResult<()> {
-        for (i, w) in self.rows("angular_velocities", w)? {
+        for (i, w) in self.rows("angular_velocities", w, &self.sim.particles.w)? {
             self.sim.particles.w[i] = w;
         }
         Ok(())

@@ -332,6 +332,9 @@ def test_clumps_added_from_python_move_as_rigid_bodies(tmp_path):
     assert abs(np.linalg.norm(x[1] - x[0]) - 0.004) < 1e-12
     assert np.array_equal(sim.orientations[0], sim.orientations[1])
     assert sim.positions[:, 2].max() < 0.02
+    sim.positions = sim.positions  # unchanged: allowed
+    with pytest.raises(ValueError, match="is a sphere of the clump 0"):
+        sim.positions = sim.positions + 0.001
     sim.write_frame(tmp_path / "dimer.csv")
     frame = tinydem.read_frame(tmp_path / "dimer.csv")
     assert list(frame["clump"]) == [0]
