@@ -371,3 +371,65 @@ fn clumps_meeting_across_a_periodic_side_keep_their_shape_and_momenta() {
             .all(|b| b.x.x >= -0.05 && b.x.x < 0.05)
     );
 }
+
+/// Every reference case with its particles read as clumps of one sphere (a `clump` column
+/// of 0 and a one-sphere template): the same particles, bit for bit, after every step of
+/// the case.
+#[test]
+fn the_reference_cases_with_one_sphere_clumps_give_the_same_bits() {
+    let t = tempfile::tempdir().unwrap();
+    let root = common::data("reference");
+    let mut cases = 0;
+    for entry in std::fs::read_dir(&root).unwrap() {
+        let dir = entry.unwrap().path();
+        let Ok(text) = std::fs::read_to_string(dir.join("scenario.toml")) else {
+            continue;
+        };
+        let plain = common::scenario_at(&text, &dir.join("scenario.toml"));
+        let Some(input) = plain.particles.clone() else {
+            continue;
+        };
+        let rows: Vec<String> = std::fs::read_to_string(&input)
+            .unwrap()
+            .lines()
+            .map(String::from)
+            .collect();
+        let csv = t.path().join(format!(
+            "{}.csv",
+            dir.file_name().unwrap().to_string_lossy()
+        ));
+        let mut clumped_rows = vec![format!("{},clump", rows[0])];
+        clumped_rows.extend(
+            rows[1..]
+                .iter()
+                .filter(|r| !r.trim().is_empty())
+                .map(|r| format!("{r},0")),
+        );
+        std::fs::write(&csv, clumped_rows.join("\n") + "\n").unwrap();
+        let r = plain.geometry.radius_min;
+        let clumped =
+            format!("{text}\n[[clumps]]\nname = \"one\"\nspheres = [[0.0, 0.0, 0.0, {r}]]\n")
+                .replace(
+                    &format!(
+                        "particles = \"{}\"",
+                        input.file_name().unwrap().to_string_lossy()
+                    ),
+                    &format!("particles = {:?}", csv.display().to_string()),
+                );
+        let clumped = common::scenario_at(&clumped, &dir.join("scenario.toml"));
+        assert_eq!(clumped.particles.as_deref(), Some(csv.as_path()));
+        let steps = plain.simulation.frames * plain.simulation.steps_per_frame;
+        let (mut a, mut b) = (
+            Simulation::new(plain).unwrap(),
+            Simulation::new(clumped).unwrap(),
+        );
+        assert_eq!(a.particles, b.particles, "{}", dir.display());
+        for _ in 0..steps {
+            a.step().unwrap();
+            b.step().unwrap();
+        }
+        assert_eq!(a.particles, b.particles, "{}", dir.display());
+        cases += 1;
+    }
+    assert!(cases >= 5, "{cases} reference cases");
+}

@@ -12,8 +12,8 @@ use crate::engine::records::Snapshot;
 use crate::engine::setup::Inputs;
 use crate::geometry::mesh::Mesh;
 use crate::io::{csv, files};
-use crate::model::particles::Particles;
-use crate::scenario::{MeshInput, MeshSource, Scenario};
+use crate::model::particles::{Particle, Particles};
+use crate::scenario::{ClumpTemplate, MeshInput, MeshSource, Scenario};
 
 impl Scenario {
     /// Reads and validates a scenario file.
@@ -96,7 +96,6 @@ pub fn with_clumps(s: &Scenario, rows: Particles, clumps: &[Option<u16>]) -> Res
     for k in rows.id_order() {
         let (id, row) = (&rows.id[k], rows.get(k));
         particles.next_id = *id;
-        let first = particles.len();
         match clumps[k] {
             None => particles.push(row),
             Some(t) => {
@@ -107,17 +106,12 @@ pub fn with_clumps(s: &Scenario, rows: Particles, clumps: &[Option<u16>]) -> Res
                         s.clumps.len()
                     );
                 };
-                let scale = row.radius / template.bounding_radius;
-                let motion = (row.x, row.q, row.v, row.w);
-                crate::engine::spawn::place_clump(&mut particles, (template, t), scale, motion);
-                particles.tag[first..].fill(row.tag);
-                if let Some(body) = particles
-                    .bodies
-                    .list
-                    .last_mut()
-                    .filter(|b| b.id.first() == *id)
-                {
-                    body.bounding_radius = row.radius; // as written, to the bit
+                if let [_] = template.spheres[..] {
+                    // A clump of one sphere is that sphere, at its row's place and radius.
+                    let material = template.material;
+                    particles.push(Particle { material, ..row });
+                } else {
+                    place_row(&mut particles, (template, t), *id, row);
                 }
             }
         }
@@ -166,5 +160,24 @@ impl Simulation {
             particles: Particles::default(),
         };
         Simulation::stage_from(scenario, inputs, snapshot)
+    }
+}
+
+/// Places the clump of template `t` (its index `template`) that the row `row` of id `id`
+/// describes: scaled by R over the template's bounding radius, its bounding radius as
+/// written (to the bit), its spheres tagged as the row.
+fn place_row(
+    particles: &mut Particles,
+    (t, template): (&ClumpTemplate, u16),
+    id: u32,
+    row: Particle,
+) {
+    let first = particles.len();
+    let scale = row.radius / t.bounding_radius;
+    let motion = (row.x, row.q, row.v, row.w);
+    crate::engine::spawn::place_clump(particles, (t, template), scale, motion);
+    particles.tag[first..].fill(row.tag);
+    if let Some(body) = (particles.bodies.list.last_mut()).filter(|b| b.id.first() == id) {
+        body.bounding_radius = row.radius;
     }
 }

@@ -20,6 +20,12 @@ pub fn scenario(text: &str) -> Scenario {
     Scenario::parse(text, &data("inline.toml")).expect("valid test scenario")
 }
 
+/// A scenario from TOML text read as if from `path` (relative paths resolve against its
+/// directory).
+pub fn scenario_at(text: &str, path: &Path) -> Scenario {
+    Scenario::parse(text, path).expect("valid test scenario")
+}
+
 /// A sphere of radius `radius` at `x` with velocity `v` and spin `w`, unrotated, tag and
 /// material 0.
 pub fn sphere(radius: f64, x: DVec3, v: DVec3, w: DVec3) -> Particle {
