@@ -12,6 +12,7 @@ the renderer. Needs the Python package
 Runs go to /tmp/tinydem-pictures/NAME; pictures to docs/book/src/pictures/.
 """
 
+import os
 import subprocess
 import sys
 import tempfile
@@ -195,7 +196,19 @@ def j():
             width=480, height=560, scenario=pressed / "run.toml", scale_bar=True)
 
 
-ALL = {"hourglass": hourglass, "b": b, "c": c, "d": d, "e": e, "f": f, "g": g, "h": h, "j": j}
+def i():
+    """Example I: the pile of tetrahedral clumps, and the packing fractions of dimers (its
+    script runs the 14 packings and draws the plot)."""
+    out = run("i", EXAMPLES / "i_clumps" / "pile_tetrahedra.toml")
+    picture(frame(out, int(tinydem.read_output(out).numbers[-1])), DOCS / "i_pile_tetrahedra.png",
+            color="height", view="front", width=720, height=420, scale_bar=True,
+            scenario=out / "run.toml")
+    subprocess.run([sys.executable, str(EXAMPLES / "i_clumps" / "packing.py")], check=True,
+                   env={**os.environ, "TINYDEM_BIN": str(BINARY)})
+
+
+ALL = {"hourglass": hourglass, "b": b, "c": c, "d": d, "e": e, "f": f, "g": g, "h": h, "i": i,
+       "j": j}
 
 if __name__ == "__main__":
     for name in [a for a in sys.argv[1:] if a != "--reuse"] or ALL:
