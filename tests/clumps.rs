@@ -433,3 +433,43 @@ fn the_reference_cases_with_one_sphere_clumps_give_the_same_bits() {
     }
     assert!(cases >= 5, "{cases} reference cases");
 }
+
+#[test]
+fn a_clump_crossing_the_sheared_side_of_a_lees_edwards_box_stays_whole() {
+    let domain = "[domain]\nmin = [-0.05, -0.05, -0.05]\nmax = [0.05, 0.05, 0.05]\nperiodic = [true, true, true]\n\
+                  lees_edwards = { velocity = 0.5, shear_axis = \"x\", gradient_axis = \"z\" }\n";
+    let mut s = sim(&text(DVec3::ZERO, 0.5, domain));
+    let v = DVec3::new(0.0, 0.0, 1.0);
+    let q = DQuat::from_rotation_y(0.8);
+    s.add_clump(
+        0,
+        1.0,
+        (DVec3::new(0.0, 0.0, 0.04), q, v, DVec3::new(0.0, 3.0, 0.0)),
+    )
+    .unwrap();
+    let mut straddled = false;
+    for _ in 0..200 {
+        s.step().unwrap();
+        let p = &s.particles;
+        let body = &p.bodies.list[0];
+        for (k, &i) in p.bodies.members(0).iter().enumerate() {
+            let (at, velocity) = body.sphere_state(k);
+            let (d, dv) = (p.x[i as usize] - at, p.v[i as usize] - velocity);
+            // The sphere is its place's image: n periods along z, n offsets along x (and
+            // whole periods), moving n shear velocities faster along x.
+            let n = (d.z / 0.1).round();
+            assert!((d.z - n * 0.1).abs() < 1e-12 && d.y.abs() < 1e-12, "{d}");
+            // The offset of the step's images: at its start.
+            let t = s.time - s.scenario.simulation.timestep;
+            let offset = (0.5 * t).rem_euclid(0.1);
+            let along = (d.x - n * offset) / 0.1;
+            assert!((along - along.round()).abs() < 1e-9, "{d} offset {offset}");
+            assert!(
+                (dv - DVec3::new(n * 0.5, 0.0, 0.0)).length() < 1e-12,
+                "{dv} n {n}"
+            );
+            straddled |= n != 0.0;
+        }
+    }
+    assert!(straddled, "no sphere was wrapped across the sheared side");
+}

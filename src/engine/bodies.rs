@@ -60,25 +60,28 @@ pub(super) fn run(
         for (k, &i) in members.of(b).iter().enumerate() {
             let i = i as usize;
             let (at, velocity) = body.sphere_state(k);
-            (x[i], v[i]) = (at + image_of(periodic, x[i] - at), velocity);
+            (x[i], v[i]) = image_of(periodic, at, velocity, x[i]);
             (q[i], w[i]) = (body.q, body.w);
         }
     }
     non_finite
 }
 
-/// The shift by whole periods along the periodic axes nearest `d`: which image of its
-/// place a sphere was at (a rebuild wraps each sphere into the box on its own), kept when
-/// the body places it anew. Zero without periodic axes (Lees-Edwards is refused).
-fn image_of(periodic: Option<Periodic>, d: DVec3) -> DVec3 {
+/// A sphere of a body at `at` with `velocity`, as the image of that place nearest `now`,
+/// where the sphere is: a rebuild wraps each sphere into the box on its own, and the sphere
+/// keeps that image when its body places it anew. Across the gradient sides of a sheared
+/// (Lees-Edwards) box the image is offset along the shear axis as it is now and moves with
+/// the shear velocity.
+fn image_of(periodic: Option<Periodic>, at: DVec3, velocity: DVec3, now: DVec3) -> (DVec3, DVec3) {
     let Some(p) = periodic else {
-        return DVec3::ZERO;
+        return (at, velocity);
     };
-    let mut shift = DVec3::ZERO;
-    for a in (0..3).filter(|&a| p.axes[a]) {
-        shift[a] = (d[a] / p.length[a]).round() * p.length[a];
+    let (shift, crossings) = p.image_towards(at, now);
+    let mut velocity = velocity;
+    if let Some(sh) = p.shear {
+        velocity[sh.axis] += crossings as f64 * sh.velocity;
     }
-    shift
+    (at + shift, velocity)
 }
 
 /// What the wrench of a body reads of its spheres.

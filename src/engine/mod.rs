@@ -367,12 +367,8 @@ impl std::fmt::Display for Unstable {
 
 impl std::error::Error for Unstable {}
 
-/// Fails unless every particle's material is one of the scenario's (and there are no
-/// clumps in a Lees-Edwards domain).
+/// Fails unless every particle's material is one of the scenario's.
 fn check_materials(p: &Particles, s: &Scenario) -> Result<()> {
-    if !p.bodies.is_empty() && s.lees_edwards.is_some() {
-        bail!("clumps in a Lees-Edwards domain are not supported yet (issue 28)");
-    }
     let n = s.materials.len();
     if let Some(k) = (0..p.len()).find(|&k| p.material[k] as usize >= n) {
         bail!(

@@ -209,12 +209,6 @@ impl Scenario {
             &simulation,
             domain,
         )?;
-        if lees_edwards.is_some() && spawn.iter().any(|r| r.clump.is_some()) {
-            bail!(
-                "[[spawn]] clump: clumps in a Lees-Edwards domain are not supported yet (issue \
-                 28); use walls or a periodic [domain] without lees_edwards"
-            );
-        }
         Ok(Scenario {
             clumps,
             geometry,
