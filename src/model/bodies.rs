@@ -105,7 +105,11 @@ impl Bodies {
 
     /// The storage indices of body b's spheres (b an index in `list`), in id order.
     pub fn members(&self, b: usize) -> &[u32] {
-        &self.members[self.start[b] as usize..self.start[b + 1] as usize]
+        Members {
+            start: &self.start,
+            members: &self.members,
+        }
+        .of(b)
     }
 
     /// The bodies to change, and where each one's spheres are stored.
@@ -185,9 +189,9 @@ pub struct Members<'a> {
     members: &'a [u32],
 }
 
-impl Members<'_> {
+impl<'a> Members<'a> {
     /// The storage indices of body b's spheres, in id order.
-    pub fn of(&self, b: usize) -> &[u32] {
+    pub fn of(&self, b: usize) -> &'a [u32] {
         &self.members[self.start[b] as usize..self.start[b + 1] as usize]
     }
 }
