@@ -37,6 +37,8 @@ fn bits_by_id(particles: &Particles) -> Vec<(u32, Vec<u64>)> {
 #[derive(Debug, PartialEq)]
 struct End {
     particles: Vec<(u32, Vec<u64>)>,
+    /// Each rigid body's id with the bits of its x, v, q, w.
+    bodies: Vec<(u32, Vec<u64>)>,
     walls: Vec<[u64; 6]>,
     removed: u64,
     kinetic_energy: u64,
@@ -53,8 +55,20 @@ fn end_of(sim: &mut Simulation) -> End {
         })
         .collect();
     let thermo = sim.thermo();
+    let all = sim.gather_particles();
+    let bodies = all
+        .bodies
+        .list
+        .iter()
+        .map(|b| {
+            let state = [b.x.to_array(), b.v.to_array(), b.w.to_array()].concat();
+            let bits = state.into_iter().chain(b.q.to_array()).map(f64::to_bits);
+            (b.id.first(), bits.collect())
+        })
+        .collect();
     End {
-        particles: bits_by_id(&sim.gather_particles()),
+        particles: bits_by_id(&all),
+        bodies,
         walls,
         removed: thermo.removed,
         kinetic_energy: thermo.kinetic_energy.to_bits(),
@@ -558,4 +572,106 @@ fn a_servo_lid_split_over_processes_and_resumed_gives_the_bits_of_one() {
     let lid = sim.take_wall_loads()[2].f.z / 200.0;
     assert!(lid > 0.02, "the lid should press on the grains: {lid} N");
     checkpoint_on_2_resumes_on_3(servo_box, 1200, 1300);
+}
+
+/// The silo of [`silo`] filled with dimers and triangles beside spheres, each from a
+/// `[[spawn]]` region of its own, through the outlet below.
+fn clump_silo() -> String {
+    let spheres = "spawn_min = [-0.05, -0.05, 0.06]\nspawn_max = [0.05, 0.05, 0.14]\n";
+    silo(0.5)
+        .replace(spheres, "")
+        .replace("max_particles = 300", "max_particles = 600")
+        + "[[clumps]]\nname = \"dimer\"\nspheres = [[0.0, 0.0, 0.0, 0.0035], [0.005, 0.0, 0.0, 0.0035]]\n\
+           [[clumps]]\nname = \"tri\"\nspheres = [[0.0, 0.0, 0.0, 0.0035], [0.006, 0.0, 0.0, 0.0035], [0.003, 0.0052, 0.0, 0.0035]]\n\
+           [[spawn]]\nmin = [-0.05, -0.05, 0.06]\nmax = [0.05, 0.05, 0.14]\nclump = \"dimer\"\nscale = { min = 0.9, max = 1.1 }\ncount = 80\n\
+           [[spawn]]\nmin = [-0.05, -0.05, 0.06]\nmax = [0.05, 0.05, 0.14]\nclump = \"tri\"\ncount = 60\n\
+           [[spawn]]\nmin = [-0.05, -0.05, 0.06]\nmax = [0.05, 0.05, 0.14]\ncount = 60\n"
+}
+
+#[test]
+fn clumps_split_over_processes_give_the_bits_of_one() {
+    let steps = 2500;
+    let text = clump_silo();
+    let mut single = common::simulate(&text, steps);
+    let reference = end_of(&mut single);
+    eprintln!(
+        "clump silo: {} spheres, {} bodies, {} removed, contacts {:?}",
+        reference.particles.len(),
+        reference.bodies.len(),
+        reference.removed,
+        reference.contacts
+    );
+    assert!(reference.bodies.len() > 80 && reference.removed > 0);
+    assert!(reference.contacts.0 > 100 && reference.contacts.1 > 20);
+    for k in [2, 3] {
+        let text = text.clone();
+        let (end, cuts) = split_run(move || common::scenario(&text), steps, k);
+        assert!(cuts > 1, "{k} processes: the boxes should be cut anew");
+        assert!(
+            end == reference,
+            "{k} processes: the clump silo differs from one process's"
+        );
+    }
+}
+
+#[test]
+fn a_checkpoint_of_clumps_on_two_processes_resumes_on_three_with_the_same_bits() {
+    let text = clump_silo();
+    checkpoint_on_2_resumes_on_3(move || common::scenario(&text), 1200, 1000);
+}
+
+#[test]
+fn clumps_in_a_periodic_chute_split_over_processes_give_the_bits_of_one() {
+    let steps = 3000;
+    let text = periodic_chute().replace("count = 400", "count = 150")
+        + "[[clumps]]\nname = \"dimer\"\nspheres = [[0.0, 0.0, 0.0, 0.0035], [0.005, 0.0, 0.0, 0.0035]]\n\
+           [[spawn]]\nmin = [-0.04, -0.03, 0.06]\nmax = [0.04, 0.03, 0.12]\nclump = \"dimer\"\ncount = 120\n";
+    let mut single = common::simulate(&text, steps);
+    let reference = end_of(&mut single);
+    eprintln!(
+        "clump chute: {} spheres, {} bodies, contacts {:?}",
+        reference.particles.len(),
+        reference.bodies.len(),
+        reference.contacts
+    );
+    assert!(reference.bodies.len() >= 100);
+    for k in [2, 3] {
+        let text = text.clone();
+        let (end, _) = split_run(move || common::scenario(&text), steps, k);
+        assert!(
+            end == reference,
+            "{k} processes: the periodic clump chute differs from one process's"
+        );
+    }
+}
+
+#[test]
+fn clumps_in_a_sheared_periodic_box_split_over_processes_give_the_bits_of_one() {
+    let steps = 1500;
+    let text = "[geometry]\nradius_min = 0.002\nradius_max = 0.002\n\
+        [material]\nyoungs_modulus = 1e6\nrestitution = 0.5\nfriction_sliding = 0.4\nfriction_rolling = 0.05\n\
+        [kinetics]\ngravity = [0.0, 0.0, 0.0]\n\
+        [simulation]\nmax_particles = 1400\n\
+        [domain]\nmin = [-0.025, -0.025, -0.025]\nmax = [0.025, 0.025, 0.025]\nperiodic = [true, true, true]\n\
+        lees_edwards = { velocity = 0.5, shear_axis = \"x\", gradient_axis = \"z\" }\n\
+        [[clumps]]\nname = \"dimer\"\nspheres = [[0.0, 0.0, 0.0, 0.002], [0.003, 0.0, 0.0, 0.002]]\n\
+        [[spawn]]\nmin = [-0.025, -0.025, -0.025]\nmax = [0.025, 0.025, 0.025]\nclump = \"dimer\"\ncount = 500\n\
+        [[spawn]]\nmin = [-0.025, -0.025, -0.025]\nmax = [0.025, 0.025, 0.025]\ncount = 300\n";
+    let mut single = common::simulate(text, steps);
+    let reference = end_of(&mut single);
+    eprintln!(
+        "sheared clumps: {} spheres, {} bodies, contacts {:?}, {} rebuilds",
+        reference.particles.len(),
+        reference.bodies.len(),
+        reference.contacts,
+        single.rebuilds()
+    );
+    assert!(reference.bodies.len() >= 400 && reference.contacts.0 > 100);
+    for k in [2, 3] {
+        let (end, _) = split_run(move || common::scenario(text), steps, k);
+        assert!(
+            end == reference,
+            "{k} processes: the sheared box of clumps differs from one process's"
+        );
+    }
 }

@@ -65,7 +65,9 @@ fn outputs(dir: &Path) -> Vec<(String, Vec<u8>)> {
     files
 }
 
-fn same_output(scenario: &Path, counts: &[usize]) {
+/// Runs `scenario` in one process and on each of `counts`: the same files, byte for byte;
+/// returns those of one process.
+fn same_output(scenario: &Path, counts: &[usize]) -> Vec<(String, Vec<u8>)> {
     let dir = tempfile::tempdir().unwrap();
     let name = scenario.to_str().unwrap();
     run(1, &["run", name, "-o", "one", "-q"], dir.path());
@@ -85,6 +87,7 @@ fn same_output(scenario: &Path, counts: &[usize]) {
             assert!(a == b, "{name} on {np} processes: {file} differs");
         }
     }
+    one
 }
 
 #[test]
@@ -309,6 +312,42 @@ fn a_bad_scenario_on_3_processes_gives_one_error() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(err.matches("error: ").count(), 1, "{err}");
     assert!(err.contains("radius_min = -1"), "{err}");
+}
+
+#[test]
+fn clumps_in_a_filling_silo_on_1_to_3_processes_write_the_same_bytes() {
+    // The silo filled with dimers and triangles beside spheres: frames with the clump
+    // column, every sphere in VTK with its body, contacts, removal of whole clumps.
+    let dir = tempfile::tempdir().unwrap();
+    let path = silo(dir.path(), 8);
+    let spheres = "spawn_min = [-0.05, -0.05, 0.06]\nspawn_max = [0.05, 0.05, 0.14]\n";
+    let region = "[[spawn]]\nmin = [-0.05, -0.05, 0.06]\nmax = [0.05, 0.05, 0.14]\n";
+    let text = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace(spheres, "")
+        .replace("max_particles = 300", "max_particles = 500")
+        + "[[clumps]]\nname = \"dimer\"\nspheres = [[0.0, 0.0, 0.0, 0.0035], [0.005, 0.0, 0.0, 0.0035]]\n\
+           [[clumps]]\nname = \"tri\"\nspheres = [[0.0, 0.0, 0.0, 0.0035], [0.006, 0.0, 0.0, 0.0035], [0.003, 0.0052, 0.0, 0.0035]]\n"
+        + &format!(
+            "{region}clump = \"dimer\"\ncount = 70\n{region}clump = \"tri\"\ncount = 50\n{region}count = 60\n"
+        );
+    std::fs::write(&path, text).unwrap();
+    let files = same_output(&path, &[2, 3]);
+    let last = files
+        .iter()
+        .rfind(|f| f.0.starts_with("particles") && f.0.ends_with(".csv"))
+        .unwrap();
+    let last = String::from_utf8_lossy(&last.1);
+    let clumps: Vec<&str> = last
+        .lines()
+        .skip(1)
+        .map(|r| r.rsplit(',').next().unwrap())
+        .collect();
+    let count = |c: &str| clumps.iter().filter(|&&k| k == c).count();
+    assert!(
+        count("0") > 30 && count("1") > 20 && count("-1") > 30,
+        "{clumps:?}"
+    );
 }
 
 #[test]

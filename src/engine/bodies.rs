@@ -17,11 +17,14 @@ use crate::neighbours::Periodic;
 /// is `rigid::step` (the torque kicks the angular momentum, then the splitting of Dullweber,
 /// Leimkuhler & McLachlan turns the body freely, gyroscopic term included). Drag acts on
 /// each sphere as on a free one (Eqs. 3-4, at the sphere's velocity).
+///
+/// In a split run, only the bodies whose spheres are `owned` move: the others are ghosts,
+/// whose spheres' states their owners send (stage 5c).
 #[inline(never)] // a stage of its own in profiles
 pub(super) fn run(
     model: &Model,
     (dt, g): (f64, DVec3),
-    periodic: Option<Periodic>,
+    (periodic, owned): (Option<Periodic>, Option<&[bool]>),
     p: &mut Particles,
     loads: &[Load],
 ) -> bool {
@@ -39,6 +42,7 @@ pub(super) fn run(
         ..
     } = p;
     let (list, members) = bodies.parts_mut();
+    let own = |b: usize| owned.is_none_or(|o| o[members.of(b)[0] as usize]);
     let spheres = Spheres {
         v,
         w,
@@ -48,6 +52,7 @@ pub(super) fn run(
     list.par_iter_mut()
         .enumerate()
         .with_min_len(64)
+        .filter(|(b, _)| own(*b))
         .for_each(|(b, body)| {
             let (f, tau) = wrench(model, &spheres, body, members.of(b), loads);
             body.v += (f / body.mass + g) * dt;
@@ -55,7 +60,7 @@ pub(super) fn run(
             (body.q, body.w) = rigid::step(body.q, body.w, tau, body.inertia, dt);
         });
     let mut non_finite = false;
-    for (b, body) in list.iter().enumerate() {
+    for (b, body) in list.iter().enumerate().filter(|(b, _)| own(*b)) {
         non_finite |= !(body.x.is_finite() && body.v.is_finite() && body.w.is_finite());
         for (k, &i) in members.of(b).iter().enumerate() {
             let i = i as usize;

@@ -531,10 +531,11 @@ impl Simulation {
             self.scenario.kinetics.gravity,
         );
         let periodic = self.neighbours.periodic;
+        let owned = self.domain.as_ref().map(|d| &d.owned[..]);
         let bodies_non_finite = bodies::run(
             &self.model,
             (dt, g),
-            periodic,
+            (periodic, owned),
             &mut self.particles,
             &self.loads,
         );

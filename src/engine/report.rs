@@ -131,12 +131,10 @@ impl Simulation {
         }
     }
 
-    /// What the status line and `log.csv` report of the current state, as LAMMPS's thermo
-    /// output does: the energies (summed in id order, so the same for any storage order),
-    /// the contacts of the last step and the deepest of them relative to the smaller radius.
-    pub fn thermo(&self) -> Thermo {
+    /// Each grain's id with its kinetic energies of translation and rotation, in id order:
+    /// a plain sphere, or a rigid body (once, by its first sphere); of all processes.
+    fn grain_energies(&self) -> Vec<(u32, f64, f64)> {
         let p = &self.particles;
-        // A grain each: a plain sphere, or a rigid body (counted once, by its first sphere).
         let mut energies: Vec<(u32, f64, f64)> = (0..p.len())
             .filter(|&k| self.own(k) && p.body[k].is_none())
             .map(|k| {
@@ -152,7 +150,8 @@ impl Simulation {
                 )
             })
             .collect();
-        energies.extend(p.bodies.list.iter().map(|b| {
+        energies.extend(p.bodies_where(|k| self.own(k)).map(|b| {
+            let b = &p.bodies.list[b];
             let (t, r) = b.kinetic_energy();
             (b.id.first(), t, r)
         }));
@@ -174,6 +173,15 @@ impl Simulation {
             }
         }
         energies.sort_unstable_by_key(|e| e.0);
+        energies
+    }
+
+    /// What the status line and `log.csv` report of the current state, as LAMMPS's thermo
+    /// output does: the energies (summed in id order, so the same for any storage order),
+    /// the contacts of the last step and the deepest of them relative to the smaller radius.
+    pub fn thermo(&self) -> Thermo {
+        let p = &self.particles;
+        let energies = self.grain_energies();
         let (translational, rotational) = energies
             .iter()
             .fold((0.0, 0.0), |(t, r), e| (t + e.1, r + e.2));

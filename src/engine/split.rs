@@ -4,11 +4,12 @@
 //! removal over all processes, and the gathers of particles, contacts and snapshots.
 
 use super::*;
-use crate::neighbours::Entries;
+use crate::model::bodies::Body as RigidBody;
+use crate::neighbours::{Entries, Periodic};
 use crate::parallel::comm::{Comm, Reader, Writer};
 use crate::parallel::domain::{
-    Domain, GHOST_STATE, Placement, REBALANCE, Tree, agree, gather_by_id, get_entry, get_particle,
-    put_entry, put_particle,
+    Domain, GHOST_STATE, Placement, REBALANCE, Tree, agree, gather_by_id, get_body, get_entry,
+    get_particle, put_body, put_entry, put_particle,
 };
 use rustc_hash::{FxHashMap, FxHashSet};
 
@@ -137,6 +138,10 @@ impl Simulation {
             own.insert(p.id[k], p.get(k));
             own_anchors.push(anchors.get(k).copied().unwrap_or(p.x[k]));
         }
+        for b in p.bodies_where(|k| d.owned[k]) {
+            own.bodies.insert(p.bodies.list[b].clone());
+        }
+        own.locate_bodies();
         pairs.retain(|e| own_ids.contains(&e.0) || own_ids.contains(&e.1));
         faces.retain(|e| own_ids.contains(&e.0));
         Snapshot {
@@ -160,20 +165,11 @@ impl Simulation {
     /// same simulation (all its particles, as made or restored), keeps its share and the
     /// ghosts it needs, and from then on steps together with the others.
     pub fn split(mut self, comm: Box<dyn Comm>) -> Result<Simulation> {
-        if !self.particles.bodies.is_empty()
-            || self.scenario.spawn.iter().any(|r| r.clump.is_some())
-        {
-            bail!(
-                "clumps cannot yet be run over several processes (issue 28): run with one \
-                 process (threads use every core of a machine)"
-            );
-        }
         let (rank, size) = (comm.rank(), comm.size());
-        let owned = self
-            .particles
-            .id
-            .iter()
-            .map(|&id| id as usize % size == rank)
+        let p = &self.particles;
+        // Dealt out by id for a start (a rigid body whole, by its first sphere's).
+        let owned = (0..p.len())
+            .map(|i| p.body[i].map_or(p.id[i], |b| b.first()) as usize % size == rank)
             .collect();
         self.domain = Some(Domain {
             comm,
@@ -236,11 +232,14 @@ impl Simulation {
         let springs = self.neighbours.entries_by_id(&self.particles.id);
         self.neighbours.clear_lists();
         let old = std::mem::take(&mut self.particles);
-        let (mut held, mut held_at, (pairs, faces)) = migrate(&mut d, old, anchors, gone, springs);
+        let periodic = self.neighbours.periodic;
+        let (mut held, mut held_at, (pairs, faces)) =
+            migrate(&mut d, (old, periodic), anchors, gone, springs);
         let n_own = held.len();
         let r_max = d.comm.max(held.max_radius()).max(0.0);
         let reach = (r_max, self.neighbours.skin, self.neighbours.periodic);
         let (ghosts_to, ghosts_from) = exchange_ghosts(&d, &mut held, &mut held_at, reach);
+        held.locate_bodies();
         let mut owned: Vec<bool> = (0..held.len()).map(|i| i < n_own).collect();
         // The lists, with the faces binned for the largest particle of all processes.
         self.particles = held;
@@ -293,8 +292,13 @@ impl Simulation {
         }
         let d = self.domain.as_ref().expect("a split run");
         let mut largest = s.geometry.radius_max;
+        // How far a clump's spheres reach beyond its centre, which is in the region.
+        let mut beyond: f64 = 0.0;
         for r in &s.spawn {
             largest = largest.max(r.radius.largest());
+            if let Some(c) = &r.clump {
+                beyond = beyond.max(s.clumps[c.template as usize].bounding_radius * c.scale.1);
+            }
         }
         let own_max = (0..p.len())
             .filter(|&i| d.owned[i])
@@ -303,7 +307,7 @@ impl Simulation {
         let present = d.comm.max(own_max).max(0.0);
         // Twice the largest radius is the reach of a test; a little more keeps rounding
         // (of images across the sides) from leaving out a particle at that reach.
-        let margin = DVec3::splat(2.5 * largest.max(present));
+        let margin = DVec3::splat(2.5 * largest.max(present) + beyond);
         let regions = Spawner::regions(s);
         let in_reach = |x: DVec3| {
             regions
@@ -322,7 +326,14 @@ impl Simulation {
                 in_reach(x) || images.iter().any(|&(s, _)| in_reach(x + s))
             }
         };
-        let picked: Vec<bool> = (0..p.len()).map(|i| d.owned[i] && near(p.x[i])).collect();
+        let mut picked: Vec<bool> = (0..p.len()).map(|i| d.owned[i] && near(p.x[i])).collect();
+        // A rigid body whole, if any of its spheres is near.
+        for b in 0..p.bodies.len() {
+            let members = p.bodies.members(b);
+            if members.iter().any(|&k| picked[k as usize]) {
+                members.iter().for_each(|&k| picked[k as usize] = true);
+            }
+        }
         let old_next = p.next_id;
         let mut around = gather_by_id(&*d.comm, p, |i| picked[i]);
         self.spawner.spawn(
@@ -339,13 +350,21 @@ impl Simulation {
         let d = self.domain.as_mut().expect("a split run");
         let tree = d.tree.as_ref().expect("cut");
         let me = d.comm.rank();
+        let periodic = self.neighbours.periodic;
+        // The new particles in this process's box: a rigid body whole, by its centre.
+        let at = owner_places(&around, &around.x, periodic);
         for i in (0..around.len()).filter(|&i| around.id[i] >= old_next) {
-            let particle = around.get(i);
-            if tree.owner(particle.x) == me {
-                self.particles.insert(around.id[i], particle);
+            if tree.owner(at[i]) == me {
+                self.particles.insert(around.id[i], around.get(i));
                 d.owned.push(true);
             }
         }
+        for b in &around.bodies.list {
+            if b.id.first() >= old_next && tree.owner(centre_in_box(b, periodic)) == me {
+                self.particles.bodies.insert(b.clone());
+            }
+        }
+        self.particles.locate_bodies();
         self.particles.next_id = around.next_id;
         self.redistribute(&FxHashSet::default(), Placement::Now);
     }
@@ -356,19 +375,31 @@ impl Simulation {
         let d = self.domain.as_ref().expect("a split run");
         let p = &self.particles;
         let mut w = Writer::default();
-        for i in (0..p.len()).filter(|&i| d.owned[i]) {
+        for i in (0..p.len()).filter(|&i| d.owned[i] && p.body[i].is_none()) {
             if let Some(f) = fate(p.x[i]) {
                 let density = self.model.densities[p.material[i] as usize];
                 w.u32(p.id[i]);
                 w.u32(f);
                 w.f64(Inertia::mass_with(p.radius[i], density.mass_per_r3));
+                w.u32(1);
             }
         }
-        let mut gone: Vec<(u32, u32, f64)> = Vec::new();
+        // A rigid body goes whole, where its centre of mass goes (as in one process).
+        for b in p.bodies_where(|i| d.owned[i]) {
+            let b = &p.bodies.list[b];
+            if let Some(f) = fate(b.x) {
+                w.u32(b.id.first());
+                w.u32(f);
+                w.f64(b.mass);
+                w.u32(b.offsets.len() as u32);
+            }
+        }
+        // (first id, fate, mass, count of ids)
+        let mut gone: Vec<(u32, u32, f64, u32)> = Vec::new();
         for m in d.comm.all_gather(w.0) {
             let mut r = Reader::new(&m);
             while !r.done() {
-                gone.push((r.u32(), r.u32(), r.f64()));
+                gone.push((r.u32(), r.u32(), r.f64(), r.u32()));
             }
         }
         if gone.is_empty() {
@@ -376,7 +407,7 @@ impl Simulation {
         }
         // Counted in id order, as in one process.
         gone.sort_unstable_by_key(|g| g.0);
-        for &(_, f, mass) in &gone {
+        for &(_, f, mass, _) in &gone {
             let out: &mut Outflow = match self.removed.outlets.get_mut(f as usize) {
                 Some(o) => o,
                 None => &mut self.removed.domain,
@@ -384,7 +415,7 @@ impl Simulation {
             out.count += 1;
             out.mass += mass;
         }
-        let ids: FxHashSet<u32> = gone.iter().map(|g| g.0).collect();
+        let ids: FxHashSet<u32> = gone.iter().flat_map(|g| g.0..g.0 + g.3).collect();
         self.redistribute(&ids, Placement::Now);
     }
 
@@ -438,11 +469,11 @@ fn recut(d: &mut Domain, own: &[DVec3]) {
 /// in, placed at `anchors` if given (collective; the boxes cut anew first if need be), with
 /// the springs of their contacts: the particles this process owns afterwards, their
 /// anchors if given, and their springs. A pair's springs go to the owners of both
-/// partners, sent by the owner of its lower id (the other owner has the same springs), so
-/// each arrives once.
+/// partners, each sent by its partner's old owner (both have the same springs), and are
+/// kept once. A rigid body goes whole, with its record, to the owner of its centre.
 fn migrate(
     d: &mut Domain,
-    p: Particles,
+    (p, periodic): (Particles, Option<Periodic>),
     anchors: Option<Vec<DVec3>>,
     gone: &FxHashSet<u32>,
     entries: Entries,
@@ -453,14 +484,16 @@ fn migrate(
         Some(a) => a.into(),
         None => p.x.as_slice().into(),
     };
+    let at = owner_places(&p, &place, periodic);
     let own: Vec<DVec3> = (0..p.len())
         .filter(|&i| d.owned[i] && !gone.contains(&p.id[i]))
-        .map(|i| place[i])
+        .map(|i| at[i])
         .collect();
     recut(d, &own);
     drop(own);
     let d = &*d;
-    let to = Destinations::of(d, &p, &place, gone, &entries);
+    let to = Destinations::of(d, &p, &at, gone, &entries);
+    drop(at);
     let me = d.comm.rank();
     let messages: Vec<Vec<u8>> = (0..d.comm.size())
         .map(|q| match q == me {
@@ -479,6 +512,9 @@ fn migrate(
             at.push(place[i as usize]);
         }
     }
+    for &b in &to.bodies[me] {
+        held.bodies.insert(p.bodies.list[b as usize].clone());
+    }
     let (pairs, faces) = &entries;
     let mut kept = (
         to.pairs[me].iter().map(|&e| pairs[e]).collect(),
@@ -491,13 +527,61 @@ fn migrate(
             receive(&mut Reader::new(m), &mut held, held_at.as_mut(), &mut kept);
         }
     }
+    // A pair whose partners had two owners came from both.
+    kept.0.sort_unstable_by_key(|e| (e.0, e.1));
+    kept.0.dedup_by_key(|e| (e.0, e.1));
+    held.locate_bodies();
     (held, held_at, kept)
+}
+
+/// Where each particle of `p` (at `place`) is placed to find its owner: its place, or for
+/// a sphere of a rigid body its body's centre of mass ([`centre_in_box`]), so that a body
+/// goes whole to the process of its centre.
+fn owner_places<'a>(
+    p: &Particles,
+    place: &'a [DVec3],
+    periodic: Option<Periodic>,
+) -> std::borrow::Cow<'a, [DVec3]> {
+    if p.bodies.is_empty() {
+        return place.into();
+    }
+    let mut at = place.to_vec();
+    for (b, body) in p.bodies.list.iter().enumerate() {
+        let c = centre_in_box(body, periodic);
+        p.bodies.members(b).iter().for_each(|&k| at[k as usize] = c);
+    }
+    at.into()
+}
+
+/// The centre of mass of `body`, put back into a periodic box (a body's centre is never
+/// wrapped in the step, as its spheres are at rebuilds): the place that decides its owner.
+fn centre_in_box(body: &RigidBody, periodic: Option<Periodic>) -> DVec3 {
+    periodic.map_or(body.x, |periodic| periodic.wrap(body.x))
+}
+
+/// How far the spheres of this process's bodies of `held` (at `held_at`, or where they
+/// are) are from their bodies' centres ([`centre_in_box`]; across periodic sides, the
+/// nearest image): a body's owner's box holds its centre, so its spheres are within this
+/// of the box, and their partners within this more than a sphere's reach.
+fn body_spread(held: &Particles, held_at: Option<&[DVec3]>, periodic: Option<Periodic>) -> f64 {
+    let mut spread: f64 = 0.0;
+    for (b, body) in held.bodies.list.iter().enumerate() {
+        let c = centre_in_box(body, periodic);
+        for &k in held.bodies.members(b) {
+            let a = held_at.map_or(held.x[k as usize], |at| at[k as usize]);
+            let a = periodic.map_or(a, |periodic| a + periodic.image_towards(a, c).0);
+            spread = spread.max(a.distance(c));
+        }
+    }
+    spread
 }
 
 /// Where [`migrate`] sends each own particle (by index) and the springs of each contact
 /// (by entry), per process.
 struct Destinations {
     particles: Vec<Vec<u32>>,
+    /// Rigid bodies (indices in `bodies.list`).
+    bodies: Vec<Vec<u32>>,
     pairs: Vec<Vec<usize>>,
     faces: Vec<Vec<usize>>,
 }
@@ -505,7 +589,7 @@ struct Destinations {
 impl Destinations {
     /// To the owner of the box each kept own particle of `p` is placed in (at `place`):
     /// the particle, its contacts with faces, and its contacts with particles of higher id
-    /// (to the owners of both partners).
+    /// (to the owners of both partners); a rigid body's record to the owner of its spheres.
     fn of(
         d: &Domain,
         p: &Particles,
@@ -524,21 +608,27 @@ impl Destinations {
         let mine = |id: u32| d.owned[index[&id] as usize];
         let mut to = Destinations {
             particles: vec![Vec::new(); k],
+            bodies: vec![Vec::new(); k],
             pairs: vec![Vec::new(); k],
             faces: vec![Vec::new(); k],
         };
         for i in (0..p.len()).filter(|&i| d.owned[i] && !gone.contains(&p.id[i])) {
             to.particles[tree.owner(place[i])].push(i as u32);
         }
+        for b in p.bodies_where(|i| d.owned[i] && !gone.contains(&p.id[i])) {
+            let first = p.bodies.members(b)[0] as usize;
+            to.bodies[tree.owner(place[first])].push(b as u32);
+        }
+        // A pair's springs go from the owner of each partner to where that partner goes
+        // (only its owner knows: a ghost body's centre is that of the last rebuild); the
+        // copies are the same bits, and [`migrate`] keeps one.
         for (e, &(a, b, _)) in pairs.iter().enumerate() {
-            if gone.contains(&a) || gone.contains(&b) || !mine(a) {
+            if gone.contains(&a) || gone.contains(&b) {
                 continue;
             }
-            let (qa, qb) = (owner(a), owner(b));
-            to.pairs[qa].push(e);
-            if qb != qa {
-                to.pairs[qb].push(e);
-            }
+            let qa = mine(a).then(|| owner(a));
+            let qb = mine(b).then(|| owner(b)).filter(|&qb| Some(qb) != qa);
+            qa.into_iter().chain(qb).for_each(|q| to.pairs[q].push(e));
         }
         for (e, &(a, _, _)) in faces.iter().enumerate() {
             if !gone.contains(&a) && mine(a) {
@@ -548,8 +638,9 @@ impl Destinations {
         to
     }
 
-    /// What goes to process `q`: its particles (with their places if `place`), then its
-    /// springs of pairs and of contacts with faces, each list after its length.
+    /// What goes to process `q`: its particles (with their places if `place`), its rigid
+    /// bodies, then its springs of pairs and of contacts with faces, each list after its
+    /// length.
     fn message(
         &self,
         q: usize,
@@ -564,6 +655,10 @@ impl Destinations {
             if let Some(place) = place {
                 w.vec3(place[i as usize]);
             }
+        }
+        w.u64(self.bodies[q].len() as u64);
+        for &b in &self.bodies[q] {
+            put_body(&mut w, &p.bodies.list[b as usize]);
         }
         w.u64(self.pairs[q].len() as u64);
         self.pairs[q]
@@ -593,6 +688,9 @@ fn receive(
         }
     }
     for _ in 0..r.u64() {
+        held.bodies.insert(get_body(r));
+    }
+    for _ in 0..r.u64() {
         pairs.push(get_entry(r));
     }
     for _ in 0..r.u64() {
@@ -602,38 +700,17 @@ fn receive(
 
 /// Ghosts: copies of own particles (all `held` holds) for the processes whose boxes are
 /// within reach of them or, across periodic sides, of their images (collective); `reach`
-/// is the largest radius of all processes, the skin and the periodic sides. Returns the ids
-/// sent to and received from each process.
+/// is the largest radius of all processes, the skin and the periodic sides. A rigid body
+/// goes whole, with its record, to every process one of its spheres is within reach of.
+/// Returns the ids sent to and received from each process.
 fn exchange_ghosts(
     d: &Domain,
     held: &mut Particles,
     held_at: &mut Option<Vec<DVec3>>,
-    (r_max, skin, periodic): (f64, f64, Option<crate::neighbours::Periodic>),
+    reach: (f64, f64, Option<Periodic>),
 ) -> (Vec<Vec<u32>>, Vec<Vec<u32>>) {
-    let (me, k) = (d.comm.rank(), d.comm.size());
-    let tree = d.tree.as_ref().expect("cut");
-    let n_own = held.len();
-    let mut ghosts_to: Vec<Vec<u32>> = vec![Vec::new(); k];
-    let (mut near, mut images, mut to) = (Vec::new(), Vec::new(), Vec::new());
-    for i in 0..n_own {
-        let x = held_at.as_ref().map_or(held.x[i], |at| at[i]);
-        let reach = held.radius[i] + r_max + skin;
-        to.clear();
-        tree.near(x, reach, &mut near);
-        to.extend_from_slice(&near);
-        if let Some(periodic) = periodic {
-            periodic.image_shifts(x, reach, &mut images);
-            for &(s, _) in &images {
-                tree.near(x + s, reach, &mut near);
-                to.extend_from_slice(&near);
-            }
-            to.sort_unstable();
-            to.dedup();
-        }
-        for &q in to.iter().filter(|&&q| q != me) {
-            ghosts_to[q].push(i as u32);
-        }
-    }
+    let k = d.comm.size();
+    let (ghosts_to, bodies_to) = ghost_destinations(d, held, held_at.as_deref(), reach);
     let messages: Vec<Vec<u8>> = (0..k)
         .map(|q| {
             let mut w = Writer::default();
@@ -643,6 +720,10 @@ fn exchange_ghosts(
                 if let Some(at) = held_at.as_ref() {
                     w.vec3(at[i as usize]);
                 }
+            }
+            w.u64(bodies_to[q].len() as u64);
+            for &b in &bodies_to[q] {
+                put_body(&mut w, &held.bodies.list[b as usize]);
             }
             w.0
         })
@@ -662,8 +743,60 @@ fn exchange_ghosts(
             }
             ghosts_from[q].push(id);
         }
+        for _ in 0..r.u64() {
+            held.bodies.insert(get_body(&mut r));
+        }
     }
     (ghosts_to, ghosts_from)
+}
+
+/// Which own particles of `held` (storage indices) go as ghosts to each process, and which
+/// rigid bodies (indices in `bodies.list`): those within `r_i + r_max + skin` of its box,
+/// or whose images are, and more by the spread of the bodies ([`body_spread`], the
+/// largest of all processes): an own sphere may lie that far outside the box.
+fn ghost_destinations(
+    d: &Domain,
+    held: &Particles,
+    held_at: Option<&[DVec3]>,
+    (r_max, skin, periodic): (f64, f64, Option<Periodic>),
+) -> (Vec<Vec<u32>>, Vec<Vec<u32>>) {
+    let (me, k) = (d.comm.rank(), d.comm.size());
+    let tree = d.tree.as_ref().expect("cut");
+    let spread = d.comm.max(body_spread(held, held_at, periodic)).max(0.0);
+    let mut ghosts_to: Vec<Vec<u32>> = vec![Vec::new(); k];
+    let mut bodies_to: Vec<Vec<u32>> = vec![Vec::new(); k];
+    let (mut near, mut images, mut to) = (Vec::new(), Vec::new(), Vec::new());
+    for i in 0..held.len() {
+        let x = held_at.map_or(held.x[i], |at| at[i]);
+        let reach = held.radius[i] + r_max + skin + spread;
+        to.clear();
+        tree.near(x, reach, &mut near);
+        to.extend_from_slice(&near);
+        if let Some(periodic) = periodic {
+            periodic.image_shifts(x, reach, &mut images);
+            for &(s, _) in &images {
+                tree.near(x + s, reach, &mut near);
+                to.extend_from_slice(&near);
+            }
+        }
+        to.sort_unstable();
+        to.dedup();
+        for &q in to.iter().filter(|&&q| q != me) {
+            match held.body[i] {
+                None => ghosts_to[q].push(i as u32),
+                Some(b) => bodies_to[q].push(held.bodies.index_of(b).expect("held") as u32),
+            }
+        }
+    }
+    // A body whole, once.
+    for (q, bodies) in bodies_to.iter_mut().enumerate() {
+        bodies.sort_unstable();
+        bodies.dedup();
+        for &b in bodies.iter() {
+            ghosts_to[q].extend_from_slice(held.bodies.members(b as usize));
+        }
+    }
+    (ghosts_to, bodies_to)
 }
 
 /// Stage 5c of a split run (collective): sends the new states of own particles of `p` to

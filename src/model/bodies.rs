@@ -164,6 +164,18 @@ impl Bodies {
         }
     }
 
+    /// Adds `body` in id order (one that came from elsewhere: another process of a split
+    /// run); its spheres are found by the next [`Bodies::locate`], which must come before
+    /// anything else reads the table.
+    pub fn insert(&mut self, body: Body) {
+        let at = self.list.partition_point(|b| b.id < body.id);
+        assert!(
+            self.list.get(at).is_none_or(|b| b.id != body.id),
+            "a body once"
+        );
+        self.list.insert(at, body);
+    }
+
     /// Adds `body`, whose spheres are stored at `first..` in order, after every other.
     pub fn push(&mut self, body: Body, first: usize) {
         assert!(

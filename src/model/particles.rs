@@ -107,6 +107,21 @@ impl Particles {
         self.bodies.push(body, first);
     }
 
+    /// Finds every body's spheres in storage again ([`Bodies::locate`]).
+    pub fn locate_bodies(&mut self) {
+        self.bodies.locate(&self.id, &self.body);
+    }
+
+    /// The indices in `bodies.list` of the bodies whose first sphere `pick` takes (by its
+    /// storage index): e.g. the bodies a process of a split run owns.
+    pub fn bodies_where<'a>(
+        &'a self,
+        pick: impl Fn(usize) -> bool + 'a,
+    ) -> impl Iterator<Item = usize> + 'a {
+        let bodies = &self.bodies;
+        (0..bodies.len()).filter(move |&b| pick(bodies.members(b)[0] as usize))
+    }
+
     pub fn get(&self, i: usize) -> Particle {
         Particle {
             x: self.x[i],

@@ -25,10 +25,20 @@
 //! processes of such a pair see it with the same bits. Positions are wrapped into the box
 //! at rebuilds, which rounds them: so the split run rebuilds at the steps the run in one
 //! process does (see `Placement`).
+//!
+//! A rigid body (clump) is owned whole by the process whose box holds its centre of mass
+//! (put back into a periodic box). Its spheres may lie outside that box, by at most the
+//! largest distance of a sphere from its body's centre (measured at each rebuild over all
+//! processes), so the reach of the ghosts grows by that much; and a body goes whole, with
+//! its record, to every process one of its spheres is near. Only the owner moves a body
+//! (stage 5a); the others take its spheres' states in stage 5c, so a ghost body's own
+//! record (x, v, q, ω) is that of the last rebuild: nothing but its mass and offsets may be
+//! read from it.
 
 use anyhow::{Result, bail};
 use glam::DVec3;
 
+use crate::model::bodies::{Body, BodyId};
 use crate::model::particles::{Particle, Particles};
 use crate::model::springs::Springs;
 use crate::parallel::comm::{Comm, Reader, Writer};
@@ -314,6 +324,39 @@ pub(crate) fn put_particle(w: &mut Writer, id: u32, p: &Particle) {
     w.u32(p.tag);
     w.u16(p.material);
     w.u8(p.fixed as u8);
+    w.u32(p.body.map_or(0, |b| b.first() + 1));
+}
+
+/// A rigid body's record in a message (beside its spheres, which name it).
+pub(crate) fn put_body(w: &mut Writer, b: &Body) {
+    w.u32(b.id.first());
+    w.u16(b.template);
+    w.f64(b.scale);
+    w.vec3(b.x);
+    w.vec3(b.v);
+    w.quat(b.q);
+    w.vec3(b.w);
+    w.f64(b.mass);
+    w.vec3(b.inertia);
+    w.u32(b.offsets.len() as u32);
+    b.offsets.iter().for_each(|&o| w.vec3(o));
+    w.f64(b.bounding_radius);
+}
+
+pub(crate) fn get_body(r: &mut Reader) -> Body {
+    Body {
+        id: BodyId::new(r.u32()),
+        template: r.u16(),
+        scale: r.f64(),
+        x: r.vec3(),
+        v: r.vec3(),
+        q: r.quat(),
+        w: r.vec3(),
+        mass: r.f64(),
+        inertia: r.vec3(),
+        offsets: (0..r.u32()).map(|_| r.vec3()).collect(),
+        bounding_radius: r.f64(),
+    }
 }
 
 pub(crate) fn get_particle(r: &mut Reader) -> (u32, Particle) {
@@ -327,7 +370,7 @@ pub(crate) fn get_particle(r: &mut Reader) -> (u32, Particle) {
         tag: r.u32(),
         material: r.u16(),
         fixed: r.u8() != 0,
-        body: None, // clumps are refused in split runs (for now)
+        body: r.u32().checked_sub(1).map(BodyId::new),
     };
     (id, p)
 }
@@ -360,14 +403,26 @@ pub(crate) fn gather_by_id(
     pick: impl Fn(usize) -> bool,
 ) -> Particles {
     let mut w = Writer::default();
-    for i in (0..p.len()).filter(|&i| pick(i)) {
+    let picked: Vec<usize> = (0..p.len()).filter(|&i| pick(i)).collect();
+    w.u64(picked.len() as u64);
+    for &i in &picked {
         put_particle(&mut w, p.id[i], &p.get(i));
     }
+    // The bodies of the spheres picked (all of a body's spheres, if any).
+    let bodies: Vec<usize> = p.bodies_where(&pick).collect();
+    w.u64(bodies.len() as u64);
+    bodies
+        .iter()
+        .for_each(|&b| put_body(&mut w, &p.bodies.list[b]));
     let mut all: Vec<(u32, Particle)> = Vec::new();
+    let mut all_bodies = Vec::new();
     for m in comm.all_gather(w.0) {
         let mut r = Reader::new(&m);
-        while !r.done() {
+        for _ in 0..r.u64() {
             all.push(get_particle(&mut r));
+        }
+        for _ in 0..r.u64() {
+            all_bodies.push(get_body(&mut r));
         }
     }
     all.sort_unstable_by_key(|e| e.0);
@@ -377,6 +432,10 @@ pub(crate) fn gather_by_id(
     };
     for (id, particle) in all {
         out.insert(id, particle);
+    }
+    if !all_bodies.is_empty() {
+        all_bodies.into_iter().for_each(|b| out.bodies.insert(b));
+        out.locate_bodies();
     }
     out
 }

@@ -56,6 +56,15 @@ pub fn join(pieces: Vec<Snapshot>) -> Result<Snapshot> {
         particles.insert(id, particle);
         anchors.push(anchor);
     }
+    // Each rigid body is in the part that holds its spheres (a body is owned whole).
+    for p in &pieces {
+        p.particles
+            .bodies
+            .list
+            .iter()
+            .for_each(|b| particles.bodies.insert(b.clone()));
+    }
+    particles.locate_bodies();
     let springs = |of: fn(&Snapshot) -> &Vec<(u32, u32, Springs)>| {
         dedup(pieces.iter().flat_map(|p| of(p).iter().copied()).collect())
     };
