@@ -473,3 +473,74 @@ fn a_clump_crossing_the_sheared_side_of_a_lees_edwards_box_stays_whole() {
     }
     assert!(straddled, "no sphere was wrapped across the sheared side");
 }
+
+#[test]
+fn a_clump_frozen_by_one_of_its_spheres_holds_still_under_a_falling_grain() {
+    let mut s = sim(&text(DVec3::new(0.0, 0.0, -G), 0.5, ""));
+    let q = DQuat::from_rotation_z(0.3);
+    s.add_clump(0, 1.0, (DVec3::ZERO, q, DVec3::ZERO, DVec3::ZERO))
+        .unwrap();
+    // A sphere dropped onto the clump's first sphere.
+    let at = s.particles.x[0] + DVec3::new(0.0, 0.0, 3.0 * R);
+    s.add_particles(&[common::sphere(R, at, DVec3::ZERO, DVec3::ZERO)])
+        .unwrap();
+    // Fixing its second sphere fixes the clump whole.
+    s.fix_particles(&[1], true).unwrap();
+    assert_eq!(s.particles.fixed, [true, true, false]);
+    let by_id = |p: &Particles| p.iter_by_id().map(|e| e.1).collect::<Vec<_>>();
+    let before = (s.particles.bodies.list[0].clone(), by_id(&s.particles));
+    run_for(&mut s, 0.1);
+    let body = &s.particles.bodies.list[0];
+    assert_eq!(*body, before.0, "the fixed clump moved");
+    let after = by_id(&s.particles);
+    assert_eq!(after[..2], before.1[..2]);
+    assert!(
+        after[..2]
+            .iter()
+            .all(|p| p.v == DVec3::ZERO && p.w == DVec3::ZERO)
+    );
+    // The sphere came to rest on it.
+    let z = after[2].x.z;
+    assert!((z - (at.z - R)).abs() < 0.1 * R, "the sphere at {z}");
+    assert!(after[2].v.length() < 1e-3);
+    // Freed, it falls with the sphere on it.
+    s.fix_particles(&[0], false).unwrap();
+    run_for(&mut s, 0.05);
+    let drop = before.0.x.z - s.particles.bodies.list[0].x.z;
+    assert!(
+        (drop - 0.5 * G * 0.05 * 0.05).abs() < 0.05 * drop,
+        "fell {drop}"
+    );
+}
+
+#[test]
+fn a_fixed_box_holds_the_clumps_whose_centre_it_holds() {
+    let dir = tempfile::tempdir().unwrap();
+    // Two dimers of a particle file: one centred in the box, one above it; and the fixed
+    // column of the frames.
+    let rows = "x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz,clump\n\
+                0.0,0.0,0.0,0.0085,0.0,0.0,0.0,1.0,0.0,0.0,0.0,0.0,0.0,0.0,0\n\
+                0.0,0.0,0.05,0.0085,0.0,0.0,0.0,1.0,0.0,0.0,0.0,0.0,0.0,0.0,0\n";
+    std::fs::write(dir.path().join("two.csv"), rows).unwrap();
+    let fixed = "[input]\nparticles = \"two.csv\"\n\
+                 [[fixed]]\nmin = [-0.01, -0.01, -0.01]\nmax = [0.01, 0.01, 0.01]\n";
+    let text = text(DVec3::new(0.0, 0.0, -G), 0.5, fixed);
+    let scenario = common::scenario_at(&text, &dir.path().join("scenario.toml"));
+    let mut s = Simulation::new(scenario).unwrap();
+    assert_eq!(s.particles.fixed, [true, true, false, false]);
+    let held = s.particles.bodies.list[0].clone();
+    run_for(&mut s, 0.1);
+    assert_eq!(s.particles.bodies.list[0], held);
+    // The other fell onto it and rests there.
+    let other = &s.particles.bodies.list[1];
+    assert!(other.x.z < 0.04 && other.x.z > 0.005, "{}", other.x.z);
+    let mut csv = Vec::new();
+    tinydem::csv::write_particles(&mut csv, &s.particles, Default::default()).unwrap();
+    let csv = String::from_utf8(csv).unwrap();
+    let rows: Vec<&str> = csv.lines().collect();
+    assert!(rows[0].ends_with(",fixed,clump"), "{}", rows[0]);
+    assert!(
+        rows[1].ends_with(",1,0") && rows[2].ends_with(",0,0"),
+        "{csv}"
+    );
+}

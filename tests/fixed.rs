@@ -172,7 +172,7 @@ fn runs_write_the_fixed_column_and_check_counts_the_held() {
     let o = common::tinydem(&["check", "s.toml"], t.path());
     let said = String::from_utf8_lossy(&o.stdout);
     assert!(
-        said.contains("holds the 81 initial particles in it in place"),
+        said.contains("holds the 81 initial grains in it in place"),
         "{said}"
     );
     let o = common::tinydem(&["run", "s.toml", "-q"], t.path());

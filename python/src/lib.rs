@@ -385,6 +385,7 @@ impl Simulation {
 
     /// Fixes the particles of `ids` (an array-like of ids): from the next step they stay
     /// where they are, at rest, whatever acts on them (as particles in a `[[fixed]]` box).
+    /// A sphere of a clump freezes its clump whole.
     fn freeze(&mut self, ids: PyArrayLike1<'_, i64, AllowTypeChange>) -> PyResult<()> {
         let ids = ids_of(ids)?;
         self.sim
@@ -392,7 +393,7 @@ impl Simulation {
             .map_err(|e| PyValueError::new_err(format!("ids: {e:#}")))
     }
 
-    /// Lets the particles of `ids` move again (from rest).
+    /// Lets the particles of `ids` move again (from rest); a sphere of a clump, its clump.
     fn unfreeze(&mut self, ids: PyArrayLike1<'_, i64, AllowTypeChange>) -> PyResult<()> {
         let ids = ids_of(ids)?;
         self.sim

@@ -338,6 +338,14 @@ def test_clumps_added_from_python_move_as_rigid_bodies(tmp_path):
     sim.write_frame(tmp_path / "dimer.csv")
     frame = tinydem.read_frame(tmp_path / "dimer.csv")
     assert list(frame["clump"]) == [0]
+    # Freezing one of its spheres holds the clump whole.
+    sim.freeze([1])
+    held = sim.positions.copy()
+    sim.step(50)
+    assert np.array_equal(sim.positions, held)
+    sim.unfreeze([0])
+    sim.step(50)
+    assert not np.array_equal(sim.positions, held)
 
 
 def test_errors_name_python_arguments(study, tmp_path):

@@ -194,9 +194,13 @@ fn bound_lines(s: &Scenario, sim: &Simulation) -> String {
         );
     }
     for (k, b) in s.fixed.iter().enumerate() {
-        let held = (sim.particles.x.iter()).filter(|x| b.contains(**x)).count();
+        // A grain each: a sphere by its centre, a clump by its centre of mass.
+        let p = &sim.particles;
+        let spheres = (0..p.len()).filter(|&i| p.body[i].is_none() && b.contains(p.x[i]));
+        let clumps = p.bodies.list.iter().filter(|c| b.contains(c.x));
+        let held = spheres.count() + clumps.count();
         bounds += &format!(
-            "fixed {k:<17}{} .. {} (holds the {held} initial particles in it in place)\n",
+            "fixed {k:<17}{} .. {} (holds the {held} initial grains in it in place)\n",
             b.min, b.max
         );
     }

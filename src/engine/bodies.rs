@@ -18,6 +18,9 @@ use crate::neighbours::Periodic;
 /// Leimkuhler & McLachlan turns the body freely, gyroscopic term included). Drag acts on
 /// each sphere as on a free one (Eqs. 3-4, at the sphere's velocity).
 ///
+/// A fixed body (its spheres fixed: by a `[[fixed]]` box that holds its centre of mass, the
+/// `fixed` column, Python's `freeze`) stays where it is, at rest.
+///
 /// In a split run, only the bodies whose spheres are `owned` move: the others are ghosts,
 /// whose spheres' states their owners send (stage 5c).
 #[inline(never)] // a stage of its own in profiles
@@ -39,6 +42,7 @@ pub(super) fn run(
         w,
         radius,
         material,
+        fixed,
         ..
     } = p;
     let (list, members) = bodies.parts_mut();
@@ -54,6 +58,11 @@ pub(super) fn run(
         .with_min_len(64)
         .filter(|(b, _)| own(*b))
         .for_each(|(b, body)| {
+            if fixed[members.of(b)[0] as usize] {
+                // Held where it is, at rest.
+                (body.v, body.w) = (DVec3::ZERO, DVec3::ZERO);
+                return;
+            }
             let (f, tau) = wrench(model, &spheres, body, members.of(b), loads);
             body.v += (f / body.mass + g) * dt;
             body.x += body.v * dt;

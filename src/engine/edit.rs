@@ -82,20 +82,27 @@ impl Simulation {
     }
 
     /// Fixes the particles of `ids` (each must be present): from the next step they stay
-    /// where they are, at rest; or, with `fixed` false, lets them move again.
+    /// where they are, at rest; or, with `fixed` false, lets them move again. A sphere of a
+    /// clump fixes (or frees) its clump whole.
     pub fn fix_particles(&mut self, ids: &[u32], fixed: bool) -> Result<()> {
         self.refuse_split("fix particles")?;
-        for k in self.stored_at(ids)? {
-            let k = k as usize;
-            if self.particles.body[k].is_some() {
-                bail!(
-                    "particle {} is a sphere of a clump: clumps cannot be fixed (yet)",
-                    self.particles.id[k]
-                );
+        let mut at = self.stored_at(ids)?;
+        let p = &mut self.particles;
+        for k in at.clone() {
+            if let Some(b) = p.body[k as usize] {
+                let b = p.bodies.index_of(b).expect("a listed body");
+                at.extend_from_slice(p.bodies.members(b));
+                if fixed {
+                    let body = &mut p.bodies.list[b];
+                    (body.v, body.w) = (DVec3::ZERO, DVec3::ZERO);
+                }
             }
-            self.particles.fixed[k] = fixed;
+        }
+        for k in at {
+            let k = k as usize;
+            p.fixed[k] = fixed;
             if fixed {
-                (self.particles.v[k], self.particles.w[k]) = (DVec3::ZERO, DVec3::ZERO);
+                (p.v[k], p.w[k]) = (DVec3::ZERO, DVec3::ZERO);
             }
         }
         Ok(())

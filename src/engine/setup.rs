@@ -353,11 +353,20 @@ impl Simulation {
             .collect()
     }
 
-    /// Fixes the particles whose centre lies in one of `boxes` (`[[fixed]]`).
-    /// (Clumps are not fixed: they move as bodies.)
+    /// Fixes the particles whose centre lies in one of `boxes` (`[[fixed]]`): a clump
+    /// whole, if its centre of mass does.
     fn fix_within(p: &mut Particles, boxes: &[crate::scenario::Region]) {
+        let inside = |x: DVec3| boxes.iter().any(|b| b.contains(x));
         for ((x, fixed), body) in p.x.iter().zip(&mut p.fixed).zip(&p.body) {
-            *fixed |= body.is_none() && boxes.iter().any(|b| b.contains(*x));
+            *fixed |= body.is_none() && inside(*x);
+        }
+        for (b, body) in p.bodies.list.iter().enumerate() {
+            if inside(body.x) {
+                p.bodies
+                    .members(b)
+                    .iter()
+                    .for_each(|&k| p.fixed[k as usize] = true);
+            }
         }
     }
 

@@ -424,9 +424,16 @@ pub fn load_particles_within(path: &Path, limits: &Limits) -> Result<Particles> 
     Ok(load_grains_within(path, limits)?.0)
 }
 
-/// A particle file (a frame) with each row's `clump` column if it has one (the template's
-/// index, or `None` for a plain sphere).
-pub fn load_grains(path: &Path) -> Result<(Particles, Option<Vec<Option<u16>>>)> {
+/// The `clump` column of a particle file: each row's template index (`None` for a plain
+/// sphere), and whether the file gave the ids (an `id` column).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ClumpColumn {
+    pub templates: Vec<Option<u16>>,
+    pub ids: bool,
+}
+
+/// A particle file (a frame) with its `clump` column if it has one.
+pub fn load_grains(path: &Path) -> Result<(Particles, Option<ClumpColumn>)> {
     let f = crate::io::files::open(path)
         .with_context(|| format!("cannot read particle file {}", path.display()))?;
     read_grains(f, &path.display().to_string(), None)
@@ -437,7 +444,7 @@ pub fn load_grains(path: &Path) -> Result<(Particles, Option<Vec<Option<u16>>>)>
 pub fn load_grains_within(
     path: &Path,
     limits: &Limits,
-) -> Result<(Particles, Option<Vec<Option<u16>>>)> {
+) -> Result<(Particles, Option<ClumpColumn>)> {
     let f = crate::io::files::open(path)
         .with_context(|| format!("cannot read particle file {}", path.display()))?;
     read_grains(f, &path.display().to_string(), Some(limits))
@@ -460,7 +467,7 @@ fn read_grains(
     input: impl Read,
     file: &str,
     limits: Option<&Limits>,
-) -> Result<(Particles, Option<Vec<Option<u16>>>)> {
+) -> Result<(Particles, Option<ClumpColumn>)> {
     let mut lines = BufReader::with_capacity(1 << 16, input);
     let mut header = String::new();
     if lines
@@ -511,6 +518,10 @@ fn read_grains(
     if columns.int_column[1].is_some() {
         keep_ids(&mut particles, ids, file)?;
     }
+    let clumps = ClumpColumn {
+        templates: clumps,
+        ids: columns.int_column[1].is_some(),
+    };
     Ok((particles, columns.int_column[4].is_some().then_some(clumps)))
 }
 

@@ -89,14 +89,18 @@ pub fn read(scenario: &Scenario) -> Result<Inputs> {
 /// The particles of an input file's `rows` whose `clump` column names a template: those
 /// rows become clumps (x, v, q, w their body's; scaled by R over the template's bounding
 /// radius, so that a run's frame reads back as it was written), the others stay spheres.
-/// A clump of row id b takes the ids b, b + 1, ... for its spheres.
-pub fn with_clumps(s: &Scenario, rows: Particles, clumps: &[Option<u16>]) -> Result<Particles> {
+/// A clump of row id b takes the ids b, b + 1, ... for its spheres; in a file without ids,
+/// each row takes the next free ids.
+pub fn with_clumps(s: &Scenario, rows: Particles, clumps: &csv::ClumpColumn) -> Result<Particles> {
     let mut particles = Particles::default();
     let mut taken = rustc_hash::FxHashSet::default();
     for k in rows.id_order() {
-        let (id, row) = (&rows.id[k], rows.get(k));
-        particles.next_id = *id;
-        match clumps[k] {
+        let row = rows.get(k);
+        if clumps.ids {
+            particles.next_id = rows.id[k];
+        }
+        let id = particles.next_id;
+        match clumps.templates[k] {
             None => particles.push(row),
             Some(t) => {
                 let Some(template) = s.clumps.get(t as usize) else {
@@ -111,11 +115,11 @@ pub fn with_clumps(s: &Scenario, rows: Particles, clumps: &[Option<u16>]) -> Res
                     let material = template.material;
                     particles.push(Particle { material, ..row });
                 } else {
-                    place_row(&mut particles, (template, t), *id, row);
+                    place_row(&mut particles, (template, t), id, row);
                 }
             }
         }
-        for id in *id..particles.next_id {
+        for id in id..particles.next_id {
             if !taken.insert(id) {
                 bail!(
                     "row {}: id {id} is taken (a clump of row id b takes b, b + 1, ... for its spheres)",
@@ -177,6 +181,7 @@ fn place_row(
     let motion = (row.x, row.q, row.v, row.w);
     crate::engine::spawn::place_clump(particles, (t, template), scale, motion);
     particles.tag[first..].fill(row.tag);
+    particles.fixed[first..].fill(row.fixed);
     if let Some(body) = (particles.bodies.list.last_mut()).filter(|b| b.id.first() == id) {
         body.bounding_radius = row.radius;
     }
