@@ -544,3 +544,39 @@ fn a_fixed_box_holds_the_clumps_whose_centre_it_holds() {
         "{csv}"
     );
 }
+
+#[test]
+fn a_stage_keeps_the_clump_templates_of_the_run_it_continues() {
+    let mut a = Simulation::new(common::scenario(POUR)).unwrap();
+    for _ in 0..300 {
+        a.step().unwrap();
+    }
+    let snapshot = a.snapshot().unwrap();
+    let no_spawn = |text: &str| text[..text.find("[[spawn]]").unwrap()].to_string();
+    // Another template added after the run's: carried.
+    let more = no_spawn(POUR)
+        + "[[clumps]]\nname = \"rod\"\nspheres = [[0.0, 0.0, 0.0, 0.005], [0.005, 0.0, 0.0, 0.005], [0.01, 0.0, 0.0, 0.005]]\n";
+    let (b, _) = Simulation::stage(common::scenario(&more), snapshot.clone()).unwrap();
+    assert_eq!(b.particles.bodies.len(), a.particles.bodies.len());
+    // The dimer made longer, or the templates swapped: refused, naming the clump.
+    let longer = no_spawn(POUR).replace("[0.007, 0.0, 0.0, 0.005]", "[0.008, 0.0, 0.0, 0.005]");
+    let swapped = {
+        let (dimer, tri) = (
+            POUR.find("[[clumps]]\nname = \"dimer\"").unwrap(),
+            POUR.find("[[clumps]]\nname = \"tri\"").unwrap(),
+        );
+        let end = POUR.find("[[spawn]]").unwrap();
+        format!("{}{}{}", &POUR[..dimer], &POUR[tri..end], &POUR[dimer..tri])
+    };
+    for text in [longer, swapped] {
+        let err = Simulation::stage(common::scenario(&text), snapshot.clone())
+            .err()
+            .expect("refused");
+        let err = format!("{err:#}");
+        assert!(
+            err.contains("is of template 0 of the run it continues")
+                && err.contains("add new ones after them"),
+            "{err}"
+        );
+    }
+}

@@ -382,6 +382,32 @@ fn check_materials(p: &Particles, s: &Scenario) -> Result<()> {
     Ok(())
 }
 
+/// Whether each clump of `p` (of a checkpoint a stage continues) is of its template in
+/// the `[[clumps]]` of `s`: the same spheres, scaled by its factor. Frames name a clump by
+/// its template's index, and `render` and `analyze` draw it from that template.
+fn check_clumps(p: &Particles, s: &Scenario) -> Result<()> {
+    for b in &p.bodies.list {
+        let t = s.clumps.get(b.template as usize);
+        let same = t.is_some_and(|t| {
+            t.spheres.len() == b.offsets.len()
+                && (t.spheres.iter().zip(&b.offsets))
+                    .all(|(sp, &o)| (sp.centre * b.scale).distance(o) <= 1e-9 * b.bounding_radius)
+        });
+        if !same {
+            let name = t.map_or("none".to_string(), |t| format!("'{}'", t.name));
+            bail!(
+                "clump {} is of template {} of the run it continues, but this scenario's \
+                 [[clumps]] entry {} ({name}) is another shape: keep the templates of that run, \
+                 in their order, and add new ones after them",
+                b.id.first(),
+                b.template,
+                b.template
+            );
+        }
+    }
+    Ok(())
+}
+
 /// The state in numbers (`Simulation::thermo`), for the status line and `log.csv`.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Thermo {

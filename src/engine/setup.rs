@@ -208,6 +208,7 @@ impl Simulation {
         let mut sim = Simulation::from_inputs(scenario, inputs)?;
         let p = snapshot.particles;
         check_materials(&p, &sim.scenario).map_err(|e| misfit(format!("{e:#}")))?;
+        check_clumps(&p, &sim.scenario).map_err(|e| misfit(format!("{e:#}")))?;
         let mut notes = vec![sim.continue_spawner(&snapshot.scenario, snapshot.spawner)?];
         let g = &sim.scenario.geometry;
         if sim.scenario.spawn.is_empty()
