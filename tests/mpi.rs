@@ -351,6 +351,69 @@ fn clumps_in_a_filling_silo_on_1_to_3_processes_write_the_same_bytes() {
 }
 
 #[test]
+fn frames_in_pieces_on_2_and_3_processes_are_the_gathered_frames() {
+    // `gather = "never"`: each process writes its piece of every frame and contact network
+    // (CSV and VTK), the first the .pvtu/.pvtp that list them; joined, they are the frames
+    // of the run in one process (tests/pieces_check.py reads the VTK with meshio).
+    let has_meshio = Command::new("python3")
+        .args(["-c", "import meshio, numpy"])
+        .status()
+        .is_ok_and(|s| s.success());
+    if !has_meshio {
+        assert!(std::env::var_os("CI").is_none(), "CI must have meshio");
+        eprintln!("SKIPPED: python3 with meshio not found (pip install meshio)");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let path = silo(dir.path(), 6);
+    let text = std::fs::read_to_string(&path).unwrap() + "gather = \"never\"\n";
+    std::fs::write(&path, text).unwrap();
+    let name = path.to_str().unwrap();
+    run(1, &["run", name, "-o", "one", "-q"], dir.path());
+    for np in [2, 3] {
+        let out = format!("np{np}");
+        run(np, &["run", name, "-o", &out, "-q"], dir.path());
+        let check = Command::new("python3")
+            .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/pieces_check.py"))
+            .args(["one", &out, "6"])
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        assert!(
+            check.status.success(),
+            "{np} processes: {}{}",
+            String::from_utf8_lossy(&check.stdout),
+            String::from_utf8_lossy(&check.stderr)
+        );
+        let pieces = std::fs::read_dir(dir.path().join(&out))
+            .unwrap()
+            .filter(|e| {
+                let name = e.as_ref().unwrap().file_name();
+                name.to_string_lossy().starts_with("particles000006_")
+            })
+            .count();
+        assert_eq!(pieces, 2 * np, "a CSV and a VTK piece per process");
+        // analyze and render read the pieces as the gathered frames.
+        for args in [
+            vec!["analyze", "DIR", "--csv", "DIR/a.csv"],
+            vec!["render", "DIR/particles000006.csv"],
+        ] {
+            for d in ["one", out.as_str()] {
+                let a: Vec<String> = args.iter().map(|a| a.replace("DIR", d)).collect();
+                let a: Vec<&str> = a.iter().map(String::as_str).collect();
+                run(1, &a, dir.path());
+            }
+        }
+        let same = |file: &str| {
+            let read = |d: &str| std::fs::read(dir.path().join(d).join(file)).unwrap();
+            assert!(read("one") == read(&out), "{np} processes: {file} differs");
+        };
+        same("a.csv");
+        same("particles000006.png");
+    }
+}
+
+#[test]
 fn a_sheared_periodic_box_on_1_to_3_processes_writes_the_same_bytes() {
     // The shear cell of the examples (periodic along x, y and z, Lees-Edwards boundaries,
     // two materials, contact networks), for fewer frames.

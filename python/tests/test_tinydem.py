@@ -463,3 +463,19 @@ def test_a_panic_of_the_engine_is_a_runtime_error():
     # PyO3's PanicException derives from BaseException: `except Exception` would miss it.
     with pytest.raises(RuntimeError, match="internal error of tinydem"):
         tinydem._tinydem._internal_panic()
+
+
+def test_a_frame_in_pieces_reads_as_one(tmp_path):
+    """A frame a split run wrote in pieces (``[output] gather = "never"``) reads as the
+    gathered frame: rows joined in id order; a gap in the pieces is an error naming it."""
+    header = "x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz,id,material"
+    row = lambda i: ",".join([str(0.1 * i), "0", "0", "0.01"] + ["0"] * 3 + ["1", "0", "0", "0"] + ["0"] * 3 + [str(i), "0"])
+    pieces = {0: [3, 0, 5], 1: [1, 4], 2: [2]}
+    for k, ids in pieces.items():
+        (tmp_path / f"particles000007_{k}.csv").write_text("\n".join([header] + [row(i) for i in ids]) + "\n")
+    frame = tinydem.read_frame(tmp_path / "particles000007.csv")
+    assert list(frame["id"]) == [0, 1, 2, 3, 4, 5]
+    assert np.allclose(frame["x"], 0.1 * np.arange(6))
+    (tmp_path / "particles000007_1.csv").unlink()
+    with pytest.raises(FileNotFoundError, match="particles000007_1.csv is missing"):
+        tinydem.read_frame(tmp_path / "particles000007.csv")

@@ -76,8 +76,30 @@ def read_table(path: PathLike) -> Dict[str, np.ndarray]:
 def read_frame(path: PathLike) -> Dict[str, np.ndarray]:
     """Reads a frame ``particlesNNNNNN.csv`` as a dict of numpy arrays by column: ``x``,
     ``y``, ``z``, ``R``, ``vx`` ... ``wz`` (float64) and, where the frame has them, ``tag``,
-    ``id``, ``material``, ``fixed`` (int64). Rows are particles in id order."""
-    return read_table(path)
+    ``id``, ``material``, ``fixed`` (int64). Rows are particles in id order. A frame that a
+    split run wrote in pieces (``particlesNNNNNN_K.csv``, ``[output] gather``) is read as
+    one; so is a contact network ``contactsNNNNNN.csv``."""
+    path = Path(path)
+    if path.is_file():
+        return read_table(path)
+    found = {}
+    for piece in path.parent.glob(f"{path.stem}_*{path.suffix}"):
+        number = piece.stem[len(path.stem) + 1 :]
+        if number.isdigit():
+            found[int(number)] = piece
+    if not found:
+        raise FileNotFoundError(f"{path}: no such frame, nor pieces {path.stem}_K{path.suffix}")
+    missing = [k for k in range(max(found) + 1) if k not in found]
+    if missing:
+        raise FileNotFoundError(f"{path}: the piece {path.stem}_{missing[0]}{path.suffix} is missing")
+    tables = [read_table(found[k]) for k in sorted(found)]
+    joined = {name: np.concatenate([t[name] for t in tables]) for name in tables[0]}
+    if "id" in joined:
+        order = np.argsort(joined["id"], kind="stable")
+    else:  # a contact network: the order of the gathered file
+        face = joined["face"] >= 0
+        order = np.lexsort((np.where(face, joined["face"], joined["id_j"]), joined["id_i"], face))
+    return {name: column[order] for name, column in joined.items()}
 
 
 class Frames(Sequence[Dict[str, np.ndarray]]):

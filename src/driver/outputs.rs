@@ -6,9 +6,10 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 
 use crate::engine::{Simulation, Thermo};
-use crate::io::csv::{Extra, write_frame};
+use crate::io::csv::{Extra, write_frame, write_frame_as};
 use crate::io::output::{FRAMES, LOG, LOG_HEADER, OUTLETS, RUN_TOML, WALLS};
-use crate::scenario::{Formats, Met, Scenario};
+use crate::io::vtk;
+use crate::scenario::{Formats, Gather, Met, Scenario};
 
 /// Writes frames in the scenario's formats, and the ParaView collection.
 pub(super) struct Frames<'a> {
@@ -18,12 +19,28 @@ pub(super) struct Frames<'a> {
     pub(super) extra: Extra,
     /// Simulated time between frames.
     frame_time: f64,
+    /// Whether each process of a split run writes its own piece of each frame
+    /// (`[output] gather`): `particlesNNNNNN_K.*`, listed by `particlesNNNNNN.pvtu`.
+    pieces: bool,
 }
 
 impl<'a> Frames<'a> {
-    /// The frames of `sim` into `dir`.
+    /// The frames of `sim` into `dir` (collective in a split run).
     pub(super) fn of(dir: &'a Path, sim: &Simulation) -> Frames<'a> {
+        let s = &sim.scenario;
+        // `auto`: in pieces if the run starts with, or may spawn, 10^7 particles or more.
+        let many = || {
+            let most = (sim.particle_count() as u64).max(s.simulation.max_particles);
+            most >= Gather::AUTO_LIMIT
+        };
+        let pieces = sim.process().is_some()
+            && match s.gather {
+                Gather::Always => false,
+                Gather::Never => true,
+                Gather::Auto => many(),
+            };
         Frames {
+            pieces,
             dir,
             formats: sim.scenario.formats,
             extra: Extra {
@@ -45,8 +62,12 @@ impl<'a> Frames<'a> {
         Ok(())
     }
 
-    /// Frame `k` (collective in a split run: all processes gather, the first writes).
+    /// Frame `k` (collective in a split run: all processes gather, the first writes; or
+    /// each writes its piece).
     pub(super) fn write(&self, k: u64, sim: &Simulation) -> Result<()> {
+        if self.pieces {
+            return self.write_pieces(k, sim);
+        }
         let particles = sim.particles_in_domain();
         let contacts = sim.scenario.contact_network.then(|| sim.contact_network());
         if !sim.is_writer() {
@@ -59,32 +80,100 @@ impl<'a> Frames<'a> {
             crate::io::csv::write_contacts(self.dir, &format!("contacts{k:06}.csv"), &contacts)?;
             if self.formats.vtk {
                 let name = format!("contacts{k:06}.vtp");
-                crate::io::vtk::write_contacts(&self.dir.join(&name), &particles, &contacts)?;
-                let entries: Vec<(f64, String)> = (0..=k)
-                    .map(|f| (f as f64 * self.frame_time, format!("contacts{f:06}.vtp")))
-                    .collect();
-                crate::io::vtk::write_collection(&self.dir.join("contacts.pvd"), &entries)?;
+                vtk::write_contacts(&self.dir.join(&name), &particles, &contacts)?;
+                self.collection("contacts", k, "vtp")?;
             }
         }
         if self.formats.vtk {
             let name = format!("particles{k:06}.vtu");
-            crate::io::vtk::write_particles(&self.dir.join(&name), &particles)?;
-            let entries: Vec<(f64, String)> = (0..=k)
-                .map(|f| (f as f64 * self.frame_time, format!("particles{f:06}.vtu")))
-                .collect();
-            crate::io::vtk::write_collection(&self.dir.join("particles.pvd"), &entries)?;
-            if sim.walls.move_at_all() {
-                crate::io::vtk::write_mesh(
-                    &self.dir.join(format!("mesh{k:06}.vtu")),
-                    &sim.walls.mesh,
-                )?;
-                let entries: Vec<(f64, String)> = (0..=k)
-                    .map(|f| (f as f64 * self.frame_time, format!("mesh{f:06}.vtu")))
-                    .collect();
-                crate::io::vtk::write_collection(&self.dir.join("mesh.pvd"), &entries)?;
-            }
+            vtk::write_particles(&self.dir.join(&name), &particles)?;
+            self.collection("particles", k, "vtu")?;
+            self.moving_mesh(k, sim)?;
         }
         Ok(())
+    }
+
+    /// Frame `k` of a split run in pieces (collective): each process writes its own
+    /// particles (CSV with ids, VTK) and the contacts it owns; once all are on disk, the
+    /// first writes the `.pvtu` and `.pvtp` files that list the VTK pieces.
+    fn write_pieces(&self, k: u64, sim: &Simulation) -> Result<()> {
+        let (rank, size) = sim.process().expect("a split run");
+        let piece = |stem: &str, ext: &str| format!("{stem}{k:06}_{rank}.{ext}");
+        let (own, held) = sim.own_particles_in_domain();
+        let contacts = sim
+            .scenario
+            .contact_network
+            .then(|| sim.own_contact_network());
+        let bodies = self.extra.clump;
+        let written = (|| -> Result<()> {
+            if self.formats.csv {
+                let extra = Extra {
+                    ids: true,
+                    ..self.extra
+                };
+                write_frame_as(self.dir, &piece("particles", "csv"), &own, extra)?;
+            }
+            if let Some(contacts) = &contacts {
+                crate::io::csv::write_contacts(self.dir, &piece("contacts", "csv"), contacts)?;
+                if self.formats.vtk {
+                    let path = self.dir.join(piece("contacts", "vtp"));
+                    vtk::write_contacts(&path, &held, contacts)?;
+                }
+            }
+            if self.formats.vtk {
+                let path = self.dir.join(piece("particles", "vtu"));
+                vtk::write_particle_piece(&path, &own, bodies)?;
+            }
+            Ok(())
+        })();
+        // Every piece on disk before a list names it.
+        sim.agree(written)?;
+        if !sim.is_writer() || !self.formats.vtk {
+            return Ok(());
+        }
+        let pieces = |stem: &str, ext: &str| -> Vec<String> {
+            (0..size)
+                .map(|q| format!("{stem}{k:06}_{q}.{ext}"))
+                .collect()
+        };
+        let list = self.dir.join(format!("particles{k:06}.pvtu"));
+        vtk::write_particle_list(&list, &pieces("particles", "vtu"), bodies)?;
+        self.collection("particles", k, "pvtu")?;
+        if contacts.is_some() {
+            let list = self.dir.join(format!("contacts{k:06}.pvtp"));
+            vtk::write_contact_list(&list, &pieces("contacts", "vtp"))?;
+            self.collection("contacts", k, "pvtp")?;
+        }
+        self.moving_mesh(k, sim)
+    }
+
+    /// The mesh of frame `k`, if it moves, and its collection.
+    fn moving_mesh(&self, k: u64, sim: &Simulation) -> Result<()> {
+        if sim.walls.move_at_all() {
+            vtk::write_mesh(&self.dir.join(format!("mesh{k:06}.vtu")), &sim.walls.mesh)?;
+            self.collection("mesh", k, "vtu")?;
+        }
+        Ok(())
+    }
+
+    /// The ParaView collection `stem.pvd` of frames 0 to `k`: frame k's file of extension
+    /// `ext`; an earlier frame's listing of pieces if it was written in pieces (a run
+    /// resumed on another number of processes may change), else its one file.
+    fn collection(&self, stem: &str, k: u64, ext: &str) -> Result<()> {
+        let one = if stem == "contacts" { "vtp" } else { "vtu" };
+        let listing = if stem == "contacts" { "pvtp" } else { "pvtu" };
+        let entries: Vec<(f64, String)> = (0..=k)
+            .map(|f| {
+                let name = |e: &str| format!("{stem}{f:06}.{e}");
+                let file = match f == k {
+                    true => name(ext),
+                    false if self.dir.join(name(listing)).exists() => name(listing),
+                    false => name(one),
+                };
+                (f as f64 * self.frame_time, file)
+            })
+            .collect();
+        vtk::write_collection(&self.dir.join(format!("{stem}.pvd")), &entries)
     }
 }
 

@@ -513,11 +513,26 @@ impl Simulation {
     /// for output; the particles themselves if it has none.
     pub fn particles_in_domain(&self) -> std::borrow::Cow<'_, Particles> {
         // Of a split run, all processes' (collective), in id order.
-        let mut p = match (&self.domain, self.neighbours.periodic) {
+        let p = match (&self.domain, self.neighbours.periodic) {
             (None, None) => return std::borrow::Cow::Borrowed(&self.particles),
             (None, Some(_)) => self.particles.clone(),
             (Some(_), _) => self.gather_particles(),
         };
+        std::borrow::Cow::Owned(self.put_in_domain(p))
+    }
+
+    /// The pieces of a frame of a split run written by each process: its own particles (in
+    /// id order, with their bodies) and, for the lines of its contacts, all it holds (own
+    /// and ghosts), as [`Simulation::particles_in_domain`] puts them. Not collective.
+    pub fn own_particles_in_domain(&self) -> (Particles, Particles) {
+        let p = &self.particles;
+        let solo = crate::parallel::comm::Solo;
+        let own = crate::parallel::domain::gather_by_id(&solo, p, |i| self.own(i));
+        (self.put_in_domain(own), self.put_in_domain(p.clone()))
+    }
+
+    /// `p` with its positions put back into the domain along its periodic axes.
+    fn put_in_domain(&self, mut p: Particles) -> Particles {
         if let Some(periodic) = self.neighbours.periodic {
             for (x, v) in p.x.iter_mut().zip(p.v.iter_mut()) {
                 (*x, *v) = periodic.wrap_state(*x, *v);
@@ -526,7 +541,7 @@ impl Simulation {
                 (b.x, b.v) = periodic.wrap_state(b.x, b.v);
             }
         }
-        std::borrow::Cow::Owned(p)
+        p
     }
 
     /// Advances the simulation by one time step Δt.

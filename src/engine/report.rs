@@ -9,16 +9,26 @@ impl Simulation {
     /// it now, from its current springs (left unchanged): the forces the next step applies.
     /// Pairs by (lower id, higher id), then contacts with faces by (id, face).
     pub fn contact_network(&self) -> Vec<ContactRecord> {
+        // Each contact from the process that owns its particle (of a pair, the lower id).
+        let network = self.own_contact_network();
+        match &self.domain {
+            Some(d) => super::split::gather_contacts(&*d.comm, network),
+            None => network,
+        }
+    }
+
+    /// This process's piece of the contact network of a split run (the contacts of its own
+    /// particles, of a pair the lower id's), in the order of [`Simulation::contact_network`];
+    /// the whole network in one process.
+    pub fn own_contact_network(&self) -> Vec<ContactRecord> {
         let mut network = self.held_contact_network();
         if let Some(d) = &self.domain {
-            // Each contact from the process that owns its particle (of a pair, the lower id).
             let p = &self.particles;
             let own: rustc_hash::FxHashSet<u32> = (0..p.len())
                 .filter(|&k| d.owned[k])
                 .map(|k| p.id[k])
                 .collect();
             network.retain(|c| own.contains(&c.id));
-            network = super::split::gather_contacts(&*d.comm, network);
         }
         network
     }

@@ -6,4 +6,5 @@ pub mod files;
 pub mod inputs;
 pub mod lock;
 pub mod output;
+pub mod pieces;
 pub mod vtk;

@@ -17,7 +17,7 @@ use crate::geometry::mesh::{Mesh, Primitive};
 use crate::model::particles::Particles;
 
 /// Where an array goes in the file.
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, PartialEq)]
 enum Section {
     PointData,
     CellData,
@@ -25,13 +25,15 @@ enum Section {
     Cells,
 }
 
-/// A `.vtu` file under construction: XML header text and the appended binary block.
+/// A `.vtu` file under construction: XML header text and the appended binary block; and
+/// the arrays it has, as the parallel file that lists pieces of its kind declares them.
 struct Vtu {
     point_data: String,
     cell_data: String,
     points: String,
     cells: String,
     appended: Vec<u8>,
+    declared: Vec<(Section, String)>,
 }
 
 /// An array's element type as VTK names it.
@@ -69,6 +71,7 @@ impl Vtu {
             points: String::new(),
             cells: String::new(),
             appended: Vec::new(),
+            declared: Vec::new(),
         }
     }
 
@@ -97,6 +100,13 @@ impl Vtu {
             "        <DataArray type=\"{}\" Name=\"{name}\" NumberOfComponents=\"{components}\" format=\"appended\" offset=\"{offset}\"/>\n",
             T::NAME
         );
+        self.declared.push((
+            section,
+            format!(
+                "      <PDataArray type=\"{}\" Name=\"{name}\" NumberOfComponents=\"{components}\"/>\n",
+                T::NAME
+            ),
+        ));
         match section {
             Section::PointData => self.point_data += &element,
             Section::CellData => self.cell_data += &element,
@@ -154,6 +164,37 @@ impl Vtu {
         ));
         let tail = "\n  </AppendedData>\n</VTKFile>\n";
         atomic_write(path, &[text.as_bytes(), &self.appended, tail.as_bytes()])
+    }
+
+    /// Writes the parallel file (`kind` `PUnstructuredGrid` or `PPolyData`) that lists the
+    /// pieces `sources` (file names beside it), each with the arrays of this one.
+    fn write_list(&self, path: &Path, kind: &str, sources: &[String]) -> Result<()> {
+        let declared = |section: Section| -> String {
+            let of = self.declared.iter().filter(|d| d.0 == section);
+            of.map(|d| d.1.as_str()).collect()
+        };
+        let mut text = String::from("<?xml version=\"1.0\"?>\n");
+        text += &format!(
+            "<VTKFile type=\"{kind}\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
+        );
+        text += &format!("  <{kind} GhostLevel=\"0\">\n");
+        text += &format!(
+            "    <PPointData>\n{}    </PPointData>\n",
+            declared(Section::PointData)
+        );
+        text += &format!(
+            "    <PCellData>\n{}    </PCellData>\n",
+            declared(Section::CellData)
+        );
+        text += &format!(
+            "    <PPoints>\n{}    </PPoints>\n",
+            declared(Section::Points)
+        );
+        for s in sources {
+            text += &format!("    <Piece Source=\"{s}\"/>\n");
+        }
+        text += &format!("  </{kind}>\n</VTKFile>\n");
+        atomic_write(path, &[text.as_bytes()])
     }
 
     /// A named array of `n` 3-vectors.
@@ -216,6 +257,23 @@ fn atomic_write(path: &Path, parts: &[&[u8]]) -> Result<()> {
 
 /// Writes the particles as a `.vtu` file, in id order.
 pub fn write_particles(path: &Path, p: &Particles) -> Result<()> {
+    particles_vtu(p, !p.bodies.is_empty()).write(path, p.len(), p.len())
+}
+
+/// Writes one process's piece of the particles of a frame (as [`write_particles`]; with
+/// the `body` array if `bodies`, so that all pieces have the same arrays).
+pub fn write_particle_piece(path: &Path, p: &Particles, bodies: bool) -> Result<()> {
+    particles_vtu(p, bodies).write(path, p.len(), p.len())
+}
+
+/// Writes the `.pvtu` file that makes the pieces `sources` (of [`write_particle_piece`])
+/// one data set for ParaView.
+pub fn write_particle_list(path: &Path, sources: &[String], bodies: bool) -> Result<()> {
+    particles_vtu(&Particles::default(), bodies).write_list(path, "PUnstructuredGrid", sources)
+}
+
+/// The particles' file, in id order; with the `body` array if `bodies`.
+fn particles_vtu(p: &Particles, bodies: bool) -> Vtu {
     use Section::*;
     let n = p.len();
     let order = p.id_order();
@@ -241,7 +299,7 @@ pub fn write_particles(path: &Path, p: &Particles) -> Result<()> {
         by_id().map(|i| p.material[i] as u32),
     );
     v.array(PointData, "fixed", 1, n, by_id().map(|i| p.fixed[i] as u8));
-    if !p.bodies.is_empty() {
+    if bodies {
         // Every sphere of a clump is a point, with its body's id (its first sphere's): -1
         // for a plain sphere.
         let body = |i: usize| p.body[i].map_or(-1, |b| b.first() as i64);
@@ -251,7 +309,7 @@ pub fn write_particles(path: &Path, p: &Particles) -> Result<()> {
     v.array(Cells, "connectivity", 1, n, 0..n as i64);
     v.array(Cells, "offsets", 1, n, 1..=n as i64);
     v.array(Cells, "types", 1, n, std::iter::repeat_n(1u8, n)); // VTK_VERTEX
-    v.write(path, n, n)
+    v
 }
 
 /// Writes the mesh faces as a `.vtu` file: one cell per face, with its radius.
@@ -300,22 +358,34 @@ pub fn write_mesh(path: &Path, mesh: &Mesh) -> Result<()> {
 /// Writes the contact network as `.vtp` lines: particle centre to particle centre for a
 /// pair, centre to contact point for a face, with the cell arrays `normal_force` and
 /// `tangential_force` (magnitudes \[N\]), `overlap` \[m\] and `face` (-1 for pairs).
+/// `p` holds the particles of the contacts (of a piece: own and ghosts).
 pub fn write_contacts(path: &Path, p: &Particles, contacts: &[ContactRecord]) -> Result<()> {
+    let n = contacts.len();
+    let v = contacts_vtp(p, contacts);
+    v.write_as(path, 2 * n, n, "PolyData", "Lines", "NumberOfLines")
+}
+
+/// Writes the `.pvtp` file that makes the pieces `sources` (of [`write_contacts`]) one
+/// data set for ParaView.
+pub fn write_contact_list(path: &Path, sources: &[String]) -> Result<()> {
+    contacts_vtp(&Particles::default(), &[]).write_list(path, "PPolyData", sources)
+}
+
+/// The contact network's file.
+fn contacts_vtp(p: &Particles, contacts: &[ContactRecord]) -> Vtu {
     use Section::*;
-    let mut at = vec![u32::MAX; p.next_id as usize];
-    for (k, &id) in p.id.iter().enumerate() {
-        at[id as usize] = k as u32;
-    }
+    let at: rustc_hash::FxHashMap<u32, usize> =
+        p.id.iter().enumerate().map(|(k, &id)| (id, k)).collect();
     let mut points = Vec::with_capacity(2 * contacts.len());
     for c in contacts {
-        let xi = p.x[at[c.id as usize] as usize];
+        let xi = p.x[at[&c.id]];
         points.push(xi);
         points.push(match c.with {
             // A pair across a periodic side: to the contact point rather than across the box.
             Partner::Particle(j)
-                if (p.x[at[j] as usize] - xi).length() <= 4.0 * (c.point - xi).length() =>
+                if (p.x[at[&(j as u32)]] - xi).length() <= 4.0 * (c.point - xi).length() =>
             {
-                p.x[at[j] as usize]
+                p.x[at[&(j as u32)]]
             }
             _ => c.point,
         });
@@ -356,7 +426,7 @@ pub fn write_contacts(path: &Path, p: &Particles, contacts: &[ContactRecord]) ->
     v.vectors(Points, "points", 2 * n, points.into_iter());
     v.array(Cells, "connectivity", 1, 2 * n, 0..2 * n as i64);
     v.array(Cells, "offsets", 1, n, (1..=n as i64).map(|k| 2 * k));
-    v.write_as(path, 2 * n, n, "PolyData", "Lines", "NumberOfLines")
+    v
 }
 
 /// Writes a `.pvd` collection of `(time, file name)` entries.

@@ -31,14 +31,14 @@
 //! [[materials]] name, density, youngs_modulus, poisson_ratio, restitution, friction_*
 //! [[interactions]] materials = [a, b], restitution, friction_*
 //! [input]      particles
-//! [output]     dir, checkpoint_every, checkpoint_minutes, formats, wall_forces, contacts
+//! [output]     dir, checkpoint_every, checkpoint_minutes, formats, wall_forces, contacts,
+//!              gather = "auto" | "always" | "never"
 //! ```
 //! Paths are relative to the scenario file. Unknown keys and values outside Table 2's
 //! "Requirements" column are errors naming the key and the allowed range.
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Result, bail};
 use glam::DVec3;
 
 use crate::geometry::mesh::Contacts;
@@ -49,11 +49,13 @@ pub use crate::model::servo::{Servo, Target};
 
 mod clumps;
 mod meshes;
+mod output;
 mod raw;
 mod resolved;
 mod spawn;
 mod validate;
 pub use clumps::{ClumpTemplate, MassSource};
+pub use output::{Formats, Gather};
 pub use resolved::changes;
 
 /// The geometry of the paper's default hourglass (Fig. 5A), embedded so that `tinydem`
@@ -449,43 +451,8 @@ pub struct Scenario {
     pub wall_forces: bool,
     /// Write the contact network with every frame (`contactsNNNNNN.csv`, and `.vtp` with VTK).
     pub contact_network: bool,
-}
-
-/// The frame formats of `[output] formats`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Formats {
-    /// `particlesNNNNNN.csv`, the original program's format.
-    pub csv: bool,
-    /// `particlesNNNNNN.vtu`, `mesh.vtu` and `particles.pvd` for ParaView.
-    pub vtk: bool,
-}
-
-impl Formats {
-    fn parse(names: Option<Vec<String>>) -> Result<Formats> {
-        let Some(names) = names else {
-            return Ok(Formats {
-                csv: true,
-                vtk: false,
-            });
-        };
-        let mut f = Formats {
-            csv: false,
-            vtk: false,
-        };
-        for name in &names {
-            match name.as_str() {
-                "csv" => f.csv = true,
-                "vtk" => f.vtk = true,
-                other => bail!(
-                    "[output] formats: unknown format \"{other}\": the formats are \"csv\" and \"vtk\""
-                ),
-            }
-        }
-        if !f.csv && !f.vtk {
-            bail!("[output] formats must name at least one of \"csv\" and \"vtk\"");
-        }
-        Ok(f)
-    }
+    /// Whether a split run gathers each frame into one file or writes a piece per process.
+    pub gather: Gather,
 }
 
 /// Default time step, Eq. (50): Δt = R_min sqrt(ρ (1 - ν²) / E).

@@ -337,4 +337,5 @@ pub(super) struct RawOutput {
     pub(super) formats: Option<Vec<String>>,
     pub(super) wall_forces: Option<bool>,
     pub(super) contacts: Option<bool>,
+    pub(super) gather: Option<String>,
 }

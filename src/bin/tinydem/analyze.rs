@@ -189,7 +189,7 @@ impl AnalyzeArgs {
         let mut no_pile = Vec::new();
         let count = frames.len();
         for (k, path) in frames {
-            let (p, clumps) = tinydem::csv::load_grains(&path)?;
+            let (p, clumps) = tinydem::io::pieces::load_frame(&path)?;
             // A pile of clumps is fitted on the clumps' spheres (its surface, and diameters
             // of the spheres for the window).
             let spheres = match clumps {
@@ -230,20 +230,14 @@ impl AnalyzeArgs {
     }
 }
 
-/// The frames `particlesNNNNNN.csv` in `dir`, by number.
+/// The frames `particlesNNNNNN.csv` in `dir` (or their pieces), by number.
 fn frames_in(dir: &Path) -> Result<Vec<(u64, PathBuf)>> {
     let mut frames: Vec<(u64, PathBuf)> = std::fs::read_dir(dir)
         .with_context(|| format!("cannot read directory {}", dir.display()))?
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter_map(|p| {
-            let k = p
-                .file_name()?
-                .to_str()?
-                .strip_prefix("particles")?
-                .strip_suffix(".csv")?
-                .parse()
-                .ok()?;
-            Some((k, p))
+            let k = tinydem::io::pieces::frame_number(p.file_name()?.to_str()?)?;
+            Some((k, dir.join(tinydem::csv::frame_name(k))))
         })
         .collect();
     frames.sort();

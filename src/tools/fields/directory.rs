@@ -8,7 +8,7 @@ use anyhow::{Context, Result, bail};
 use glam::DVec3;
 
 use super::{Fields, Grid, Kernel, Sums};
-use crate::io::csv::{load_contacts, load_particles};
+use crate::io::pieces::{frame_number, load_frame, load_network};
 use crate::model::integrate::Inertia;
 use crate::model::particles::Particles;
 use crate::scenario::Scenario;
@@ -58,9 +58,9 @@ pub fn of_directory(
     };
     let frames = selected(dir, options.frames)?;
     let read = |k: u64| -> Result<(Particles, Vec<crate::engine::records::ContactRecord>)> {
-        let p = load_particles(&dir.join(crate::io::csv::frame_name(k)))?;
+        let (p, _) = load_frame(&dir.join(crate::io::csv::frame_name(k)))?;
         let name = format!("contacts{k:06}.csv");
-        let contacts = load_contacts(&dir.join(&name)).with_context(|| {
+        let contacts = load_network(&dir.join(&name)).with_context(|| {
             format!("the contact stress needs the contact network {name}: run with [output] contacts = true")
         })?;
         Ok((p, contacts))
@@ -99,13 +99,7 @@ pub fn of_directory(
 fn selected(dir: &Path, range: Option<(u64, u64)>) -> Result<Vec<u64>> {
     let mut all: Vec<u64> = std::fs::read_dir(dir)
         .with_context(|| format!("cannot read {}", dir.display()))?
-        .filter_map(|e| {
-            let name = e.ok()?.file_name().into_string().ok()?;
-            name.strip_prefix("particles")?
-                .strip_suffix(".csv")?
-                .parse()
-                .ok()
-        })
+        .filter_map(|e| frame_number(e.ok()?.file_name().to_str()?))
         .collect();
     all.sort_unstable();
     let picked: Vec<u64> = match range {

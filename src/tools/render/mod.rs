@@ -329,10 +329,10 @@ pub struct Rendered {
     pub notes: Vec<String>,
 }
 
-/// The number of a frame file `particlesNNNNNN.csv`.
+/// The number of a frame file `particlesNNNNNN.csv` (or `particlesNNNNNN_0.csv`, the
+/// first piece of one a split run wrote in pieces).
 fn frame_number(p: &Path) -> Option<u64> {
-    let name = p.file_stem()?.to_str()?;
-    name.strip_prefix("particles")?.parse().ok()
+    crate::io::pieces::frame_number(p.file_name()?.to_str()?)
 }
 
 /// The times of the frames listed in a directory's `frames.csv`, by frame number.
@@ -416,7 +416,7 @@ impl Source {
     /// The particles of a frame: a clump's row (with the scenario's templates) as its
     /// spheres.
     fn particles_of(&self, frame: &Path) -> Result<Particles> {
-        let (p, clumps) = crate::io::csv::load_grains(frame)?;
+        let (p, clumps) = crate::io::pieces::load_frame(frame)?;
         match (clumps, &self.sim) {
             (Some(c), Some(sim)) if !sim.scenario.clumps.is_empty() => {
                 crate::io::inputs::with_clumps(&sim.scenario, p, &c)
@@ -459,7 +459,7 @@ fn frames_of(path: &Path) -> Result<Vec<PathBuf>> {
     let mut f: Vec<PathBuf> = std::fs::read_dir(path)
         .with_context(|| format!("cannot read directory {}", path.display()))?
         .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| frame_number(p).is_some() && p.extension().is_some_and(|e| e == "csv"))
+        .filter_map(|p| Some(path.join(crate::io::csv::frame_name(frame_number(&p)?))))
         .collect();
     f.sort();
     anyhow::ensure!(
