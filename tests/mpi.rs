@@ -410,6 +410,31 @@ fn frames_in_pieces_on_2_and_3_processes_are_the_gathered_frames() {
         };
         same("a.csv");
         same("particles000006.png");
+        // The checkpoint is in parts, one per process, and is the run's state: a stage
+        // from it (in one process) writes what a stage from the gathered one does.
+        let files: Vec<String> = std::fs::read_dir(dir.path().join(&out))
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .filter(|n| n.starts_with("checkpoint"))
+            .collect();
+        assert_eq!(files.len(), np, "{np} processes: {files:?}");
+        assert!(files.iter().all(|f| f.contains(&format!("-of-{np}"))));
+        for from in ["one", out.as_str()] {
+            let (checkpoint, to) = (format!("{from}/checkpoint.bin"), format!("from_{from}"));
+            let args = [
+                "run",
+                name,
+                "--from",
+                &checkpoint,
+                "-o",
+                &to,
+                "-q",
+                "--overwrite",
+            ];
+            run(1, &args, dir.path());
+        }
+        let from_one = outputs(&dir.path().join("from_one"));
+        assert!(from_one == outputs(&dir.path().join(format!("from_{out}"))));
     }
 }
 

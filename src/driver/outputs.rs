@@ -27,20 +27,8 @@ pub(super) struct Frames<'a> {
 impl<'a> Frames<'a> {
     /// The frames of `sim` into `dir` (collective in a split run).
     pub(super) fn of(dir: &'a Path, sim: &Simulation) -> Frames<'a> {
-        let s = &sim.scenario;
-        // `auto`: in pieces if the run starts with, or may spawn, 10^7 particles or more.
-        let many = || {
-            let most = (sim.particle_count() as u64).max(s.simulation.max_particles);
-            most >= Gather::AUTO_LIMIT
-        };
-        let pieces = sim.process().is_some()
-            && match s.gather {
-                Gather::Always => false,
-                Gather::Never => true,
-                Gather::Auto => many(),
-            };
         Frames {
-            pieces,
+            pieces: in_pieces(sim),
             dir,
             formats: sim.scenario.formats,
             extra: Extra {
@@ -175,6 +163,23 @@ impl<'a> Frames<'a> {
             .collect();
         vtk::write_collection(&self.dir.join(format!("{stem}.pvd")), &entries)
     }
+}
+
+/// Whether `sim`, a split run, writes its frames and checkpoints in pieces, one per
+/// process (`[output] gather`; `auto`: if the run starts with, or may spawn, 10^7
+/// particles or more). Collective.
+pub(super) fn in_pieces(sim: &Simulation) -> bool {
+    let s = &sim.scenario;
+    let many = || {
+        let most = (sim.particle_count() as u64).max(s.simulation.max_particles);
+        most >= Gather::AUTO_LIMIT
+    };
+    sim.process().is_some()
+        && match s.gather {
+            Gather::Always => false,
+            Gather::Never => true,
+            Gather::Auto => many(),
+        }
 }
 
 /// Writes `run.toml`: the resolved scenario of the run (every default filled in, paths

@@ -523,7 +523,8 @@ fn stop(dir: &Path, sim: &Simulation, extra: Extra, keep: Option<u64>) -> Result
     if writer {
         eprintln!("{stop}");
     }
-    if writer && sim.process().is_some() && checkpoint::newer_parts(&path).is_some() {
+    let join = sim.process().is_some() && !super::outputs::in_pieces(sim);
+    if writer && join && checkpoint::newer_parts(&path).is_some() {
         let fp = fingerprint(sim);
         let joined =
             checkpoint::load(&path, Some(fp)).and_then(|s| checkpoint::save(&path, &s, fp));
@@ -559,8 +560,17 @@ fn save_pieces(dir: &Path, sim: &Simulation) -> Result<PathBuf> {
     Ok(path)
 }
 
-/// Writes the checkpoint of `sim` into `dir`, returning its path.
+/// Writes the checkpoint of `sim` into `dir`, returning its path: one file, or in a split
+/// run that writes in pieces (`[output] gather`) its parts, one per process, with no
+/// gather (reading the checkpoint joins them; the one file of an earlier step goes).
 fn save_checkpoint(dir: &Path, sim: &Simulation) -> Result<PathBuf> {
+    if super::outputs::in_pieces(sim) {
+        let path = save_pieces(dir, sim)?;
+        if sim.is_writer() {
+            let _ = std::fs::remove_file(&path);
+        }
+        return Ok(path);
+    }
     let path = dir.join(CHECKPOINT);
     write_checkpoint(&path, sim)?;
     Ok(path)

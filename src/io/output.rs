@@ -62,10 +62,15 @@ pub fn take_output(dir: &Path) -> Result<Lock> {
 /// what the tools make of it beside its frames (pictures and animations, fields), which a
 /// new run into the directory would leave stale.
 pub fn is_run_output(name: &str) -> bool {
+    // `prefixNNNNNN.ext`, or `prefixNNNNNN_K.ext`, piece K of a frame of a split run.
     let frame = |prefix: &str| {
         name.strip_prefix(prefix).is_some_and(|rest| {
-            let digits = rest.split('.').next().unwrap_or("");
-            !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit())
+            let number = rest.split('.').next().unwrap_or("");
+            let digits = |d: &str| !d.is_empty() && d.bytes().all(|b| b.is_ascii_digit());
+            match number.split_once('_') {
+                Some((frame, piece)) => digits(frame) && digits(piece),
+                None => digits(number),
+            }
         })
     };
     frame("particles")
@@ -120,4 +125,32 @@ pub fn claim_output(dir: &Path, overwrite: bool) -> Result<()> {
         std::fs::remove_file(&p).with_context(|| format!("cannot remove {}", p.display()))?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::is_run_output;
+
+    #[test]
+    fn frames_their_pieces_and_listings_are_run_output() {
+        for name in [
+            "particles000003.csv",
+            "particles000003_1.csv",
+            "particles000003_12.vtu",
+            "particles000003.pvtu",
+            "contacts000003_0.vtp",
+            "contacts000003.pvtp",
+            "checkpoint.bin.40.part-1-of-2",
+        ] {
+            assert!(is_run_output(name), "{name}");
+        }
+        for name in [
+            "particles_a.csv",
+            "particles000003_.csv",
+            "notes.csv",
+            "bed.csv",
+        ] {
+            assert!(!is_run_output(name), "{name}");
+        }
+    }
 }
