@@ -355,13 +355,7 @@ fn frames_in_pieces_on_2_and_3_processes_are_the_gathered_frames() {
     // `gather = "never"`: each process writes its piece of every frame and contact network
     // (CSV and VTK), the first the .pvtu/.pvtp that list them; joined, they are the frames
     // of the run in one process (tests/pieces_check.py reads the VTK with meshio).
-    let has_meshio = Command::new("python3")
-        .args(["-c", "import meshio, numpy"])
-        .status()
-        .is_ok_and(|s| s.success());
-    if !has_meshio {
-        assert!(std::env::var_os("CI").is_none(), "CI must have meshio");
-        eprintln!("SKIPPED: python3 with meshio not found (pip install meshio)");
+    if !common::has_meshio() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();

@@ -3,21 +3,14 @@
 //! Without meshio the test reports that it was skipped, except under CI, where `.ci/run`
 //! installs meshio and the test must run.
 
+mod common;
+
 use std::path::Path;
 use std::process::Command;
 
 #[test]
 fn vtk_frames_match_csv_frames_in_a_real_reader() {
-    let has_meshio = Command::new("python3")
-        .args(["-c", "import meshio, numpy"])
-        .status()
-        .is_ok_and(|s| s.success());
-    if !has_meshio {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "CI must have meshio (pip install meshio)"
-        );
-        eprintln!("SKIPPED: python3 with meshio not found (pip install meshio)");
+    if !common::has_meshio() {
         return;
     }
     let t = tempfile::tempdir().unwrap();

@@ -97,3 +97,20 @@ pub fn drum_off(n: usize) -> String {
         f.join("\n")
     )
 }
+
+/// Whether python3 with meshio (a real VTK reader) is here; without it a test that needs it
+/// says it was skipped, except under CI, where `.ci/run` installs meshio: there it fails.
+pub fn has_meshio() -> bool {
+    let found = Command::new("python3")
+        .args(["-c", "import meshio, numpy"])
+        .status()
+        .is_ok_and(|s| s.success());
+    if !found {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "CI must have meshio (pip install meshio)"
+        );
+        eprintln!("SKIPPED: python3 with meshio not found (pip install meshio)");
+    }
+    found
+}
