@@ -86,8 +86,12 @@ pub fn load(path: &Path, fingerprint: Option<u64>) -> Result<Snapshot> {
     if let Some(parts) = newer_parts(path) {
         return load_parts(&parts, fingerprint);
     }
-    let bytes = crate::io::files::read(path)
-        .with_context(|| format!("cannot read checkpoint {}", path.display()))?;
+    let bytes = crate::io::files::read(path).with_context(|| {
+        let lacking = parts::missing_parts(path).map_or(String::new(), |m| {
+            format!(" (nor its parts of a split run: {m} missing)")
+        });
+        format!("cannot read checkpoint {}{lacking}", path.display())
+    })?;
     decode(&bytes, fingerprint).with_context(|| format!("cannot resume from {}", path.display()))
 }
 

@@ -148,6 +148,24 @@ pub fn newer_parts(path: &Path) -> Option<Vec<PathBuf>> {
         .then(|| newest.iter().map(|p| p.0.clone()).collect())
 }
 
+/// What the newest incomplete set of parts of the checkpoint at `path` lacks, as words
+/// ("checkpoint.bin.40.part-1-of-2"), if there is such a set: for the error of a
+/// checkpoint that is neither a file nor a complete set.
+pub fn missing_parts(path: &Path) -> Option<String> {
+    let of = file_name(path);
+    let parts = parts_beside(path, &of);
+    let set = parts
+        .chunk_by(|a, b| (a.1.step, a.1.n) == (b.1.step, b.1.n))
+        .filter(|set| set.len() < set[0].1.n)
+        .max_by_key(|set| set[0].1.step)?;
+    let Part { step, n, .. } = set[0].1;
+    let missing: Vec<String> = (0..n)
+        .filter(|&k| set.iter().all(|p| p.1.k != k))
+        .map(|k| format!("{of}.{step}.part-{k}-of-{n}"))
+        .collect();
+    Some(missing.join(", "))
+}
+
 /// Reads and joins the parts `paths` (part 0 to n-1 of one checkpoint).
 pub fn load_parts(paths: &[PathBuf], fingerprint: Option<u64>) -> Result<Snapshot> {
     let n = paths.len();
@@ -242,9 +260,13 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("checkpoint.bin");
         let (pieces, whole) = pieces();
-        // Part 0 alone (a stop that did not finish): no checkpoint to read.
+        // Part 0 alone (a stop that did not finish): no checkpoint to read, and the error
+        // names the missing part.
         save_part(&path, 0, 2, &pieces[0], 7).unwrap();
         assert!(newer_parts(&path).is_none());
+        let e = format!("{:#}", super::super::load(&path, Some(7)).unwrap_err());
+        let missing = format!("checkpoint.bin.{}.part-1-of-2 missing", pieces[0].steps);
+        assert!(e.contains(&missing), "{e}");
         // An older complete set is read while the newer one is unfinished.
         let mut old = pieces.clone();
         old.iter_mut()
