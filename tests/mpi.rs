@@ -433,6 +433,51 @@ fn frames_in_pieces_on_2_and_3_processes_are_the_gathered_frames() {
 }
 
 #[test]
+fn a_particle_file_of_clumps_without_ids_read_in_shares_writes_the_same_bytes() {
+    // Each process reads its share of the file (none reads it all): rows without ids, so a
+    // row's id is its place in the file, after the spheres of the clumps before it.
+    let dir = tempfile::tempdir().unwrap();
+    let path = silo(dir.path(), 4);
+    let mut rows = String::from("x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz,clump\n");
+    for k in 0..120 {
+        let (x, y, z) = (
+            (k % 6) as f64 * 0.015 - 0.04,
+            (k / 6 % 5) as f64 * 0.015 - 0.03,
+            0.07 + (k / 30) as f64 * 0.015,
+        );
+        let clump = [0, -1, 1][k % 3];
+        let r = [0.006, 0.0035, 0.0065][k % 3];
+        rows += &format!("{x},{y},{z},{r},0,0,-0.5,1,0,0,0,0,0,0,{clump}\n");
+    }
+    std::fs::write(dir.path().join("grains.csv"), rows).unwrap();
+    let spheres = "spawn_min = [-0.05, -0.05, 0.06]\nspawn_max = [0.05, 0.05, 0.14]\n";
+    let text = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace(spheres, "")
+        .replace("max_particles = 300", "max_particles = 0")
+        + "[input]\nparticles = \"grains.csv\"\n\
+           [[clumps]]\nname = \"dimer\"\nspheres = [[0.0, 0.0, 0.0, 0.0035], [0.005, 0.0, 0.0, 0.0035]]\n\
+           [[clumps]]\nname = \"tri\"\nspheres = [[0.0, 0.0, 0.0, 0.0035], [0.006, 0.0, 0.0, 0.0035], [0.003, 0.0052, 0.0, 0.0035]]\n";
+    std::fs::write(&path, text).unwrap();
+    let files = same_output(&path, &[2, 3, 4]);
+    let first = &files
+        .iter()
+        .find(|f| f.0 == "particles000000.csv")
+        .unwrap()
+        .1;
+    // Rows: dimer (ids 0, 1), sphere (2), triangle (3, 4, 5), dimer (6, 7), ...
+    let text = String::from_utf8_lossy(first);
+    let ids: Vec<&str> = (text.lines().skip(1).take(4))
+        .map(|l| l.rsplit(',').nth(2).unwrap())
+        .collect();
+    assert_eq!(
+        ids,
+        ["0", "2", "3", "6"],
+        "a row's id follows the spheres before it"
+    );
+}
+
+#[test]
 fn a_sheared_periodic_box_on_1_to_3_processes_writes_the_same_bytes() {
     // The shear cell of the examples (periodic along x, y and z, Lees-Edwards boundaries,
     // two materials, contact networks), for fewer frames.

@@ -318,15 +318,23 @@ fn open_on(
     options: &Options,
     comm: Option<Box<dyn Comm>>,
 ) -> Result<(Simulation, Vec<String>)> {
-    let opened = open(scenario, options.resume, options.from);
-    Ok(match comm.filter(|c| c.size() > 1) {
-        Some(comm) => {
-            let (sim, notes) = crate::parallel::domain::agree(&*comm, opened)?;
-            let split = sim.split(comm);
-            (split?, notes)
+    let Some(comm) = comm.filter(|c| c.size() > 1) else {
+        return open(scenario, options.resume, options.from);
+    };
+    let fresh = options.resume.is_none() && options.from.is_none();
+    if fresh && scenario.particles.is_some() {
+        // Each process reads its share of the particle file, none them all.
+        if let Some(why) = scenario.spawn_box_outside() {
+            anyhow::bail!("{why}");
         }
-        None => opened?,
-    })
+        let inputs = crate::io::inputs::read_share(&scenario, &*comm);
+        let sim = inputs.and_then(|i| Simulation::from_inputs(scenario, i));
+        let sim = crate::parallel::domain::agree(&*comm, sim)?;
+        return Ok((sim.split_shares(comm)?, Vec::new()));
+    }
+    let opened = open(scenario, options.resume, options.from);
+    let (sim, notes) = crate::parallel::domain::agree(&*comm, opened)?;
+    Ok((sim.split(comm)?, notes))
 }
 
 /// What `tinydem check` would refuse the run for (collective): an error naming it all.

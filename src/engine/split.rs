@@ -167,13 +167,26 @@ impl Simulation {
     /// Splits this simulation over the processes of `comm`: each process calls it with the
     /// same simulation (all its particles, as made or restored), keeps its share and the
     /// ghosts it needs, and from then on steps together with the others.
-    pub fn split(mut self, comm: Box<dyn Comm>) -> Result<Simulation> {
+    pub fn split(self, comm: Box<dyn Comm>) -> Result<Simulation> {
         let (rank, size) = (comm.rank(), comm.size());
         let p = &self.particles;
         // Dealt out by id for a start (a rigid body whole, by its first sphere's).
         let owned = (0..p.len())
             .map(|i| p.body[i].map_or(p.id[i], |b| b.first()) as usize % size == rank)
             .collect();
+        self.split_owning(comm, owned)
+    }
+
+    /// Splits a simulation of which each process of `comm` holds a share (of the initial
+    /// particles, [`crate::io::inputs::read_share`]), none twice: each starts as the owner
+    /// of what it holds, and from then on they step together.
+    pub fn split_shares(self, comm: Box<dyn Comm>) -> Result<Simulation> {
+        let owned = vec![true; self.particles.len()];
+        self.split_owning(comm, owned)
+    }
+
+    /// Splits this simulation, this process owning the particles `owned` says at first.
+    fn split_owning(mut self, comm: Box<dyn Comm>, owned: Vec<bool>) -> Result<Simulation> {
         self.domain = Some(Domain {
             comm,
             tree: None,
@@ -215,8 +228,10 @@ impl Simulation {
         let anchors = match placement {
             Placement::Now => None,
             Placement::Anchors => {
+                // (Decided together: a process that holds nothing has all its anchors.)
                 let (a, _) = self.neighbours.anchors();
-                (a.len() == self.particles.len()).then(|| a.to_vec())
+                let anchored = a.len() == self.particles.len();
+                (!self.any(!anchored)).then(|| a.to_vec())
             }
         };
         // Carried along with the particles, if any.

@@ -450,6 +450,46 @@ pub fn load_grains_within(
     read_grains(f, &path.display().to_string(), Some(limits))
 }
 
+/// Share `k` of `n` of a particle file (`[input] particles`), for a run split over `n`
+/// processes whose process `k` reads only it: the rows that start in the k-th of n equal
+/// byte ranges after the header, each row read by one process; and whether the file gives
+/// the ids (an `id` column). Without, its ids count from 0 within the share: the caller
+/// adds the rows of the shares before.
+pub fn load_grains_share(
+    path: &Path,
+    limits: &Limits,
+    (k, n): (usize, usize),
+) -> Result<(Particles, Option<ClumpColumn>, bool)> {
+    use std::io::{Seek, SeekFrom};
+    let file = path.display().to_string();
+    let mut f = crate::io::files::open(path)
+        .with_context(|| format!("cannot read particle file {file}"))?;
+    let len = f.metadata().map(|m| m.len()).unwrap_or(0);
+    let mut header = String::new();
+    BufReader::new(&mut f)
+        .read_line(&mut header)
+        .with_context(|| format!("{file}:1: cannot read line (not UTF-8 text?)"))?;
+    let body = header.len() as u64;
+    // The first row that starts at or after byte `at`.
+    let mut row_at = |at: u64| -> Result<u64> {
+        if at <= body || at >= len {
+            return Ok(at.clamp(body, len));
+        }
+        f.seek(SeekFrom::Start(at - 1))?;
+        let mut skipped = Vec::new();
+        BufReader::new(&mut f).read_until(b'\n', &mut skipped)?;
+        Ok(at - 1 + skipped.len() as u64)
+    };
+    let share = |j: usize| body + (len - body) * j as u64 / n as u64;
+    let (from, to) = (row_at(share(k))?, row_at(share(k + 1))?);
+    f.seek(SeekFrom::Start(from))?;
+    let name = format!("{file} (the share of process {k} of {n}: bytes {from} to {to})");
+    let ids = Header::parse(&header, &file)?.int_column[1].is_some();
+    let rows = std::io::Cursor::new(header.into_bytes()).chain(f.take(to - from));
+    let (particles, clumps) = read_grains(rows, &name, Some(limits))?;
+    Ok((particles, clumps, ids))
+}
+
 pub fn read_particles(input: impl Read, file: &str) -> Result<Particles> {
     read_particles_within(input, file, None)
 }
@@ -535,6 +575,33 @@ pub fn load_particles(path: &Path) -> Result<Particles> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn shares_of_a_file_hold_each_row_once_in_order() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("rows.csv");
+        let mut text = String::from("x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz\n");
+        for k in 0..37 {
+            // Rows of different lengths, so that the shares' edges fall anywhere in them.
+            text += &format!("{}.{},0,0,0.5,0,0,0,1,0,0,0,0,0,0\n", k, "7".repeat(k % 5));
+        }
+        std::fs::write(&path, &text).unwrap();
+        let limits = Limits {
+            materials: 1,
+            radius_min: 0.5,
+            radius_max: 0.5,
+        };
+        let whole = load_particles_within(&path, &limits).unwrap();
+        for n in 1..=7 {
+            let mut x = Vec::new();
+            for k in 0..n {
+                let (p, clumps, ids) = load_grains_share(&path, &limits, (k, n)).unwrap();
+                assert!(clumps.is_none() && !ids);
+                x.extend(p.x);
+            }
+            assert_eq!(x, whole.x, "{n} shares");
+        }
+    }
 
     #[test]
     fn contact_networks_read_back_as_written() {

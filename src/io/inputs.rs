@@ -13,6 +13,8 @@ use crate::engine::setup::Inputs;
 use crate::geometry::mesh::Mesh;
 use crate::io::{csv, files};
 use crate::model::particles::{Particle, Particles};
+use crate::parallel::comm::{Comm, Reader};
+use crate::parallel::domain::agree;
 use crate::scenario::{ClumpTemplate, MeshInput, MeshSource, Scenario};
 
 impl Scenario {
@@ -86,13 +88,86 @@ pub fn read(scenario: &Scenario) -> Result<Inputs> {
     Ok(Inputs { meshes, particles })
 }
 
+/// What the files of `scenario` hold for process `k` of a run split over the processes of
+/// `comm` (collective): the meshes, and its share of the particle file
+/// ([`csv::load_grains_share`]), with the ids the whole file gives them, so that no process
+/// reads or holds them all. An error on any process is the error of all.
+pub fn read_share(scenario: &Scenario, comm: &dyn Comm) -> Result<Inputs> {
+    let read = || -> Result<_> {
+        let meshes = meshes(scenario)?;
+        let Some(path) = &scenario.particles else {
+            return Ok((meshes, None));
+        };
+        let g = &scenario.geometry;
+        let limits = csv::Limits {
+            materials: scenario.materials.len(),
+            radius_min: g.radius_min,
+            radius_max: g.radius_max,
+        };
+        let share = csv::load_grains_share(path, &limits, (comm.rank(), comm.size()))?;
+        Ok((meshes, Some((path, share))))
+    };
+    let (meshes, share) = agree(comm, read())?;
+    let Some((path, (mut rows, clumps, ids))) = share else {
+        return Ok(Inputs {
+            meshes,
+            particles: Particles::default(),
+        });
+    };
+    // Without ids, a row's id is its place in the file, and a clump's spheres take the
+    // next ones: the rows and ids of the shares before come first.
+    let spheres = |t: Option<u16>| match t.and_then(|t| scenario.clumps.get(t as usize)) {
+        Some(template) if template.spheres.len() > 1 => template.spheres.len() as u64,
+        _ => 1,
+    };
+    let taken: u64 = match &clumps {
+        Some(c) => c.templates.iter().map(|&t| spheres(t)).sum(),
+        None => rows.len() as u64,
+    };
+    let before = |mine: u64| -> u64 {
+        let all = comm.all_gather(mine.to_le_bytes().to_vec());
+        all[..comm.rank()]
+            .iter()
+            .map(|m| Reader::new(m).u64())
+            .sum()
+    };
+    let (rows_before, ids_before) = (before(rows.len() as u64), before(taken));
+    if !ids {
+        rows.id.iter_mut().for_each(|id| *id += rows_before as u32);
+        rows.next_id += rows_before as u32;
+    }
+    let particles = match clumps {
+        None => Ok(rows),
+        Some(c) => with_clumps_from(scenario, rows, &c, ids_before as u32)
+            .with_context(|| format!("particle file {}", path.display())),
+    };
+    let mut particles = agree(comm, particles)?;
+    let next = comm.all_gather((particles.next_id as u64).to_le_bytes().to_vec());
+    particles.next_id = next.iter().map(|m| Reader::new(m).u64()).max().unwrap_or(0) as u32;
+    Ok(Inputs { meshes, particles })
+}
+
 /// The particles of an input file's `rows` whose `clump` column names a template: those
 /// rows become clumps (x, v, q, w their body's; scaled by R over the template's bounding
 /// radius, so that a run's frame reads back as it was written), the others stay spheres.
 /// A clump of row id b takes the ids b, b + 1, ... for its spheres; in a file without ids,
 /// each row takes the next free ids.
 pub fn with_clumps(s: &Scenario, rows: Particles, clumps: &csv::ClumpColumn) -> Result<Particles> {
-    let mut particles = Particles::default();
+    with_clumps_from(s, rows, clumps, 0)
+}
+
+/// [`with_clumps`] for rows whose ids, if the file gives none, start at `first` (a share of
+/// the file that follows others).
+fn with_clumps_from(
+    s: &Scenario,
+    rows: Particles,
+    clumps: &csv::ClumpColumn,
+    first: u32,
+) -> Result<Particles> {
+    let mut particles = Particles {
+        next_id: first,
+        ..Particles::default()
+    };
     let mut taken = rustc_hash::FxHashSet::default();
     for k in rows.id_order() {
         let row = rows.get(k);
