@@ -178,7 +178,7 @@ impl Simulation {
     }
 
     /// Splits a simulation of which each process of `comm` holds a share (of the initial
-    /// particles, [`crate::io::inputs::read_share`]), none twice: each starts as the owner
+    /// particles, read by `io::inputs::read_share`), none twice: each starts as the owner
     /// of what it holds, and from then on they step together.
     pub fn split_shares(self, comm: Box<dyn Comm>) -> Result<Simulation> {
         let owned = vec![true; self.particles.len()];
