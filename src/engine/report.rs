@@ -22,12 +22,7 @@ impl Simulation {
     /// the whole network in one process.
     pub fn own_contact_network(&self) -> Vec<ContactRecord> {
         let mut network = self.held_contact_network();
-        if let Some(d) = &self.domain {
-            let p = &self.particles;
-            let own: rustc_hash::FxHashSet<u32> = (0..p.len())
-                .filter(|&k| d.owned[k])
-                .map(|k| p.id[k])
-                .collect();
+        if let Some(own) = self.own_ids() {
             network.retain(|c| own.contains(&c.id));
         }
         network
@@ -37,10 +32,7 @@ impl Simulation {
     pub(super) fn held_contact_network(&self) -> Vec<ContactRecord> {
         let mut out = self.held_pair_records();
         out.extend(self.held_face_records());
-        out.sort_by_key(|r| match r.with {
-            Partner::Particle(j) => (0, r.id, j),
-            Partner::Face(f) => (1, r.id, f),
-        });
+        out.sort_by_key(ContactRecord::network_order);
         out
     }
 
@@ -197,12 +189,7 @@ impl Simulation {
             .fold((0.0, 0.0), |(t, r), e| (t + e.1, r + e.2));
         let radius_of: rustc_hash::FxHashMap<u32, f64> =
             p.id.iter().copied().zip(p.radius.iter().copied()).collect();
-        let own: Option<rustc_hash::FxHashSet<u32>> = self.domain.as_ref().map(|d| {
-            (0..p.len())
-                .filter(|&k| d.owned[k])
-                .map(|k| p.id[k])
-                .collect()
-        });
+        let own = self.own_ids();
         let mut thermo = Thermo {
             particles: energies.len(),
             kinetic_energy: translational + rotational,

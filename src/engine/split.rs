@@ -55,10 +55,7 @@ pub(crate) fn gather_contacts(comm: &dyn Comm, mine: Vec<ContactRecord>) -> Vec<
             });
         }
     }
-    all.sort_by_key(|r| match r.with {
-        Partner::Particle(j) => (0, r.id, j),
-        Partner::Face(f) => (1, r.id, f),
-    });
+    all.sort_by_key(ContactRecord::network_order);
     all
 }
 
@@ -128,10 +125,7 @@ impl Simulation {
         let p = &self.particles;
         let (mut pairs, mut faces) = self.neighbours.entries_by_id(&p.id);
         let (anchors, _) = self.neighbours.anchors();
-        let own_ids: FxHashSet<u32> = (0..p.len())
-            .filter(|&k| d.owned[k])
-            .map(|k| p.id[k])
-            .collect();
+        let own_ids = self.own_ids().expect("a split run");
         let mut own = Particles {
             next_id: p.next_id,
             ..Particles::default()
@@ -209,6 +203,18 @@ impl Simulation {
     pub fn owns(&self, id: u32) -> bool {
         let p = &self.particles;
         (0..p.len()).any(|i| p.id[i] == id && self.own(i))
+    }
+
+    /// The ids of this process's own particles, in a split run.
+    pub(crate) fn own_ids(&self) -> Option<FxHashSet<u32>> {
+        let d = self.domain.as_ref()?;
+        let p = &self.particles;
+        Some(
+            (0..p.len())
+                .filter(|&k| d.owned[k])
+                .map(|k| p.id[k])
+                .collect(),
+        )
     }
 
     /// Whether the particle stored at `i` is this process's own (always, in one process).

@@ -106,10 +106,7 @@ pub fn load_network(path: &Path) -> Result<Vec<ContactRecord>> {
     for piece in pieces? {
         all.extend(load_contacts(&piece)?);
     }
-    all.sort_by_key(|r| match r.with {
-        crate::engine::records::Partner::Particle(j) => (0, r.id, j),
-        crate::engine::records::Partner::Face(f) => (1, r.id, f),
-    });
+    all.sort_by_key(ContactRecord::network_order);
     Ok(all)
 }
 

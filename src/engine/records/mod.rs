@@ -104,6 +104,17 @@ pub struct ContactRecord {
     pub overlap: f64,
 }
 
+impl ContactRecord {
+    /// Where it stands in a network: pairs by (lower id, higher id), then contacts with
+    /// faces by (id, face).
+    pub fn network_order(&self) -> (u8, u32, usize) {
+        match self.with {
+            Partner::Particle(j) => (0, self.id, j),
+            Partner::Face(f) => (1, self.id, f),
+        }
+    }
+}
+
 /// FNV-1a, 64 bit, of `text`: how records name what they were made from (the mesh files'
 /// faces, a checkpoint's scenario).
 pub fn hash(text: &str) -> u64 {
