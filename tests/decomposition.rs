@@ -298,7 +298,18 @@ fn checkpoint_on_2_resumes_on_3(
                 for _ in 0..first {
                     sim.step().unwrap();
                 }
-                (sim.snapshot().unwrap(), sim.snapshot_piece())
+                // What the writer is handed to write, and the others not (they never
+                // hold the whole): the snapshot and the particles of a frame.
+                let for_writer = sim.snapshot_for_writer().unwrap();
+                let frame = sim.particles_in_domain().into_owned();
+                let all = sim.snapshot().unwrap();
+                match sim.is_writer() {
+                    true => {
+                        assert!(for_writer.as_ref() == Some(&all) && frame.id == all.particles.id)
+                    }
+                    false => assert!(for_writer.is_none() && frame.is_empty()),
+                }
+                (all, sim.snapshot_piece())
             })
         })
         .collect();

@@ -9,6 +9,7 @@ use crate::engine::{Simulation, Thermo};
 use crate::io::csv::{Extra, write_frame, write_frame_as};
 use crate::io::output::{FRAMES, LOG, LOG_HEADER, OUTLETS, RUN_TOML, WALLS};
 use crate::io::vtk;
+use crate::parallel::comm::Reach;
 use crate::scenario::{Formats, Gather, Met, Scenario};
 
 /// Writes frames in the scenario's formats, and the ParaView collection.
@@ -57,7 +58,10 @@ impl<'a> Frames<'a> {
             return self.write_pieces(k, sim);
         }
         let particles = sim.particles_in_domain();
-        let contacts = sim.scenario.contact_network.then(|| sim.contact_network());
+        let contacts = sim
+            .scenario
+            .contact_network
+            .then(|| sim.contact_network_to(Reach::Writer));
         if !sim.is_writer() {
             return Ok(());
         }

@@ -70,7 +70,9 @@ pub struct Summary {
     pub wall_seconds: f64,
     /// Wall time per stage of the step, and for writing frames and checkpoints.
     pub stage_times: StageTimes,
-    pub output_seconds: f64,
+    /// Wall time spent writing frames (with their logs) and checkpoints.
+    pub frame_seconds: f64,
+    pub checkpoint_seconds: f64,
     /// Pairs that overlapped by more than the smaller radius (warned of, not stopped), and
     /// the likely cause.
     pub warnings: usize,
@@ -170,11 +172,9 @@ pub fn run_on(
             ));
         }
         if sim.steps.is_multiple_of(steps_per_frame) {
-            let t = Instant::now();
             let frame = sim.steps / steps_per_frame;
             record.frame(&mut sim, frame)?;
             checkpoints.after_frame(output_dir, &sim, frame)?;
-            record.output_seconds += t.elapsed().as_secs_f64();
         }
         checkpoints.timed(output_dir, &sim)?;
         record.status.progress(sim.steps);
@@ -183,7 +183,7 @@ pub fn run_on(
             return Err(stop(output_dir, &sim, record.out.extra, keep)?.into());
         }
     }
-    record.finish(output_dir, &sim, start)
+    record.finish(output_dir, &sim, (start, checkpoints.seconds))
 }
 
 /// `options`, silenced on the processes that do not write.
@@ -220,8 +220,8 @@ struct Record<'a> {
     logs: Option<Logs>,
     status: Status,
     frames_written: u64,
-    /// Wall time spent writing frames and checkpoints.
-    output_seconds: f64,
+    /// Wall time spent writing frames and their logs.
+    frame_seconds: f64,
     /// The condition of `[simulation] until` that ends the run, and its frame.
     ended_by: Option<(Met, u64)>,
 }
@@ -249,7 +249,7 @@ impl<'a> Record<'a> {
             logs,
             status: Status::new(options.verbosity, total_steps, sim.steps),
             frames_written: 0,
-            output_seconds: 0.0,
+            frame_seconds: 0.0,
             ended_by: None,
         })
     }
@@ -257,6 +257,7 @@ impl<'a> Record<'a> {
     /// Frame `frame`: its files, its lines in the logs and its status line, and whether a
     /// condition of `[simulation] until` ends the run at it (collective).
     fn frame(&mut self, sim: &mut Simulation, frame: u64) -> Result<()> {
+        let t = Instant::now();
         let written = self.out.write(frame, sim);
         sim.agree(written)?;
         self.frames_written += 1;
@@ -267,6 +268,7 @@ impl<'a> Record<'a> {
             .flatten();
         let logged = Logs::frame(self.logs.as_mut(), sim, frame, (&th, met.as_ref()));
         sim.agree(logged)?;
+        self.frame_seconds += t.elapsed().as_secs_f64();
         self.status.frame(sim, frame, &th);
         self.ended_by = met.map(|m| (m, frame));
         Ok(())
@@ -287,11 +289,17 @@ impl<'a> Record<'a> {
 
     /// The end of a complete run: its last checkpoint, so that it can be extended or
     /// staged, and its summary.
-    fn finish(mut self, output_dir: &Path, sim: &Simulation, start: Instant) -> Result<Summary> {
+    /// `clock`: the run's start and the time its checkpoints took so far.
+    fn finish(
+        self,
+        output_dir: &Path,
+        sim: &Simulation,
+        (start, checkpoint_seconds): (Instant, f64),
+    ) -> Result<Summary> {
         self.status.finish();
         let t = Instant::now();
         save_checkpoint(output_dir, sim)?;
-        self.output_seconds += t.elapsed().as_secs_f64();
+        let checkpoint_seconds = checkpoint_seconds + t.elapsed().as_secs_f64();
         if sim.is_writer() {
             let _ = std::fs::remove_file(output_dir.join(INTERRUPTED));
         }
@@ -302,7 +310,8 @@ impl<'a> Record<'a> {
             rebuilds: sim.rebuilds(),
             wall_seconds: start.elapsed().as_secs_f64(),
             stage_times: sim.stage_times.clone(),
-            output_seconds: self.output_seconds,
+            frame_seconds: self.frame_seconds,
+            checkpoint_seconds,
             warnings: sim.warnings().count(),
             advice: sim.advice(),
             removed: sim.removed.clone(),
@@ -391,6 +400,8 @@ struct Checkpoints {
     at: Option<u64>,
     /// The step and time of the last checkpoint asked by SIGCONT.
     sigcont: Option<(u64, Instant)>,
+    /// Wall time spent writing them.
+    seconds: f64,
 }
 
 impl Checkpoints {
@@ -401,18 +412,23 @@ impl Checkpoints {
             last: Instant::now(),
             at: None,
             sigcont: None,
+            seconds: 0.0,
         }
     }
 
-    fn written(&mut self, sim: &Simulation) {
+    /// A checkpoint now, timed.
+    fn save(&mut self, dir: &Path, sim: &Simulation) -> Result<()> {
+        let t = Instant::now();
+        save_checkpoint(dir, sim)?;
+        self.seconds += t.elapsed().as_secs_f64();
         (self.last, self.at) = (Instant::now(), Some(sim.steps));
+        Ok(())
     }
 
     /// After frame `frame` was written: `checkpoint_every`.
     fn after_frame(&mut self, dir: &Path, sim: &Simulation, frame: u64) -> Result<()> {
         if self.every > 0 && frame.is_multiple_of(self.every) {
-            save_checkpoint(dir, sim)?;
-            self.written(sim);
+            self.save(dir, sim)?;
         }
         Ok(())
     }
@@ -424,8 +440,7 @@ impl Checkpoints {
             && sim.steps.is_multiple_of(100)
             && sim.any(self.last.elapsed() >= self.interval)
         {
-            save_checkpoint(dir, sim)?;
-            self.written(sim);
+            self.save(dir, sim)?;
         }
         Ok(())
     }
@@ -445,7 +460,9 @@ impl Checkpoints {
         let [checkpoint_now, mut stop_now] =
             sim.any_each([asked(|r| &r.checkpoint), asked(|r| &r.stop)]);
         if checkpoint_now && self.at != Some(sim.steps) {
+            let t = Instant::now();
             let path = save_pieces(dir, sim)?;
+            self.seconds += t.elapsed().as_secs_f64();
             self.at = Some(sim.steps);
             self.sigcont = Some((sim.steps, Instant::now()));
             if sim.is_writer() {
@@ -588,12 +605,8 @@ fn save_checkpoint(dir: &Path, sim: &Simulation) -> Result<PathBuf> {
 /// starts a stage from it). In a split run: collective, one file (as of one process)
 /// written by the first.
 pub fn write_checkpoint(path: &Path, sim: &Simulation) -> Result<()> {
-    let snapshot = sim.snapshot()?;
-    let saved = if sim.is_writer() {
-        checkpoint::save(path, &snapshot, fingerprint(sim))
-    } else {
-        Ok(())
-    };
+    let snapshot = sim.snapshot_for_writer()?;
+    let saved = snapshot.map_or(Ok(()), |s| checkpoint::save(path, &s, fingerprint(sim)));
     sim.agree(saved)
 }
 

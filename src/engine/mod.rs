@@ -511,12 +511,14 @@ impl Simulation {
     /// The particles with their positions put back into the domain along its periodic
     /// axes (between neighbour-list rebuilds they may be up to half the skin beyond a side),
     /// for output; the particles themselves if it has none.
+    /// Of a split run: all processes' particles in id order on the first (collective), and
+    /// none on the others (they write nothing; [`Simulation::gather_particles`] gives all
+    /// to all).
     pub fn particles_in_domain(&self) -> std::borrow::Cow<'_, Particles> {
-        // Of a split run, all processes' (collective), in id order.
         let p = match (&self.domain, self.neighbours.periodic) {
             (None, None) => return std::borrow::Cow::Borrowed(&self.particles),
             (None, Some(_)) => self.particles.clone(),
-            (Some(_), _) => self.gather_particles(),
+            (Some(_), _) => self.gather_particles_to(crate::parallel::comm::Reach::Writer),
         };
         std::borrow::Cow::Owned(self.put_in_domain(p))
     }
@@ -527,7 +529,8 @@ impl Simulation {
     pub fn own_particles_in_domain(&self) -> (Particles, Particles) {
         let p = &self.particles;
         let solo = crate::parallel::comm::Solo;
-        let own = crate::parallel::domain::gather_by_id(&solo, p, |i| self.own(i));
+        let reach = crate::parallel::comm::Reach::Everyone;
+        let own = crate::parallel::domain::gather_by_id((&solo, reach), p, |i| self.own(i));
         (self.put_in_domain(own), self.put_in_domain(p.clone()))
     }
 

@@ -2,6 +2,7 @@
 //! (`Thermo`), over all processes of a split run.
 
 use super::*;
+use crate::parallel::comm::Reach;
 
 impl Simulation {
     /// The contact network at the current state: every touching particle pair and
@@ -9,10 +10,16 @@ impl Simulation {
     /// it now, from its current springs (left unchanged): the forces the next step applies.
     /// Pairs by (lower id, higher id), then contacts with faces by (id, face).
     pub fn contact_network(&self) -> Vec<ContactRecord> {
+        self.contact_network_to(Reach::Everyone)
+    }
+
+    /// [`Simulation::contact_network`] on the processes `reach` names (collective in a
+    /// split run); the others get none.
+    pub(crate) fn contact_network_to(&self, reach: Reach) -> Vec<ContactRecord> {
         // Each contact from the process that owns its particle (of a pair, the lower id).
         let network = self.own_contact_network();
         match &self.domain {
-            Some(d) => super::split::gather_contacts(&*d.comm, network),
+            Some(d) => super::split::gather_contacts((&*d.comm, reach), network),
             None => network,
         }
     }

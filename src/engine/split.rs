@@ -6,7 +6,7 @@
 use super::*;
 use crate::model::bodies::Body as RigidBody;
 use crate::neighbours::{Entries, Periodic};
-use crate::parallel::comm::{Comm, Reader, Writer};
+use crate::parallel::comm::{Comm, Reach, Reader, Writer};
 use crate::parallel::domain::{
     Domain, GHOST_STATE, Placement, REBALANCE, Tree, agree, gather_by_id, get_body, get_entry,
     get_particle, put_body, put_entry, put_particle,
@@ -16,8 +16,21 @@ use rustc_hash::{FxHashMap, FxHashSet};
 mod moves;
 use moves::{centre_in_box, exchange_ghosts, migrate, owner_places};
 
+/// The snapshot of the encoded pieces of every process.
+fn join_pieces(pieces: &[Vec<u8>]) -> Result<Snapshot> {
+    let pieces = pieces
+        .iter()
+        .map(|bytes| super::records::decode(bytes, Some(0)))
+        .collect::<Result<Vec<_>>>()?;
+    super::records::join(pieces)
+}
+
 /// Every process's contacts (collective), in the order of `Simulation::contact_network`.
-pub(crate) fn gather_contacts(comm: &dyn Comm, mine: Vec<ContactRecord>) -> Vec<ContactRecord> {
+/// on the processes `reach` names (the others get none).
+pub(crate) fn gather_contacts(
+    (comm, reach): (&dyn Comm, Reach),
+    mine: Vec<ContactRecord>,
+) -> Vec<ContactRecord> {
     let mut w = Writer::default();
     for c in &mine {
         w.u32(c.id);
@@ -37,7 +50,7 @@ pub(crate) fn gather_contacts(comm: &dyn Comm, mine: Vec<ContactRecord>) -> Vec<
         w.f64(c.overlap);
     }
     let mut all = Vec::new();
-    for m in comm.all_gather(w.0) {
+    for m in comm.gather_to(reach, w.0) {
         let mut r = Reader::new(&m);
         while !r.done() {
             let id = r.u32();
@@ -108,13 +121,19 @@ impl Simulation {
     pub(crate) fn snapshot_split(&self) -> Result<Snapshot> {
         let d = self.domain.as_ref().expect("a split run");
         let mine = super::records::encode(&self.snapshot_piece(), 0);
-        let pieces = d
-            .comm
-            .all_gather(mine)
-            .iter()
-            .map(|bytes| super::records::decode(bytes, Some(0)))
-            .collect::<Result<Vec<_>>>()?;
-        super::records::join(pieces)
+        join_pieces(&d.comm.all_gather(mine))
+    }
+
+    /// The snapshot of the run on the writer, `None` on the other processes of a split run
+    /// (collective), which never hold more than their own piece.
+    pub fn snapshot_for_writer(&self) -> Result<Option<Snapshot>> {
+        let Some(d) = &self.domain else {
+            return self.snapshot().map(Some);
+        };
+        let mine = super::records::encode(&self.snapshot_piece(), 0);
+        let pieces = d.comm.gather(mine);
+        let joined = (!pieces.is_empty()).then(|| join_pieces(&pieces));
+        agree(&*d.comm, joined.transpose())
     }
 
     /// This process's piece of the state of a split run: its own particles (with their
@@ -359,7 +378,7 @@ impl Simulation {
             }
         }
         let old_next = p.next_id;
-        let mut around = gather_by_id(&*d.comm, p, |i| picked[i]);
+        let mut around = gather_by_id((&*d.comm, Reach::Everyone), p, |i| picked[i]);
         self.spawner.spawn(
             s,
             &mut around,
@@ -462,10 +481,16 @@ impl Simulation {
     /// All particles of a split run, in id order, on every process (collective); this
     /// process's particles in one.
     pub fn gather_particles(&self) -> Particles {
+        self.gather_particles_to(Reach::Everyone)
+    }
+
+    /// [`Simulation::gather_particles`] on the processes `reach` names (collective); the
+    /// others get none.
+    pub(crate) fn gather_particles_to(&self, reach: Reach) -> Particles {
         let p = &self.particles;
         match &self.domain {
-            Some(d) => gather_by_id(&*d.comm, p, |i| d.owned[i]),
-            None => gather_by_id(&crate::parallel::comm::Solo, p, |_| true),
+            Some(d) => gather_by_id((&*d.comm, reach), p, |i| d.owned[i]),
+            None => gather_by_id((&crate::parallel::comm::Solo, reach), p, |_| true),
         }
     }
 

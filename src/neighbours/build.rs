@@ -117,7 +117,7 @@ impl Neighbours {
                 .map(|&o| at[o as usize])
                 .collect::<Vec<DVec3>>()
         });
-        let index = storage_index(particles);
+        let index = IdIndex::of(particles);
         let history = Histories {
             pairs: History::of_present(&index, particles.len(), pairs, true),
             faces: History::of_present(&index, particles.len(), faces_history, false),

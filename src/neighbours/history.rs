@@ -66,7 +66,7 @@ impl History {
         pairs: bool,
     ) -> Result<History, String> {
         Self::keyed(
-            &storage_index(particles),
+            &IdIndex::of(particles),
             particles.len(),
             entries,
             pairs,
@@ -75,9 +75,9 @@ impl History {
     }
 
     /// [`History::in_storage`] for `n` particles, whose storage indices by id are `index`
-    /// ([`storage_index`]), of the entries that name only them; the others are left out.
+    /// ([`IdIndex::of`]), of the entries that name only them; the others are left out.
     pub(crate) fn of_present(
-        index: &[u32],
+        index: &IdIndex,
         n: usize,
         entries: &[(u32, u32, Springs)],
         pairs: bool,
@@ -86,13 +86,13 @@ impl History {
     }
 
     pub(crate) fn keyed(
-        index: &[u32],
+        index: &IdIndex,
         n: usize,
         entries: &[(u32, u32, Springs)],
         pairs: bool,
         skip_absent: bool,
     ) -> Result<History, String> {
-        let at = |id: u32| index.get(id as usize).copied().filter(|&k| k != NONE);
+        let at = |id: u32| index.get(id);
         if !skip_absent {
             let named = |e: &(u32, u32, Springs)| [Some(e.0), pairs.then_some(e.1)];
             if let Some(id) = entries
@@ -158,13 +158,49 @@ pub struct Histories {
     pub faces: History,
 }
 
-/// The storage index of each id of `particles` (by id; [`NONE`] for ids it lacks).
-pub(crate) fn storage_index(particles: &Particles) -> Vec<u32> {
-    let mut index = vec![NONE; particles.next_id as usize];
-    for (k, &id) in particles.id.iter().enumerate() {
-        index[id as usize] = k as u32;
+/// Where each particle of a set is stored, by id: a table over all ids when the set holds
+/// most of them (a run in one process), a sorted list of its own otherwise (a process of a
+/// split run holds a few of many ids, and its memory follows what it holds, not the total).
+pub(crate) enum IdIndex {
+    /// The storage index at each id ([`NONE`] for ids the set lacks).
+    Table(Vec<u32>),
+    /// (id, storage index), by id.
+    Sorted(Vec<(u32, u32)>),
+}
+
+impl IdIndex {
+    /// A table while it takes at most about twice the memory of the sorted list.
+    fn table_pays(held: usize, ids: usize) -> bool {
+        ids <= 2 * held + 4096
     }
-    index
+
+    /// The index of the ids of `particles`.
+    pub(crate) fn of(particles: &Particles) -> IdIndex {
+        if Self::table_pays(particles.len(), particles.next_id as usize) {
+            let mut index = vec![NONE; particles.next_id as usize];
+            for (k, &id) in particles.id.iter().enumerate() {
+                index[id as usize] = k as u32;
+            }
+            return IdIndex::Table(index);
+        }
+        let mut index: Vec<(u32, u32)> = (0..particles.len() as u32)
+            .map(|k| (particles.id[k as usize], k))
+            .collect();
+        index.sort_unstable();
+        IdIndex::Sorted(index)
+    }
+
+    /// Where the particle of id `id` is stored, if the set holds it.
+    #[inline]
+    pub(crate) fn get(&self, id: u32) -> Option<u32> {
+        match self {
+            IdIndex::Table(index) => index.get(id as usize).copied().filter(|&k| k != NONE),
+            IdIndex::Sorted(index) => index
+                .binary_search_by_key(&id, |e| e.0)
+                .ok()
+                .map(|at| index[at].1),
+        }
+    }
 }
 
 /// The history of particle pairs of a list, by (lower id, higher id).

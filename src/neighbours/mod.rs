@@ -543,12 +543,43 @@ mod tests {
         let entries = [(0, 2, s(1.0)), (1, 7, s(2.0)), (2, 1, s(3.0))];
         let err = History::in_storage(&p, &entries, true).unwrap_err();
         assert!(err.contains("id 7"), "{err}");
-        let index = storage_index(&p);
+        let index = IdIndex::of(&p);
         let h = History::of_present(&index, p.len(), &entries, true);
         assert_eq!(
             h.entries(),
             vec![(0, 2, s(1.0)), (1, 2, s(3.0))],
             "the pair with 7 left out, the others keyed low to high"
+        );
+    }
+
+    #[test]
+    fn an_index_of_few_of_many_ids_is_a_sorted_list_that_finds_what_a_table_finds() {
+        let x = vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z];
+        let mut p = particles(&x, &[0.1; 4]);
+        (p.id, p.next_id) = (vec![900_000, 5, 12_345, 17], 1_000_000);
+        let sorted = IdIndex::of(&p);
+        assert!(
+            matches!(sorted, IdIndex::Sorted(_)),
+            "4 of 10^6 ids: no table"
+        );
+        p.next_id = 900_001;
+        let index = IdIndex::of(&p);
+        let table = match &index {
+            IdIndex::Sorted(list) => {
+                let mut t = vec![NONE; 900_001];
+                list.iter().for_each(|&(id, k)| t[id as usize] = k);
+                IdIndex::Table(t)
+            }
+            IdIndex::Table(_) => unreachable!("4 of 900,001 ids"),
+        };
+        for id in [0, 5, 17, 18, 12_345, 899_999, 900_000, 900_001, u32::MAX] {
+            assert_eq!(sorted.get(id), table.get(id), "id {id}");
+        }
+        assert_eq!(sorted.get(12_345), Some(2));
+        (p.id, p.next_id) = (vec![0, 1, 2, 3], 4);
+        assert!(
+            matches!(IdIndex::of(&p), IdIndex::Table(_)),
+            "all ids: a table"
         );
     }
 

@@ -10,6 +10,14 @@ use std::sync::{Arc, Barrier, Mutex};
 
 use glam::{DQuat, DVec3};
 
+/// Where a gather leaves the whole: on every process, or on the first only (the writer of
+/// the output: the others then never hold all particles).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Reach {
+    Everyone,
+    Writer,
+}
+
 /// The collective operations of a run split over `size` processes.
 pub trait Comm: Send + Sync {
     /// This process, from 0.
@@ -20,6 +28,23 @@ pub trait Comm: Send + Sync {
     fn all_to_all(&self, send: Vec<Vec<u8>>) -> Vec<Vec<u8>>;
     /// What every process contributed, by rank (on every process).
     fn all_gather(&self, data: Vec<u8>) -> Vec<Vec<u8>>;
+
+    /// What every process contributed, by rank, on the first process (the writer); nothing
+    /// on the others, which so never hold the whole.
+    fn gather(&self, data: Vec<u8>) -> Vec<Vec<u8>> {
+        let mut send = vec![Vec::new(); self.size()];
+        send[0] = data;
+        let got = self.all_to_all(send);
+        if self.rank() == 0 { got } else { Vec::new() }
+    }
+
+    /// [`Comm::all_gather`] or [`Comm::gather`], as `reach` says.
+    fn gather_to(&self, reach: Reach, data: Vec<u8>) -> Vec<Vec<u8>> {
+        match reach {
+            Reach::Everyone => self.all_gather(data),
+            Reach::Writer => self.gather(data),
+        }
+    }
 
     /// Sends each `(q, message)` of `send` to process q and receives one message from each
     /// process q of `from`, of the length given with it, in that order: messages between
@@ -452,6 +477,11 @@ mod tests {
                     let r = c.rank() as u8;
                     let got = c.all_to_all((0..3).map(|q| vec![r, q as u8]).collect());
                     let all = c.all_gather(vec![r * 10]);
+                    let first = c.gather(vec![r; 2]);
+                    match r {
+                        0 => assert_eq!(first, vec![vec![0; 2], vec![1; 2], vec![2; 2]]),
+                        _ => assert!(first.is_empty(), "only the first holds them all"),
+                    }
                     let total = c.sum_i64(&[r as i64, 1]);
                     (got, all, total, c.any(r == 2), c.max(r as f64))
                 })

@@ -41,7 +41,7 @@ use glam::DVec3;
 use crate::model::bodies::{Body, BodyId};
 use crate::model::particles::{Particle, Particles};
 use crate::model::springs::Springs;
-use crate::parallel::comm::{Comm, Reader, Writer};
+use crate::parallel::comm::{Comm, Reach, Reader, Writer};
 
 /// Past this ratio of the largest process's particle count to the mean, the boxes are cut
 /// anew at the next rebuild.
@@ -396,9 +396,10 @@ pub(crate) fn get_entry(r: &mut Reader) -> (u32, u32, Springs) {
 }
 
 /// The particles of `p` that `pick` picks (storage indices), of every process
-/// (collective), in id order; `next_id` that of `p`.
+/// (collective), in id order, on the processes `reach` names (the others get none);
+/// `next_id` that of `p`.
 pub(crate) fn gather_by_id(
-    comm: &dyn Comm,
+    (comm, reach): (&dyn Comm, Reach),
     p: &Particles,
     pick: impl Fn(usize) -> bool,
 ) -> Particles {
@@ -416,7 +417,7 @@ pub(crate) fn gather_by_id(
         .for_each(|&b| put_body(&mut w, &p.bodies.list[b]));
     let mut all: Vec<(u32, Particle)> = Vec::new();
     let mut all_bodies = Vec::new();
-    for m in comm.all_gather(w.0) {
+    for m in comm.gather_to(reach, w.0) {
         let mut r = Reader::new(&m);
         for _ in 0..r.u64() {
             all.push(get_particle(&mut r));

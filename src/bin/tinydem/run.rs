@@ -189,8 +189,10 @@ fn time_shares(summary: &Summary) -> Vec<String> {
         .iter()
         .map(|&stage| (stage.name(), times.of(stage)))
         .collect();
-    parts.push(("output", summary.output_seconds));
-    let other = summary.wall_seconds - times.total() - summary.output_seconds;
+    parts.push(("frames", summary.frame_seconds));
+    parts.push(("checkpoints", summary.checkpoint_seconds));
+    let other =
+        summary.wall_seconds - times.total() - summary.frame_seconds - summary.checkpoint_seconds;
     parts.push(("other", other.max(0.0)));
     parts
         .iter()
