@@ -811,7 +811,7 @@ fn a_run_reports_where_its_time_went() {
         .lines()
         .find(|l| l.starts_with("time: "))
         .unwrap_or_else(|| panic!("no time line in\n{err}"));
-    for stage in ["particle contacts", "integrate", "output"] {
+    for stage in ["particle contacts", "integrate", "frames"] {
         assert!(line.contains(stage), "{stage} missing from {line}");
     }
     // Quiet runs stay quiet.

@@ -333,7 +333,25 @@ fn checkpoint_on_2_resumes_on_3(
     // Resumed on 3 processes, and in one.
     let resumed = {
         let (snapshot, make) = (snapshot.clone(), make.clone());
-        split_resume(move || (make(), snapshot.clone()), then, 3)
+        let open = move |comm: Threads| {
+            let sim = Simulation::restore(make(), snapshot.clone()).unwrap();
+            sim.split(Box::new(comm)).unwrap()
+        };
+        split_resume(open, then, 3)
+    };
+    // Resumed on 3 processes from the parts, each reading its share only (the first none
+    // of the two parts, the others one each).
+    let from_shares = {
+        let (path, make, n) = (path.clone(), make.clone(), snapshot.particles.len());
+        let open = move |comm: Threads| {
+            let share = (comm.rank(), comm.size());
+            let piece = tinydem::checkpoint::load_share(&path, Some(7), share).unwrap();
+            let piece = piece.expect("a checkpoint in parts");
+            assert!(piece.particles.len() < n, "no process reads all parts");
+            let (sim, pending) = Simulation::restore_share(make(), piece).unwrap();
+            sim.split_shares_with(Box::new(comm), pending).unwrap()
+        };
+        split_resume(open, then, 3)
     };
     let mut one = Simulation::restore(make(), snapshot).unwrap();
     for _ in 0..then {
@@ -347,22 +365,24 @@ fn checkpoint_on_2_resumes_on_3(
         resumed == reference,
         "resumed on 3 processes, the run differs"
     );
+    assert!(
+        from_shares == reference,
+        "resumed on 3 processes from shares of the parts, the run differs"
+    );
 }
 
 /// A run restored from a snapshot and continued for `steps` on `k` processes.
 fn split_resume(
-    make: impl Fn() -> (Scenario, tinydem::simulation::Snapshot) + Send + Clone + 'static,
+    open: impl Fn(Threads) -> Simulation + Send + Clone + 'static,
     steps: u64,
     k: usize,
 ) -> End {
     let handles: Vec<_> = Threads::group(k)
         .into_iter()
         .map(|comm| {
-            let make = make.clone();
+            let open = open.clone();
             std::thread::spawn(move || {
-                let (scenario, snapshot) = make();
-                let sim = Simulation::restore(scenario, snapshot).unwrap();
-                let mut sim = sim.split(Box::new(comm)).unwrap();
+                let mut sim = open(comm);
                 for _ in 0..steps {
                     sim.step().unwrap();
                 }

@@ -433,6 +433,89 @@ fn frames_in_pieces_on_2_and_3_processes_are_the_gathered_frames() {
 }
 
 #[test]
+fn a_checkpoint_in_parts_of_3_processes_resumes_in_shares_on_4_2_and_1_with_the_same_bytes() {
+    // A run in pieces on 3 processes ends with its checkpoint in 3 parts; extended to more
+    // frames on 4 processes (the first reads no part, the others one each: no process
+    // reads all), on 2 and in one, the new frames are those of the run never cut. On 4,
+    // every collective goes in rounds of a few kB (MPI's 32-bit counts for big messages).
+    let dir = tempfile::tempdir().unwrap();
+    let path = silo(dir.path(), 10);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let name = path.to_str().unwrap();
+    run(1, &["run", name, "-o", "one", "-q"], dir.path());
+    let short = dir.path().join("short.toml");
+    let in_pieces = text.replace("frames = 10", "frames = 6") + "gather = \"never\"\n";
+    std::fs::write(&short, in_pieces).unwrap();
+    run(
+        3,
+        &["run", short.to_str().unwrap(), "-o", "cut", "-q"],
+        dir.path(),
+    );
+    let parts = std::fs::read_dir(dir.path().join("cut"))
+        .unwrap()
+        .filter(|e| {
+            e.as_ref()
+                .unwrap()
+                .file_name()
+                .to_string_lossy()
+                .contains(".part-")
+        })
+        .count();
+    assert_eq!(parts, 3, "the checkpoint in a part per process");
+    let copy = |to: &str| {
+        std::fs::create_dir(dir.path().join(to)).unwrap();
+        for e in std::fs::read_dir(dir.path().join("cut")).unwrap() {
+            let e = e.unwrap();
+            std::fs::copy(e.path(), dir.path().join(to).join(e.file_name())).unwrap();
+        }
+    };
+    // And the parts joined into one file by `tinydem checkpoint merge`, resumed in one.
+    copy("merged");
+    run(
+        1,
+        &["checkpoint", "merge", "merged/checkpoint.bin"],
+        dir.path(),
+    );
+    assert!(dir.path().join("merged/checkpoint.bin").exists());
+    for (out, np) in [
+        ("resumed4", 4),
+        ("resumed2", 2),
+        ("resumed1", 1),
+        ("merged", 1),
+    ] {
+        if out != "merged" {
+            copy(out);
+        }
+        let checkpoint = format!("{out}/checkpoint.bin");
+        let args = ["run", name, "-o", out, "-q", "--resume", &checkpoint];
+        let resumed = match np {
+            1 => common::tinydem(&args, dir.path()),
+            _ => {
+                let mut c = mpirun(np, &args, dir.path());
+                if np == 4 {
+                    c.env("TINYDEM_MPI_ROUND_BYTES", "4000");
+                }
+                c.output().unwrap()
+            }
+        };
+        assert!(
+            resumed.status.success(),
+            "{np}: {}",
+            String::from_utf8_lossy(&resumed.stderr)
+        );
+        for k in 7..=10 {
+            for file in [
+                format!("particles{k:06}.csv"),
+                format!("contacts{k:06}.csv"),
+            ] {
+                let read = |d: &str| std::fs::read(dir.path().join(d).join(&file)).unwrap();
+                assert!(read("one") == read(out), "{out}: {file} differs");
+            }
+        }
+    }
+}
+
+#[test]
 fn a_particle_file_of_clumps_without_ids_read_in_shares_writes_the_same_bytes() {
     // Each process reads its share of the file (none reads it all): rows without ids, so a
     // row's id is its place in the file, after the spheres of the clumps before it.

@@ -14,6 +14,7 @@ use crate::io::checkpoint;
 use crate::io::csv::{Extra, frame_name};
 use crate::io::lock::Lock;
 use crate::io::output::{claim_output, take_output};
+use crate::neighbours::Entries;
 use crate::parallel::comm::Comm;
 use crate::scenario::{Met, Scenario};
 
@@ -341,9 +342,43 @@ fn open_on(
         let sim = crate::parallel::domain::agree(&*comm, sim)?;
         return Ok((sim.split_shares(comm)?, Vec::new()));
     }
+    if let Some(path) = options.resume {
+        // Each process reads its share of a checkpoint in parts, none them all.
+        let share = resume_share(&scenario, path, &*comm);
+        let share = crate::parallel::domain::agree(&*comm, share)?;
+        let parts = share.is_some();
+        if comm.any(parts) && comm.any(!parts) {
+            anyhow::bail!(
+                "the processes found different checkpoints at {}",
+                path.display()
+            );
+        }
+        if let Some((sim, pending)) = share {
+            return Ok((sim.split_shares_with(comm, pending)?, Vec::new()));
+        }
+    }
     let opened = open(scenario, options.resume, options.from);
     let (sim, notes) = crate::parallel::domain::agree(&*comm, opened)?;
     Ok((sim.split(comm)?, notes))
+}
+
+/// This process's share of the checkpoint at `path` restored, with the springs its
+/// particles share with others' (`None` if it is one file, which every process reads).
+fn resume_share(
+    scenario: &Scenario,
+    path: &Path,
+    comm: &dyn Comm,
+) -> Result<Option<(Simulation, Entries)>> {
+    let fresh = Simulation::new(Scenario {
+        particles: None,
+        ..scenario.clone()
+    })?;
+    let fingerprint = Some(fingerprint(&fresh));
+    let share = (comm.rank(), comm.size());
+    let Some(snapshot) = checkpoint::load_share(path, fingerprint, share)? else {
+        return Ok(None);
+    };
+    Simulation::restore_share(scenario.clone(), snapshot).map(Some)
 }
 
 /// What `tinydem check` would refuse the run for (collective): an error naming it all.

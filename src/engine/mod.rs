@@ -23,8 +23,8 @@ use crate::model::motion::{Motion, Pose, RigidVelocity};
 use crate::model::particles::Particles;
 use crate::model::servo;
 use crate::neighbours::{
-    CellGrid, ContactList, FACE_PIECE, Histories, History, MIN_PARALLEL_LEN, NONE, Neighbours,
-    Store, cut, face_grid,
+    CellGrid, ContactList, Entries, FACE_PIECE, Histories, History, IdIndex, MIN_PARALLEL_LEN,
+    NONE, Neighbours, Store, cut, face_grid,
 };
 use crate::parallel::domain::Domain;
 

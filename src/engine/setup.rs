@@ -129,6 +129,30 @@ impl Simulation {
         Ok(sim)
     }
 
+    /// A process's share of a checkpoint in parts (`checkpoint::load_share`), restored as
+    /// [`Simulation::restore_from`] restores a whole one, for
+    /// [`Simulation::split_shares_with`]: with the springs of its particles' contacts with
+    /// particles of other shares beside it, for the split to send to their owners.
+    pub fn restore_share_from(
+        scenario: Scenario,
+        inputs: Inputs,
+        mut snapshot: Snapshot,
+    ) -> Result<(Simulation, Entries)> {
+        let index = IdIndex::of(&snapshot.particles);
+        let held = |id: u32| index.get(id).is_some();
+        let (pairs, pending) = std::mem::take(&mut snapshot.pair_history)
+            .into_iter()
+            .partition(|e| held(e.0) && held(e.1));
+        drop(index);
+        snapshot.pair_history = pairs;
+        let built_at = snapshot.built_at;
+        let mut sim = Simulation::restore_from(scenario, inputs, snapshot)?;
+        // A share of no particles has no anchors: its clock of the last rebuild is still
+        // that of all, for the split's rebuild to place the walls alike.
+        sim.built_at = built_at;
+        Ok((sim, (pending, Vec::new())))
+    }
+
     /// Why `snapshot` cannot continue this run, if it cannot: its counts of particles and
     /// anchors, materials, [[spawn]] regions, mesh files, outlets and faces must fit.
     fn check_same_run(&self, snapshot: &Snapshot) -> std::result::Result<(), String> {

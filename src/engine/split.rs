@@ -187,19 +187,31 @@ impl Simulation {
         let owned = (0..p.len())
             .map(|i| p.body[i].map_or(p.id[i], |b| b.first()) as usize % size == rank)
             .collect();
-        self.split_owning(comm, owned)
+        self.split_owning(comm, owned, Entries::default())
     }
 
     /// Splits a simulation of which each process of `comm` holds a share (of the initial
     /// particles, read by `io::inputs::read_share`), none twice: each starts as the owner
     /// of what it holds, and from then on they step together.
     pub fn split_shares(self, comm: Box<dyn Comm>) -> Result<Simulation> {
+        self.split_shares_with(comm, Entries::default())
+    }
+
+    /// [`Simulation::split_shares`] of a share of a checkpoint's parts
+    /// (`Simulation::restore_share`), with the springs of its particles' contacts with
+    /// particles of other shares (`pending`), which go to the owners with the particles.
+    pub fn split_shares_with(self, comm: Box<dyn Comm>, pending: Entries) -> Result<Simulation> {
         let owned = vec![true; self.particles.len()];
-        self.split_owning(comm, owned)
+        self.split_owning(comm, owned, pending)
     }
 
     /// Splits this simulation, this process owning the particles `owned` says at first.
-    fn split_owning(mut self, comm: Box<dyn Comm>, owned: Vec<bool>) -> Result<Simulation> {
+    fn split_owning(
+        mut self,
+        comm: Box<dyn Comm>,
+        owned: Vec<bool>,
+        pending: Entries,
+    ) -> Result<Simulation> {
         self.domain = Some(Domain {
             comm,
             tree: None,
@@ -208,7 +220,7 @@ impl Simulation {
             recv: Vec::new(),
             cuts: 0,
         });
-        self.redistribute(&FxHashSet::default(), Placement::Anchors);
+        self.redistribute_with(&FxHashSet::default(), Placement::Anchors, pending);
         Ok(self)
     }
 
@@ -247,6 +259,12 @@ impl Simulation {
     /// anew when out of balance) with the springs of their contacts, then the ghosts each
     /// process needs, then the lists; all at the particles' places of `placement`.
     pub(crate) fn redistribute(&mut self, gone: &FxHashSet<u32>, placement: Placement) {
+        self.redistribute_with(gone, placement, Entries::default());
+    }
+
+    /// [`Simulation::redistribute`], with springs beside the lists' (`pending`: of contacts
+    /// with particles this process does not hold) carried to their owners too.
+    fn redistribute_with(&mut self, gone: &FxHashSet<u32>, placement: Placement, pending: Entries) {
         // The anchors of the run in one process, if its lists were built: there the lists
         // are built again, with the mesh and sheared images where they were then, as a
         // checkpoint restores them.
@@ -272,7 +290,9 @@ impl Simulation {
         }
         let mut d = self.domain.take().expect("a split run");
         // The old lists and particles go as soon as what they hold is out.
-        let springs = self.neighbours.entries_by_id(&self.particles.id);
+        let mut springs = self.neighbours.entries_by_id(&self.particles.id);
+        springs.0.extend(pending.0);
+        springs.1.extend(pending.1);
         self.neighbours.clear_lists();
         let old = std::mem::take(&mut self.particles);
         let periodic = self.neighbours.periodic;

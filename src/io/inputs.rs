@@ -13,6 +13,7 @@ use crate::engine::setup::Inputs;
 use crate::geometry::mesh::Mesh;
 use crate::io::{csv, files};
 use crate::model::particles::{Particle, Particles};
+use crate::neighbours::Entries;
 use crate::parallel::comm::{Comm, Reader};
 use crate::parallel::domain::agree;
 use crate::scenario::{ClumpTemplate, MeshInput, MeshSource, Scenario};
@@ -224,6 +225,16 @@ impl Simulation {
             particles: Particles::default(),
         };
         Simulation::restore_from(scenario, inputs, snapshot)
+    }
+
+    /// A process's share of a checkpoint in parts, with the meshes of `scenario` read: see
+    /// [`Simulation::restore_share_from`].
+    pub fn restore_share(scenario: Scenario, snapshot: Snapshot) -> Result<(Simulation, Entries)> {
+        let inputs = Inputs {
+            meshes: meshes(&scenario)?,
+            particles: Particles::default(),
+        };
+        Simulation::restore_share_from(scenario, inputs, snapshot)
     }
 
     /// Starts a new stage of a study from the snapshot of another run, with the meshes of

@@ -250,6 +250,28 @@ mod over_mpi {
         }
     }
 
+    /// The most bytes one call of a collective moves into or out of a process: MPI's counts
+    /// and offsets are 32-bit, so longer messages (a gathered frame of 10^7 particles is
+    /// 2.2 GB) go in rounds, each message `chunk` bytes at a time.
+    /// (`TINYDEM_MPI_ROUND_BYTES` sets it smaller, for the tests of the rounds.)
+    const ROUND: usize = 1 << 30;
+
+    /// The bytes of each message in a round, with `size` processes.
+    fn chunk(size: usize) -> usize {
+        static ROUND_BYTES: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+        let round = ROUND_BYTES.get_or_init(|| {
+            let set = std::env::var("TINYDEM_MPI_ROUND_BYTES").ok();
+            set.and_then(|b| b.parse().ok()).unwrap_or(ROUND).min(ROUND)
+        });
+        (round / size).max(1)
+    }
+
+    /// The bytes of a message of `len` that round `round` moves, `chunk` at a time.
+    fn slice(len: u64, round: usize, chunk: usize) -> std::ops::Range<usize> {
+        let len = len as usize;
+        (round * chunk).min(len)..((round + 1) * chunk).min(len)
+    }
+
     /// The offsets of consecutive pieces of `counts` bytes.
     fn offsets(counts: &[mpi::Count]) -> Vec<mpi::Count> {
         counts
@@ -262,17 +284,13 @@ mod over_mpi {
             .collect()
     }
 
-    /// `buf` cut into pieces of `counts` bytes.
-    fn pieces(buf: &[u8], counts: &[mpi::Count]) -> Vec<Vec<u8>> {
+    /// `buf`, cut into consecutive pieces of `counts` bytes, appended to `got`'s.
+    fn append(got: &mut [Vec<u8>], buf: &[u8], counts: &[mpi::Count]) {
         let mut at = 0;
-        counts
-            .iter()
-            .map(|&c| {
-                let piece = buf[at..at + c as usize].to_vec();
-                at += c as usize;
-                piece
-            })
-            .collect()
+        for (g, &c) in got.iter_mut().zip(counts) {
+            g.extend_from_slice(&buf[at..at + c as usize]);
+            at += c as usize;
+        }
     }
 
     /// `len` zero bytes in a real allocation: an empty `Vec`'s pointer is 1, which OpenMPI
@@ -301,18 +319,39 @@ mod over_mpi {
             self.world.size() as usize
         }
         fn all_to_all(&self, send: Vec<Vec<u8>>) -> Vec<Vec<u8>> {
-            let counts: Vec<mpi::Count> = send.iter().map(|m| count(m.len())).collect();
-            let mut from = vec![0 as mpi::Count; self.size()];
-            self.world.all_to_all_into(&counts[..], &mut from[..]);
-            let flat = allocated(send.concat());
-            let mut buf = zeros(from.iter().map(|&c| c as usize).sum());
-            {
-                let out = Partition::new(&flat[..], &counts[..], offsets(&counts));
-                let into_offsets = offsets(&from);
-                let mut into = PartitionMut::new(&mut buf[..], &from[..], into_offsets);
-                self.world.all_to_all_varcount_into(&out, &mut into);
+            let lens: Vec<u64> = send.iter().map(|m| m.len() as u64).collect();
+            let mut from = vec![0u64; self.size()];
+            self.world.all_to_all_into(&lens[..], &mut from[..]);
+            let chunk = chunk(self.size());
+            let longest = lens.iter().chain(&from).copied().max().unwrap_or(0);
+            let mut rounds = 0u64;
+            self.world.all_reduce_into(
+                &longest.div_ceil(chunk as u64).max(1),
+                &mut rounds,
+                SystemOperation::max(),
+            );
+            let mut got: Vec<Vec<u8>> = from
+                .iter()
+                .map(|&n| Vec::with_capacity(n as usize))
+                .collect();
+            for round in 0..rounds as usize {
+                let part = |m: &[u8]| slice(m.len() as u64, round, chunk);
+                let counts: Vec<mpi::Count> = send.iter().map(|m| count(part(m).len())).collect();
+                let into: Vec<mpi::Count> = from
+                    .iter()
+                    .map(|&n| count(slice(n, round, chunk).len()))
+                    .collect();
+                let flat = allocated(send.iter().flat_map(|m| &m[part(m)]).copied().collect());
+                let mut buf = zeros(into.iter().map(|&c| c as usize).sum());
+                {
+                    let out = Partition::new(&flat[..], &counts[..], offsets(&counts));
+                    let into_offsets = offsets(&into);
+                    let mut into = PartitionMut::new(&mut buf[..], &into[..], into_offsets);
+                    self.world.all_to_all_varcount_into(&out, &mut into);
+                }
+                append(&mut got, &buf, &into);
             }
-            pieces(&buf, &from)
+            got
         }
         fn exchange(&self, send: Vec<(usize, Vec<u8>)>, from: &[(usize, usize)]) -> Vec<Vec<u8>> {
             let rank = |q: usize| self.world.process_at_rank(q as mpi::Rank);
@@ -362,17 +401,31 @@ mod over_mpi {
             total
         }
         fn all_gather(&self, data: Vec<u8>) -> Vec<Vec<u8>> {
-            let mut counts = vec![0 as mpi::Count; self.size()];
+            let mut lens = vec![0u64; self.size()];
             self.world
-                .all_gather_into(&count(data.len()), &mut counts[..]);
-            let mut buf = zeros(counts.iter().map(|&c| c as usize).sum());
-            let data = allocated(data);
-            {
-                let at = offsets(&counts);
-                let mut into = PartitionMut::new(&mut buf[..], &counts[..], at);
-                self.world.all_gather_varcount_into(&data[..], &mut into);
+                .all_gather_into(&(data.len() as u64), &mut lens[..]);
+            let chunk = chunk(self.size());
+            let longest = lens.iter().copied().max().unwrap_or(0);
+            let rounds = longest.div_ceil(chunk as u64).max(1) as usize;
+            let mut got: Vec<Vec<u8>> = lens
+                .iter()
+                .map(|&n| Vec::with_capacity(n as usize))
+                .collect();
+            for round in 0..rounds {
+                let counts: Vec<mpi::Count> = lens
+                    .iter()
+                    .map(|&n| count(slice(n, round, chunk).len()))
+                    .collect();
+                let mine = allocated(data[slice(data.len() as u64, round, chunk)].to_vec());
+                let mut buf = zeros(counts.iter().map(|&c| c as usize).sum());
+                {
+                    let at = offsets(&counts);
+                    let mut into = PartitionMut::new(&mut buf[..], &counts[..], at);
+                    self.world.all_gather_varcount_into(&mine[..], &mut into);
+                }
+                append(&mut got, &buf, &counts);
             }
-            pieces(&buf, &counts)
+            got
         }
     }
 }

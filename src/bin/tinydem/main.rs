@@ -56,9 +56,35 @@ enum Command {
     /// Draw columns of a CSV table (log.csv, walls.csv, analyze --csv) against one of them,
     /// as SVG or PNG: a legend, units, log axes.
     Plot(plot::PlotArgs),
+    /// Checkpoints: `merge` joins the parts a split run wrote (`checkpoint.bin.STEP.part-K-of-N`)
+    /// into the one file.
+    #[command(subcommand)]
+    Checkpoint(CheckpointCommand),
     /// The dense-packing benchmark of the paper's Section 5: timed steps in settled
     /// packings; each size and thread count runs in its own process.
     Bench(bench::BenchArgs),
+}
+
+#[derive(Subcommand)]
+enum CheckpointCommand {
+    /// Join the newest complete set of parts of a checkpoint into the one file (as a run in
+    /// one process writes it) and remove the parts.
+    Merge {
+        /// The checkpoint, e.g. output/checkpoint.bin (its parts are beside it).
+        checkpoint: PathBuf,
+    },
+}
+
+impl CheckpointCommand {
+    fn execute(self) -> Result<()> {
+        match self {
+            CheckpointCommand::Merge { checkpoint } => {
+                let n = tinydem::checkpoint::merge(&checkpoint)?;
+                eprintln!("joined {n} parts into {}", checkpoint.display());
+                Ok(())
+            }
+        }
+    }
 }
 
 #[derive(Args)]
@@ -203,6 +229,7 @@ fn execute(
         Some(Command::Analyze(args)) => args.execute(),
         Some(Command::Plot(args)) => args.execute(),
         Some(Command::Check(args)) => args.execute(),
+        Some(Command::Checkpoint(c)) => c.execute(),
     }
 }
 

@@ -163,7 +163,8 @@ impl Destinations {
                 .collect();
         let tree = d.tree.as_ref().expect("cut");
         let owner = |id: u32| tree.owner(place[index[&id] as usize]);
-        let mine = |id: u32| d.owned[index[&id] as usize];
+        // (A share of a checkpoint's parts has springs of particles it does not hold.)
+        let mine = |id: u32| index.get(&id).is_some_and(|&i| d.owned[i as usize]);
         let mut to = Destinations {
             particles: vec![Vec::new(); k],
             bodies: vec![Vec::new(); k],

@@ -12,7 +12,9 @@ use crate::scenario::{FrictionSprings, Scenario};
 use anyhow::{Context, Result};
 
 pub mod parts;
-pub use parts::{is_part, load_parts, newer_parts, part_path, remove_parts, save_part};
+pub use parts::{
+    is_part, load_parts, load_share, merge, newer_parts, part_path, remove_parts, save_part,
+};
 
 /// A fingerprint of everything a checkpoint's state depends on: the physics, time step,
 /// spawning and mesh. The number of frames and the output may change on resume.

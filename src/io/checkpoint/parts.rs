@@ -20,6 +20,7 @@ use anyhow::{Context, Result, bail, ensure};
 
 use super::{decode, encode_into, join};
 use crate::engine::records::Snapshot;
+use crate::model::particles::Particles;
 
 const MAGIC: &[u8; 12] = b"TINYDEM PART";
 /// The bytes before a part's checkpoint.
@@ -168,24 +169,86 @@ pub fn missing_parts(path: &Path) -> Option<String> {
 
 /// Reads and joins the parts `paths` (part 0 to n-1 of one checkpoint).
 pub fn load_parts(paths: &[PathBuf], fingerprint: Option<u64>) -> Result<Snapshot> {
-    let n = paths.len();
-    let pieces = paths
-        .iter()
-        .enumerate()
-        .map(|(k, path)| {
-            let bytes = crate::io::files::read(path)?;
-            read_part(&bytes, k, n, fingerprint)
-                .and_then(|piece| of_its_step(path, &piece).map(|()| piece))
-                .with_context(|| format!("cannot resume from {}", path.display()))
-        })
+    join_parts(paths, 0..paths.len(), fingerprint)
+}
+
+/// Reads part `k` of the parts `paths` of one checkpoint.
+fn read_nth(paths: &[PathBuf], k: usize, fingerprint: Option<u64>) -> Result<Snapshot> {
+    let bytes = crate::io::files::read(&paths[k])?;
+    read_part(&bytes, k, paths.len(), fingerprint)
+        .and_then(|piece| of_its_step(&paths[k], &piece).map(|()| piece))
+        .with_context(|| format!("cannot resume from {}", paths[k].display()))
+}
+
+/// Reads and joins the parts `which` (not empty) of the parts `paths` of one checkpoint.
+fn join_parts(
+    paths: &[PathBuf],
+    which: std::ops::Range<usize>,
+    fingerprint: Option<u64>,
+) -> Result<Snapshot> {
+    let (first, last) = (which.start, which.end - 1);
+    let pieces = which
+        .map(|k| read_nth(paths, k, fingerprint))
         .collect::<Result<Vec<_>>>()?;
     join(pieces).with_context(|| {
         format!(
             "cannot join the parts {} to {}",
-            paths[0].display(),
-            paths[n - 1].display()
+            paths[first].display(),
+            paths[last].display()
         )
     })
+}
+
+/// Joins the newest complete set of parts of the checkpoint at `path` into the one file a
+/// run in one process writes (with the parts' fingerprint), removing the parts; returns how
+/// many it joined.
+pub fn merge(path: &Path) -> Result<usize> {
+    let Some(paths) = newer_parts(path) else {
+        let lacking = missing_parts(path).map_or(String::new(), |m| format!(" ({m} missing)"));
+        bail!(
+            "{}: no complete set of parts newer than the file to join{lacking}",
+            path.display()
+        );
+    };
+    let mut head = [0; HEADER + STEP_AT];
+    crate::io::files::open(&paths[0])?
+        .read_exact(&mut head)
+        .with_context(|| format!("cannot read {}", paths[0].display()))?;
+    let fingerprint = u64::from_le_bytes(head[HEADER + STEP_AT - 8..].try_into()?);
+    let joined = load_parts(&paths, Some(fingerprint))?;
+    super::save(path, &joined, fingerprint)?;
+    Ok(paths.len())
+}
+
+/// Process `j` of `count`'s share of the checkpoint at `path` when it is a set of parts
+/// ([`newer_parts`]; `None` when it is one file): the parts `j n / count .. (j+1) n / count`
+/// of the n, joined, so that no process reads all. A share of no part holds no particles
+/// and the state all processes share (from the first part). Its springs name particles of
+/// other shares too: a split run's redistribution sends them to their owners.
+pub fn load_share(
+    path: &Path,
+    fingerprint: Option<u64>,
+    (j, count): (usize, usize),
+) -> Result<Option<Snapshot>> {
+    let Some(paths) = newer_parts(path) else {
+        return Ok(None);
+    };
+    let n = paths.len();
+    let share = j * n / count..(j + 1) * n / count;
+    if !share.is_empty() {
+        return join_parts(&paths, share, fingerprint).map(Some);
+    }
+    let first = read_nth(&paths, 0, fingerprint)?;
+    Ok(Some(Snapshot {
+        particles: Particles {
+            next_id: first.particles.next_id,
+            ..Particles::default()
+        },
+        anchors: Vec::new(),
+        pair_history: Vec::new(),
+        face_history: Vec::new(),
+        ..first
+    }))
 }
 
 fn read_part(bytes: &[u8], k: usize, n: usize, fingerprint: Option<u64>) -> Result<Snapshot> {
@@ -221,7 +284,6 @@ fn of_its_step(path: &Path, piece: &Snapshot) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::particles::Particles;
 
     /// Two pieces of one state (particles 3 and 4, their contact in both) and their join.
     fn pieces() -> (Vec<Snapshot>, Snapshot) {
@@ -313,6 +375,64 @@ mod tests {
             .map(|e| e.unwrap().file_name().into_string().unwrap())
             .collect();
         assert_eq!(names, ["checkpoint.bin"]);
+    }
+
+    #[test]
+    fn shares_of_the_parts_hold_each_part_once_and_a_damaged_one_is_named() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("checkpoint.bin");
+        let (pieces, whole) = pieces();
+        assert!(load_share(&path, Some(7), (0, 1)).unwrap().is_none());
+        super::super::save(&path, &whole, 7).unwrap();
+        assert!(
+            load_share(&path, Some(7), (0, 2)).unwrap().is_none(),
+            "one file"
+        );
+        save_part(&path, 0, 2, &pieces[0], 7).unwrap();
+        save_part(&path, 1, 2, &pieces[1], 7).unwrap();
+        std::fs::remove_file(&path).unwrap();
+        let share = |j, count| load_share(&path, Some(7), (j, count)).unwrap().unwrap();
+        assert_eq!(share(0, 1), whole, "one share: all parts");
+        for count in [2, 3] {
+            let shares: Vec<Snapshot> = (0..count).map(|j| share(j, count)).collect();
+            let ids: Vec<u32> = shares.iter().flat_map(|s| s.particles.id.clone()).collect();
+            assert_eq!(ids, [4, 3], "{count} shares: each part once, in order");
+            for s in &shares {
+                assert_eq!(
+                    (s.steps, &s.spawner, &s.removed),
+                    (whole.steps, &whole.spawner, &whole.removed)
+                );
+                assert_eq!(s.anchors.len(), s.particles.len());
+            }
+        }
+        // Of 3 shares of 2 parts the first holds none; the contact of 3 and 4 is in both.
+        assert!(share(0, 3).pair_history.is_empty() && share(0, 3).particles.is_empty());
+        assert_eq!(share(1, 3).pair_history, share(2, 3).pair_history);
+        let part = part_path(&path, whole.steps, 1, 2);
+        let mut bytes = std::fs::read(&part).unwrap();
+        bytes[60] ^= 1;
+        std::fs::write(&part, &bytes).unwrap();
+        let e = format!("{:#}", load_share(&path, Some(7), (1, 2)).unwrap_err());
+        assert!(e.contains(".part-1-of-2") && e.contains("checksum"), "{e}");
+        assert!(
+            load_share(&path, Some(7), (0, 2)).is_ok(),
+            "the other share reads"
+        );
+    }
+
+    #[test]
+    fn merge_joins_the_parts_into_the_one_file_with_their_fingerprint() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("checkpoint.bin");
+        let (pieces, whole) = pieces();
+        save_part(&path, 0, 2, &pieces[0], 7).unwrap();
+        let e = format!("{:#}", merge(&path).unwrap_err());
+        assert!(e.contains("part-1-of-2 missing"), "{e}");
+        save_part(&path, 1, 2, &pieces[1], 7).unwrap();
+        assert_eq!(merge(&path).unwrap(), 2);
+        assert!(newer_parts(&path).is_none() && parts_beside(&path, "checkpoint.bin").is_empty());
+        assert_eq!(super::super::load(&path, Some(7)).unwrap(), whole);
+        assert!(merge(&path).is_err(), "nothing newer than the file to join");
     }
 
     #[test]
