@@ -12,11 +12,11 @@ use tinydem::scenario::Scenario;
 use tinydem::simulation::{Simulation, Wrench};
 
 /// Each particle's id with the bits of its state, in id order.
-fn state_by_id(sim: &Simulation) -> Vec<(u32, Vec<u64>)> {
+fn state_by_id(sim: &Simulation) -> Vec<(u64, Vec<u64>)> {
     bits_by_id(&sim.particles)
 }
 
-fn bits_by_id(particles: &Particles) -> Vec<(u32, Vec<u64>)> {
+fn bits_by_id(particles: &Particles) -> Vec<(u64, Vec<u64>)> {
     particles
         .iter_by_id()
         .map(|(id, p)| {
@@ -36,9 +36,9 @@ fn bits_by_id(particles: &Particles) -> Vec<(u32, Vec<u64>)> {
 /// since the start, the particles removed and the energy.
 #[derive(Debug, PartialEq)]
 struct End {
-    particles: Vec<(u32, Vec<u64>)>,
+    particles: Vec<(u64, Vec<u64>)>,
     /// Each rigid body's id with the bits of its x, v, q, w.
-    bodies: Vec<(u32, Vec<u64>)>,
+    bodies: Vec<(u64, Vec<u64>)>,
     walls: Vec<[u64; 6]>,
     removed: u64,
     kinetic_energy: u64,

@@ -41,12 +41,12 @@ fn removal_keeps_ids_unique_and_conserves_the_count() {
          [[outlets]]\nmin = [-1.0, -1.0, -0.03]\nmax = [0.0, 1.0, -0.02]\n",
         0,
     );
-    let mut mass: BTreeMap<u32, f64> = BTreeMap::new();
-    let mut gone: BTreeSet<u32> = BTreeSet::new();
+    let mut mass: BTreeMap<u64, f64> = BTreeMap::new();
+    let mut gone: BTreeSet<u64> = BTreeSet::new();
     for step in 0..3000 {
         sim.step().unwrap();
         let p = &sim.particles;
-        let ids: BTreeSet<u32> = p.id.iter().copied().collect();
+        let ids: BTreeSet<u64> = p.id.iter().copied().collect();
         assert_eq!(ids.len(), p.len(), "step {step}: ids repeat");
         assert!(
             ids.is_disjoint(&gone),
@@ -54,7 +54,7 @@ fn removal_keeps_ids_unique_and_conserves_the_count() {
         );
         assert_eq!(
             p.len() as u64 + sim.removed.count(),
-            p.next_id as u64,
+            p.next_id,
             "step {step}: inside + removed != created"
         );
         for (k, &id) in p.id.iter().enumerate() {
@@ -306,7 +306,7 @@ fn the_contact_network_of_a_settled_bed_balances_every_grain() {
     let sim = settled_bed(14_000);
     let network = sim.contact_network();
     let p = &sim.particles;
-    let at = |id: u32| p.id.iter().position(|&k| k == id).unwrap();
+    let at = |id: u64| p.id.iter().position(|&k| k == id).unwrap();
     let mut net = vec![DVec3::ZERO; p.len()];
     let mut from_faces = DVec3::ZERO;
     let (mut pairs, mut faces) = (0, 0);
@@ -322,8 +322,8 @@ fn the_contact_network_of_a_settled_bed_balances_every_grain() {
         );
         match c.with {
             Partner::Particle(j) => {
-                assert!((j as u32) > c.id, "a pair is listed under its lower id");
-                net[at(j as u32)] -= f;
+                assert!(j > c.id, "a pair is listed under its lower id");
+                net[at(j)] -= f;
                 pairs += 1;
             }
             Partner::Face(_) => {
@@ -348,4 +348,82 @@ fn the_contact_network_of_a_settled_bed_balances_every_grain() {
             p.id[k]
         );
     }
+}
+
+/// Ids past 2^32 (a long insertion run's, or a file's) round-trip: read from a particle
+/// file, written in every frame, kept with their springs in the checkpoint, and a run
+/// resumed from it writes the frames of the run never cut.
+#[test]
+fn ids_beyond_2_to_the_32_round_trip_through_frames_and_checkpoints() {
+    let dir = tempfile::tempdir().unwrap();
+    let ids: [u64; 3] = [5_000_000_000, 5_000_000_007, 1 << 40];
+    // Two grains touching as they fall (their springs by those ids), one apart.
+    let rows = [(0.0, 0.0099), (0.0, 0.0), (0.05, 0.0)];
+    let mut csv = String::from("x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz,id\n");
+    for ((x, y), id) in rows.iter().zip(ids) {
+        csv += &format!("{x},{y},0,0.005,0.1,0,0,1,0,0,0,0,0,5,{id}\n");
+    }
+    std::fs::write(dir.path().join("grains.csv"), csv).unwrap();
+    let scenario = |frames: u32| {
+        format!(
+            "[material]\nfriction_sliding = 0.5\nfriction_rolling = 0.1\n\
+             [simulation]\nmax_particles = 0\nspawn_attempts = 0\nframes = {frames}\nsteps_per_frame = 100\n\
+             [input]\nparticles = \"grains.csv\"\n"
+        )
+    };
+    std::fs::write(dir.path().join("s2.toml"), scenario(2)).unwrap();
+    std::fs::write(dir.path().join("s4.toml"), scenario(4)).unwrap();
+    let run = |args: &[&str]| {
+        let out = common::tinydem(args, dir.path());
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    run(&["run", "s4.toml", "-o", "whole", "-q"]);
+    run(&["run", "s2.toml", "-o", "cut", "-q"]);
+    run(&[
+        "run",
+        "s4.toml",
+        "-o",
+        "cut",
+        "-q",
+        "--resume",
+        "cut/checkpoint.bin",
+    ]);
+    let read =
+        |d: &str| std::fs::read_to_string(dir.path().join(d).join("particles000004.csv")).unwrap();
+    let frame = read("whole");
+    assert_eq!(
+        read("cut"),
+        frame,
+        "resumed from the checkpoint, the run differs"
+    );
+    let header = frame.lines().next().unwrap();
+    let at = header
+        .split(',')
+        .position(|c| c == "id")
+        .expect("an id column");
+    let written: Vec<u64> = frame
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(at).unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(written, ids);
+    // A checkpoint after one step holds the touching pair's springs under those ids.
+    let one_step = scenario(1).replace("steps_per_frame = 100", "steps_per_frame = 1");
+    std::fs::write(dir.path().join("s1.toml"), one_step).unwrap();
+    run(&["run", "s1.toml", "-o", "step", "-q"]);
+    let snapshot =
+        tinydem::checkpoint::load(&dir.path().join("step/checkpoint.bin"), None).unwrap();
+    assert_eq!(snapshot.particles.next_id, (1 << 40) + 1);
+    assert!(
+        snapshot
+            .pair_history
+            .iter()
+            .any(|e| (e.0, e.1) == (ids[0], ids[1])),
+        "{:?}",
+        snapshot.pair_history
+    );
 }

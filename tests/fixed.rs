@@ -115,7 +115,7 @@ fn a_box_a_column_and_fix_particles_give_the_same_bits() {
     let by_column = settle(Simulation::from_parts(s, Mesh::default(), read).unwrap());
     // Fixed from outside, before the first step.
     let mut s = sim("", grains.clone());
-    s.fix_particles(&(0..FLOOR as u32).collect::<Vec<u32>>(), true)
+    s.fix_particles(&(0..FLOOR as u64).collect::<Vec<u64>>(), true)
         .unwrap();
     assert!(
         s.fix_particles(&[99], true)

@@ -371,7 +371,7 @@ impl Simulation {
             .sim
             .add_particles(&new)
             .map_err(|e| PyValueError::new_err(format!("material: {e:#}")))?;
-        Ok(Array1::from_iter(ids.into_iter().map(i64::from)).into_pyarray(py))
+        Ok(Array1::from_iter(ids.into_iter().map(|id| id as i64)).into_pyarray(py))
     }
 
     /// Removes the particles of `ids` (an array-like of ids), with the springs of their
@@ -558,12 +558,12 @@ fn _tinydem(m: &Bound<'_, PyModule>) -> PyResult<()> {
     Ok(())
 }
 
-/// Particle ids from Python: whole numbers from 0 to 2^32 - 1.
-fn ids_of(ids: PyArrayLike1<'_, i64, AllowTypeChange>) -> PyResult<Vec<u32>> {
+/// Particle ids from Python: whole numbers from 0 (64-bit, as numpy's int64 holds them).
+fn ids_of(ids: PyArrayLike1<'_, i64, AllowTypeChange>) -> PyResult<Vec<u64>> {
     ids.as_array()
         .iter()
         .map(|&id| {
-            u32::try_from(id).map_err(|_| PyValueError::new_err(format!("ids: {id} is no id")))
+            u64::try_from(id).map_err(|_| PyValueError::new_err(format!("ids: {id} is no id")))
         })
         .collect()
 }

@@ -111,7 +111,7 @@ impl Simulation {
         {
             told.push((
                 1,
-                p.id[k] as u64,
+                p.id[k],
                 0,
                 format!(
                     "particle {} has a non-finite state (x = {}, v = {}, w = {})",
@@ -124,10 +124,11 @@ impl Simulation {
         for d in deep.iter().take(5) {
             let (a, other) = d.key(&p.id);
             let b = match other {
-                Partner::Particle(j) => j as u64,
-                Partner::Face(f) => (1 << 40) | f as u64,
+                Partner::Particle(j) => j,
+                // (Faces after every particle: ids stay below 2^62.)
+                Partner::Face(f) => (1 << 63) | f as u64,
             };
-            told.push((2, a as u64, b, d.describe(&p.id)));
+            told.push((2, a, b, d.describe(&p.id)));
         }
         told
     }

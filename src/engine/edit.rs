@@ -12,7 +12,7 @@ impl Simulation {
 
     /// Adds `new` particles with the next ids (returned); the lists take them in at the
     /// next step. Their materials must be the scenario's.
-    pub fn add_particles(&mut self, new: &[crate::model::particles::Particle]) -> Result<Vec<u32>> {
+    pub fn add_particles(&mut self, new: &[crate::model::particles::Particle]) -> Result<Vec<Id>> {
         self.refuse_split("add particles")?;
         let n = self.scenario.materials.len();
         if let Some(p) = new.iter().find(|p| p.material as usize >= n) {
@@ -39,7 +39,7 @@ impl Simulation {
         template: usize,
         scale: f64,
         (x, q, v, w): (DVec3, glam::DQuat, DVec3, DVec3),
-    ) -> Result<u32> {
+    ) -> Result<Id> {
         self.refuse_split("add clumps")?;
         let Some(t) = self.scenario.clumps.get(template) else {
             bail!(
@@ -64,7 +64,7 @@ impl Simulation {
 
     /// Removes the particles of `ids` (each must be present) and the springs of their
     /// contacts; the others keep theirs. Not counted as outflow.
-    pub fn remove_particles(&mut self, ids: &[u32]) -> Result<()> {
+    pub fn remove_particles(&mut self, ids: &[Id]) -> Result<()> {
         self.refuse_split("remove particles")?;
         let mut gone = self.stored_at(ids)?;
         // A sphere of a clump takes its whole body with it.
@@ -84,7 +84,7 @@ impl Simulation {
     /// Fixes the particles of `ids` (each must be present): from the next step they stay
     /// where they are, at rest; or, with `fixed` false, lets them move again. A sphere of a
     /// clump fixes (or frees) its clump whole.
-    pub fn fix_particles(&mut self, ids: &[u32], fixed: bool) -> Result<()> {
+    pub fn fix_particles(&mut self, ids: &[Id], fixed: bool) -> Result<()> {
         self.refuse_split("fix particles")?;
         let mut at = self.stored_at(ids)?;
         let p = &mut self.particles;
@@ -121,8 +121,8 @@ impl Simulation {
     }
 
     /// The storage index of each particle of `ids` (each must be present).
-    fn stored_at(&self, ids: &[u32]) -> Result<Vec<u32>> {
-        let at: rustc_hash::FxHashMap<u32, u32> = (self.particles.id.iter().enumerate())
+    fn stored_at(&self, ids: &[Id]) -> Result<Vec<u32>> {
+        let at: rustc_hash::FxHashMap<Id, u32> = (self.particles.id.iter().enumerate())
             .map(|(k, &id)| (id, k as u32))
             .collect();
         ids.iter()

@@ -20,11 +20,11 @@ use crate::model::exact::{Scale, Scales8, Sum6, pack};
 use crate::model::integrate::{Density, Inertia, Response, State, advance};
 use crate::model::lanes::{Gather, Lanes};
 use crate::model::motion::{Motion, Pose, RigidVelocity};
-use crate::model::particles::Particles;
+use crate::model::particles::{Id, Particles};
 use crate::model::servo;
 use crate::neighbours::{
-    CellGrid, ContactList, Entries, FACE_PIECE, Histories, History, IdIndex, MIN_PARALLEL_LEN,
-    NONE, Neighbours, Store, cut, face_grid,
+    CellGrid, ContactList, Entries, Entry, FACE_PIECE, Histories, History, IdIndex,
+    MIN_PARALLEL_LEN, NONE, Neighbours, Store, cut, face_grid,
 };
 use crate::parallel::domain::Domain;
 
@@ -277,6 +277,7 @@ impl StageTimes {
 /// a warning; deeper than twice that, a sign of instability.
 #[derive(Clone, Copy, Debug)]
 pub struct Deep {
+    /// The particle's storage index, and its partner's (not its id) or the face.
     i: usize,
     other: Partner,
     delta: f64,
@@ -292,7 +293,7 @@ impl Deep {
 
     /// "particles 1 and 2 overlap by ..., more than the smaller radius ..." (or diameter),
     /// naming the particles by their `ids`.
-    fn describe(&self, ids: &[u32]) -> String {
+    fn describe(&self, ids: &[Id]) -> String {
         let (bound, size) = if self.through() {
             ("diameter", 2.0 * self.limit)
         } else {
@@ -301,7 +302,8 @@ impl Deep {
         let i = ids[self.i];
         match self.other {
             Partner::Particle(j) => {
-                let (a, b) = (i.min(ids[j]), i.max(ids[j]));
+                let j = ids[j as usize];
+                let (a, b) = (i.min(j), i.max(j));
                 format!(
                     "particles {a} and {b} overlap by {:.3e} m, more than the smaller {bound} {size:.3e} m",
                     self.delta
@@ -315,10 +317,13 @@ impl Deep {
     }
 
     /// The pair in ids, the same whatever the storage order.
-    fn key(&self, ids: &[u32]) -> (u32, Partner) {
+    fn key(&self, ids: &[Id]) -> (Id, Partner) {
         let i = ids[self.i];
         match self.other {
-            Partner::Particle(j) => (i.min(ids[j]), Partner::Particle(i.max(ids[j]) as usize)),
+            Partner::Particle(j) => {
+                let j = ids[j as usize];
+                (i.min(j), Partner::Particle(i.max(j)))
+            }
             face => (i, face),
         }
     }
@@ -329,7 +334,7 @@ impl Deep {
 #[derive(Clone, Debug, Default)]
 pub struct Warnings {
     /// Pairs by id: the particle (the lower id of a particle pair) and its partner.
-    seen: rustc_hash::FxHashSet<(u32, Partner)>,
+    seen: rustc_hash::FxHashSet<(Id, Partner)>,
     /// Descriptions of the pairs seen for the first time since the last
     /// [`Simulation::take_new_warnings`], with their step.
     fresh: Vec<String>,
@@ -473,7 +478,10 @@ impl Simulation {
             return self.snapshot_split();
         }
         let p = &self.particles;
-        let history = self.neighbours.history(&p.id, p.next_id as usize);
+        // The springs by id, each once, in (id, partner) order.
+        let (mut pairs, mut faces) = self.neighbours.entries_by_id(&p.id);
+        pairs.sort_unstable_by_key(|e| (e.0, e.1));
+        faces.sort_unstable_by_key(|e| (e.0, e.1));
         let (anchors, lonely) = self.neighbours.anchors();
         Ok(Snapshot {
             steps: self.steps,
@@ -482,8 +490,8 @@ impl Simulation {
             spawner: self.spawner.state(),
             anchors: anchors.to_vec(),
             lonely: lonely.to_vec(),
-            pair_history: history.pairs.entries(),
-            face_history: history.faces.entries(),
+            pair_history: pairs,
+            face_history: faces,
             removed: self.removed.clone(),
             wall_sums: self.walls.sums.clone(),
             scenario: self.scenario.to_toml(),
@@ -631,7 +639,7 @@ impl Simulation {
             return self.spawn_split();
         }
         let s = &self.scenario;
-        if (self.particles.next_id as u64) < s.simulation.max_particles {
+        if self.particles.next_id < s.simulation.max_particles {
             self.spawner.spawn(
                 s,
                 &mut self.particles,

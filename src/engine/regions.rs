@@ -46,7 +46,7 @@ impl Simulation {
             return;
         }
         // Counted in id order, so the masses sum in an order of their own.
-        let mut by_id: Vec<(u32, u32, u32)> = gone
+        let mut by_id: Vec<(Id, u32, u32)> = gone
             .iter()
             .map(|&(i, f)| (p.id[i as usize], i, f))
             .collect();

@@ -71,7 +71,7 @@ impl Simulation {
                 m: self.mass_of(j),
             };
             let coef = self.model.law.pair(p.material[i], p.material[j]);
-            let with = Partner::Particle(p.id[j] as usize);
+            let with = Partner::Particle(p.id[j]);
             out.push(self.record(i, other, &kin, coef, springs, with));
         }
         out
@@ -142,9 +142,9 @@ impl Simulation {
 
     /// Each grain's id with its kinetic energies of translation and rotation, in id order:
     /// a plain sphere, or a rigid body (once, by its first sphere); of all processes.
-    fn grain_energies(&self) -> Vec<(u32, f64, f64)> {
+    fn grain_energies(&self) -> Vec<(Id, f64, f64)> {
         let p = &self.particles;
-        let mut energies: Vec<(u32, f64, f64)> = (0..p.len())
+        let mut energies: Vec<(Id, f64, f64)> = (0..p.len())
             .filter(|&k| self.own(k) && p.body[k].is_none())
             .map(|k| {
                 let m = Inertia::mass_with(
@@ -169,7 +169,7 @@ impl Simulation {
             use crate::parallel::comm::{Reader, Writer};
             let mut w = Writer::default();
             for &(id, t, r) in &energies {
-                w.u32(id);
+                w.u64(id);
                 w.f64(t);
                 w.f64(r);
             }
@@ -177,7 +177,7 @@ impl Simulation {
             for m in d.comm.all_gather(w.0) {
                 let mut r = Reader::new(&m);
                 while !r.done() {
-                    energies.push((r.u32(), r.f64(), r.f64()));
+                    energies.push((r.u64(), r.f64(), r.f64()));
                 }
             }
         }
@@ -194,7 +194,7 @@ impl Simulation {
         let (translational, rotational) = energies
             .iter()
             .fold((0.0, 0.0), |(t, r), e| (t + e.1, r + e.2));
-        let radius_of: rustc_hash::FxHashMap<u32, f64> =
+        let radius_of: rustc_hash::FxHashMap<Id, f64> =
             p.id.iter().copied().zip(p.radius.iter().copied()).collect();
         let own = self.own_ids();
         let mut thermo = Thermo {
@@ -212,7 +212,7 @@ impl Simulation {
             let smaller = match c.with {
                 Partner::Particle(j) => {
                     thermo.pair_contacts += 1;
-                    r.min(radius_of[&(j as u32)])
+                    r.min(radius_of[&(j as Id)])
                 }
                 Partner::Face(_) => {
                     thermo.wall_contacts += 1;

@@ -139,7 +139,7 @@ impl Simulation {
         mut snapshot: Snapshot,
     ) -> Result<(Simulation, Entries)> {
         let index = IdIndex::of(&snapshot.particles);
-        let held = |id: u32| index.get(id).is_some();
+        let held = |id: Id| index.get(id).is_some();
         let (pairs, pending) = std::mem::take(&mut snapshot.pair_history)
             .into_iter()
             .partition(|e| held(e.0) && held(e.1));
@@ -344,8 +344,8 @@ impl Simulation {
     fn carried_face_contacts(
         &self,
         old_files: &[(u64, u64)],
-        face_history: &[(u32, u32, Springs)],
-    ) -> Vec<(u32, u32, Springs)> {
+        face_history: &[Entry],
+    ) -> Vec<Entry> {
         let mut face_map: Vec<Option<u32>> = Vec::new();
         for (old, found) in old_files.iter().zip(self.same_files(old_files)) {
             let start = found.map(|j| self.walls.files[j].faces.start as u32);
@@ -355,7 +355,7 @@ impl Simulation {
             .iter()
             .filter_map(|&(id, f, springs)| {
                 let f = face_map.get(f as usize).copied().flatten()?;
-                Some((id, f, springs))
+                Some((id, f as Id, springs))
             })
             .collect()
     }

@@ -9,7 +9,7 @@ use rustc_hash::FxHashMap;
 
 use crate::geometry::mesh::Face;
 use crate::model::bodies::{Body, BodyId};
-use crate::model::particles::{Particle, Particles};
+use crate::model::particles::{Id, Particle, Particles};
 use crate::neighbours::{CellGrid, Periodic, cell_of, key};
 use crate::scenario::{
     ClumpTemplate, RadiusDistribution, Region, Scenario, SpawnClump, SpawnRegion,
@@ -170,8 +170,8 @@ impl Spawner {
     }
 
     /// Whether a step at time `t` would try to spawn, `next_id` particles having been made.
-    pub fn active(&self, s: &Scenario, next_id: u32, t: f64) -> bool {
-        if s.simulation.spawn_attempts == 0 || next_id as u64 >= s.simulation.max_particles {
+    pub fn active(&self, s: &Scenario, next_id: Id, t: f64) -> bool {
+        if s.simulation.spawn_attempts == 0 || next_id >= s.simulation.max_particles {
             return false;
         }
         if s.spawn.is_empty() {
@@ -186,8 +186,8 @@ impl Spawner {
     /// Whether no step from time `t` on will spawn, `next_id` particles having been made:
     /// `N_max` reached, or every `[[spawn]]` region past its `stop` or its `count` (the
     /// spawn box tries until `N_max`).
-    pub fn finished(&self, s: &Scenario, next_id: u32, t: f64) -> bool {
-        if s.simulation.spawn_attempts == 0 || next_id as u64 >= s.simulation.max_particles {
+    pub fn finished(&self, s: &Scenario, next_id: Id, t: f64) -> bool {
+        if s.simulation.spawn_attempts == 0 || next_id >= s.simulation.max_particles {
             return true;
         }
         if s.spawn.is_empty() && self.box_off {
@@ -233,8 +233,7 @@ impl Spawner {
     ) -> usize {
         let max = s.simulation.max_particles;
         let attempts = s.simulation.spawn_attempts;
-        if attempts == 0 || particles.next_id as u64 >= max || (s.spawn.is_empty() && self.box_off)
-        {
+        if attempts == 0 || particles.next_id >= max || (s.spawn.is_empty() && self.box_off) {
             return 0;
         }
         if s.spawn.is_empty() {
@@ -352,7 +351,7 @@ impl Spawner {
         let (lo, hi) = (source.region.min, source.region.max);
         let mut inserted = 0;
         for _ in 0..attempts {
-            if particles.next_id as u64 >= max || inserted >= budget {
+            if particles.next_id >= max || inserted >= budget {
                 break;
             }
             let radius = match *pending {
@@ -421,7 +420,7 @@ impl Spawner {
         let (lo, hi) = (source.region.min, source.region.max);
         let mut inserted = 0;
         for _ in 0..attempts {
-            if particles.next_id as u64 + t.spheres.len() as u64 > max || inserted >= budget {
+            if particles.next_id + t.spheres.len() as u64 > max || inserted >= budget {
                 break;
             }
             let scale = match *pending {

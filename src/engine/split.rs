@@ -33,11 +33,11 @@ pub(crate) fn gather_contacts(
 ) -> Vec<ContactRecord> {
     let mut w = Writer::default();
     for c in &mine {
-        w.u32(c.id);
+        w.u64(c.id);
         match c.with {
             Partner::Particle(j) => {
                 w.u8(0);
-                w.u64(j as u64);
+                w.u64(j);
             }
             Partner::Face(f) => {
                 w.u8(1);
@@ -53,10 +53,10 @@ pub(crate) fn gather_contacts(
     for m in comm.gather_to(reach, w.0) {
         let mut r = Reader::new(&m);
         while !r.done() {
-            let id = r.u32();
-            let with = match (r.u8(), r.u64() as usize) {
+            let id = r.u64();
+            let with = match (r.u8(), r.u64()) {
                 (0, j) => Partner::Particle(j),
-                (_, f) => Partner::Face(f),
+                (_, f) => Partner::Face(f as usize),
             };
             all.push(ContactRecord {
                 id,
@@ -231,13 +231,13 @@ impl Simulation {
 
     /// Whether the particle of id `id` is this process's own (of a split run; in one
     /// process, whether it exists).
-    pub fn owns(&self, id: u32) -> bool {
+    pub fn owns(&self, id: Id) -> bool {
         let p = &self.particles;
         (0..p.len()).any(|i| p.id[i] == id && self.own(i))
     }
 
     /// The ids of this process's own particles, in a split run.
-    pub(crate) fn own_ids(&self) -> Option<FxHashSet<u32>> {
+    pub(crate) fn own_ids(&self) -> Option<FxHashSet<Id>> {
         let d = self.domain.as_ref()?;
         let p = &self.particles;
         Some(
@@ -258,13 +258,13 @@ impl Simulation {
     /// (but those of ids in `gone`) to the owners of the boxes they are in (the boxes cut
     /// anew when out of balance) with the springs of their contacts, then the ghosts each
     /// process needs, then the lists; all at the particles' places of `placement`.
-    pub(crate) fn redistribute(&mut self, gone: &FxHashSet<u32>, placement: Placement) {
+    pub(crate) fn redistribute(&mut self, gone: &FxHashSet<Id>, placement: Placement) {
         self.redistribute_with(gone, placement, Entries::default());
     }
 
     /// [`Simulation::redistribute`], with springs beside the lists' (`pending`: of contacts
     /// with particles this process does not hold) carried to their owners too.
-    fn redistribute_with(&mut self, gone: &FxHashSet<u32>, placement: Placement, pending: Entries) {
+    fn redistribute_with(&mut self, gone: &FxHashSet<Id>, placement: Placement, pending: Entries) {
         // The anchors of the run in one process, if its lists were built: there the lists
         // are built again, with the mesh and sheared images where they were then, as a
         // checkpoint restores them.
@@ -323,14 +323,14 @@ impl Simulation {
             self.neighbours.forget_anchors();
         }
         owned = order.iter().map(|&o| owned[o as usize]).collect();
-        let at: FxHashMap<u32, u32> = self
+        let at: FxHashMap<Id, u32> = self
             .particles
             .id
             .iter()
             .enumerate()
             .map(|(i, &id)| (id, i as u32))
             .collect();
-        let by_id = |mut ids: Vec<u32>| {
+        let by_id = |mut ids: Vec<Id>| {
             ids.sort_unstable();
             ids.iter().map(|id| at[id]).collect::<Vec<u32>>()
         };
@@ -417,7 +417,7 @@ impl Simulation {
 
     /// The particles of ids from `first` in `around` (spawned on every process) that are in
     /// this process's box: a rigid body whole, by its centre.
-    fn keep_spawned(&mut self, around: &Particles, first: u32) {
+    fn keep_spawned(&mut self, around: &Particles, first: Id) {
         let d = self.domain.as_mut().expect("a split run");
         let tree = d.tree.as_ref().expect("cut");
         let me = d.comm.rank();
@@ -446,28 +446,28 @@ impl Simulation {
         for i in (0..p.len()).filter(|&i| d.owned[i] && p.body[i].is_none()) {
             if let Some(f) = fate(p.x[i]) {
                 let density = self.model.densities[p.material[i] as usize];
-                w.u32(p.id[i]);
+                w.u64(p.id[i]);
                 w.u32(f);
                 w.f64(Inertia::mass_with(p.radius[i], density.mass_per_r3));
-                w.u32(1);
+                w.u64(1);
             }
         }
         // A rigid body goes whole, where its centre of mass goes (as in one process).
         for b in p.bodies_where(|i| d.owned[i]) {
             let b = &p.bodies.list[b];
             if let Some(f) = fate(b.x) {
-                w.u32(b.id.first());
+                w.u64(b.id.first());
                 w.u32(f);
                 w.f64(b.mass);
-                w.u32(b.offsets.len() as u32);
+                w.u64(b.offsets.len() as u64);
             }
         }
         // (first id, fate, mass, count of ids)
-        let mut gone: Vec<(u32, u32, f64, u32)> = Vec::new();
+        let mut gone: Vec<(Id, u32, f64, u64)> = Vec::new();
         for m in d.comm.all_gather(w.0) {
             let mut r = Reader::new(&m);
             while !r.done() {
-                gone.push((r.u32(), r.u32(), r.f64(), r.u32()));
+                gone.push((r.u64(), r.u32(), r.f64(), r.u64()));
             }
         }
         if gone.is_empty() {
@@ -483,7 +483,7 @@ impl Simulation {
             out.count += 1;
             out.mass += mass;
         }
-        let ids: FxHashSet<u32> = gone.iter().flat_map(|g| g.0..g.0 + g.3).collect();
+        let ids: FxHashSet<Id> = gone.iter().flat_map(|g| g.0..g.0 + g.3).collect();
         self.redistribute(&ids, Placement::Now);
     }
 

@@ -11,7 +11,7 @@ use anyhow::{Context, Result, bail};
 use glam::{DQuat, DVec3};
 
 use crate::engine::records::{ContactRecord, Partner};
-use crate::model::particles::{Particle, Particles};
+use crate::model::particles::{Id, MAX_ID, Particle, Particles};
 
 pub const COLUMNS: [&str; 14] = [
     "x", "y", "z", "R", "vx", "vy", "vz", "q0", "q1", "q2", "q3", "wx", "wy", "wz",
@@ -195,10 +195,9 @@ fn contact(line: &str, file: &str, n: usize) -> Result<ContactRecord> {
             .ok_or_else(|| anyhow::anyhow!("{file}:{n}: '{text}' is not a finite number"))?;
     }
     let (id, j, face) = (int(0)?, int(1)?, int(2)?);
-    let id =
-        u32::try_from(id).map_err(|_| anyhow::anyhow!("{file}:{n}: id_i {id} out of range"))?;
+    let id = Id::try_from(id).map_err(|_| anyhow::anyhow!("{file}:{n}: id_i {id} out of range"))?;
     let with = match (j, face) {
-        (j, -1) if (0..=u32::MAX as i64).contains(&j) => Partner::Particle(j as usize),
+        (j, -1) if j >= 0 => Partner::Particle(j as Id),
         (-1, f) if f >= 0 => Partner::Face(f as usize),
         _ => bail!(
             "{file}:{n}: a contact is with a particle (id_j, face = -1) or a face (id_j = -1, face)"
@@ -274,12 +273,12 @@ impl Header {
 
     /// The values of row `line` (line `n` of `file`): the 14 quantities and the whole
     /// numbers.
-    fn row(&self, line: &str, n: usize, file: &str) -> Result<([f64; 14], [u32; 5])> {
+    fn row(&self, line: &str, n: usize, file: &str) -> Result<([f64; 14], [u64; 5])> {
         let (names, int_column, quantity_of_column) =
             (self.columns, &self.int_column, &self.quantity_of_column);
         let mut values = [0.0f64; 14];
         let mut count = 0;
-        let mut ints = [0u32; 5];
+        let mut ints = [0u64; 5];
         for (col, text) in line.split(',').enumerate() {
             count += 1;
             if col >= names {
@@ -290,7 +289,7 @@ impl Header {
                 let parsed = if k == 4 {
                     text.parse::<i64>()
                         .ok()
-                        .and_then(|c| u32::try_from(c + 1).ok())
+                        .and_then(|c| u64::try_from(c + 1).ok())
                 } else {
                     text.parse().ok()
                 };
@@ -329,7 +328,7 @@ impl Header {
 }
 
 /// The particle of a row's values `v` and whole numbers `ints` (line `n` of `file`).
-fn particle(v: [f64; 14], ints: [u32; 5], n: usize, file: &str) -> Result<Particle> {
+fn particle(v: [f64; 14], ints: [u64; 5], n: usize, file: &str) -> Result<Particle> {
     if v[3] <= 0.0 {
         bail!("{file}:{n}: radius R = {} must be > 0", v[3]);
     }
@@ -354,7 +353,8 @@ fn particle(v: [f64; 14], ints: [u32; 5], n: usize, file: &str) -> Result<Partic
             q / norm
         },
         w: DVec3::new(v[11], v[12], v[13]),
-        tag: ints[0],
+        tag: u32::try_from(ints[0])
+            .map_err(|_| anyhow::anyhow!("{file}:{n}: tag {} is out of range", ints[0]))?,
         material: u16::try_from(ints[2])
             .map_err(|_| anyhow::anyhow!("{file}:{n}: material {} is out of range", ints[2]))?,
         fixed: ints[3] == 1,
@@ -363,14 +363,14 @@ fn particle(v: [f64; 14], ints: [u32; 5], n: usize, file: &str) -> Result<Partic
 }
 
 /// The ids of a file's particles, which they keep (a frame of a run that removed some).
-fn keep_ids(particles: &mut Particles, ids: Vec<u32>, file: &str) -> Result<()> {
+fn keep_ids(particles: &mut Particles, ids: Vec<Id>, file: &str) -> Result<()> {
     let mut sorted = ids.clone();
     sorted.sort_unstable();
     if let Some(w) = sorted.windows(2).find(|w| w[0] == w[1]) {
         bail!("{file}: particle id {} appears twice", w[0]);
     }
-    if sorted.last().is_some_and(|&m| m >= u32::MAX / 2) {
-        bail!("{file}: particle ids must be below {}", u32::MAX / 2);
+    if sorted.last().is_some_and(|&m| m >= MAX_ID) {
+        bail!("{file}: particle ids must be below {MAX_ID}");
     }
     particles.next_id = sorted.last().map_or(0, |&m| m + 1);
     particles.id = ids;

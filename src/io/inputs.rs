@@ -12,7 +12,7 @@ use crate::engine::records::Snapshot;
 use crate::engine::setup::Inputs;
 use crate::geometry::mesh::Mesh;
 use crate::io::{csv, files};
-use crate::model::particles::{Particle, Particles};
+use crate::model::particles::{Id, Particle, Particles};
 use crate::neighbours::Entries;
 use crate::parallel::comm::{Comm, Reader};
 use crate::parallel::domain::agree;
@@ -134,17 +134,17 @@ pub fn read_share(scenario: &Scenario, comm: &dyn Comm) -> Result<Inputs> {
     };
     let (rows_before, ids_before) = (before(rows.len() as u64), before(taken));
     if !ids {
-        rows.id.iter_mut().for_each(|id| *id += rows_before as u32);
-        rows.next_id += rows_before as u32;
+        rows.id.iter_mut().for_each(|id| *id += rows_before);
+        rows.next_id += rows_before;
     }
     let particles = match clumps {
         None => Ok(rows),
-        Some(c) => with_clumps_from(scenario, rows, &c, ids_before as u32)
+        Some(c) => with_clumps_from(scenario, rows, &c, ids_before)
             .with_context(|| format!("particle file {}", path.display())),
     };
     let mut particles = agree(comm, particles)?;
-    let next = comm.all_gather((particles.next_id as u64).to_le_bytes().to_vec());
-    particles.next_id = next.iter().map(|m| Reader::new(m).u64()).max().unwrap_or(0) as u32;
+    let next = comm.all_gather(particles.next_id.to_le_bytes().to_vec());
+    particles.next_id = next.iter().map(|m| Reader::new(m).u64()).max().unwrap_or(0);
     Ok(Inputs { meshes, particles })
 }
 
@@ -163,7 +163,7 @@ fn with_clumps_from(
     s: &Scenario,
     rows: Particles,
     clumps: &csv::ClumpColumn,
-    first: u32,
+    first: Id,
 ) -> Result<Particles> {
     let mut particles = Particles {
         next_id: first,
@@ -259,7 +259,7 @@ impl Simulation {
 fn place_row(
     particles: &mut Particles,
     (t, template): (&ClumpTemplate, u16),
-    id: u32,
+    id: Id,
     row: Particle,
 ) {
     let first = particles.len();

@@ -9,7 +9,7 @@ use anyhow::{Result, bail};
 
 use crate::engine::records::ContactRecord;
 use crate::io::csv::{ClumpColumn, load_contacts, load_grains};
-use crate::model::particles::{Particle, Particles};
+use crate::model::particles::{Id, Particle, Particles};
 
 /// The number of the frame a file of an output directory names: `particlesNNNNNN.csv`, or
 /// the first piece `particlesNNNNNN_0.csv` of a frame written in pieces (the other pieces
@@ -67,7 +67,7 @@ pub fn load_frame(path: &Path) -> Result<(Particles, Option<ClumpColumn>)> {
     let Some(pieces) = pieces_of(path).filter(|_| !path.exists()) else {
         return load_grains(path);
     };
-    let mut rows: Vec<(u32, Particle, Option<u16>)> = Vec::new();
+    let mut rows: Vec<(Id, Particle, Option<u16>)> = Vec::new();
     let mut clumps = false;
     for piece in pieces? {
         let (p, c) = load_grains(&piece)?;

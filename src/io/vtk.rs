@@ -14,7 +14,7 @@ use anyhow::{Context, Result};
 
 use crate::engine::records::{ContactRecord, Partner};
 use crate::geometry::mesh::{Mesh, Primitive};
-use crate::model::particles::Particles;
+use crate::model::particles::{Id, Particles};
 
 /// Where an array goes in the file.
 #[derive(Clone, Copy, PartialEq)]
@@ -279,7 +279,8 @@ fn particles_vtu(p: &Particles, bodies: bool) -> Vtu {
     let order = p.id_order();
     let by_id = || order.iter().copied();
     let mut v = Vtu::new();
-    v.array(PointData, "id", 1, n, by_id().map(|i| p.id[i]));
+    // (Int64, VTK's own id type: ids stay below 2^62.)
+    v.array(PointData, "id", 1, n, by_id().map(|i| p.id[i] as i64));
     v.array(PointData, "radius", 1, n, by_id().map(|i| p.radius[i]));
     v.vectors(PointData, "velocity", n, by_id().map(|i| p.v[i]));
     v.vectors(PointData, "angular_velocity", n, by_id().map(|i| p.w[i]));
@@ -374,7 +375,7 @@ pub fn write_contact_list(path: &Path, sources: &[String]) -> Result<()> {
 /// The contact network's file.
 fn contacts_vtp(p: &Particles, contacts: &[ContactRecord]) -> Vtu {
     use Section::*;
-    let at: rustc_hash::FxHashMap<u32, usize> =
+    let at: rustc_hash::FxHashMap<Id, usize> =
         p.id.iter().enumerate().map(|(k, &id)| (id, k)).collect();
     let mut points = Vec::with_capacity(2 * contacts.len());
     for c in contacts {
@@ -383,9 +384,9 @@ fn contacts_vtp(p: &Particles, contacts: &[ContactRecord]) -> Vtu {
         points.push(match c.with {
             // A pair across a periodic side: to the contact point rather than across the box.
             Partner::Particle(j)
-                if (p.x[at[&(j as u32)]] - xi).length() <= 4.0 * (c.point - xi).length() =>
+                if (p.x[at[&(j as Id)]] - xi).length() <= 4.0 * (c.point - xi).length() =>
             {
-                p.x[at[&(j as u32)]]
+                p.x[at[&(j as Id)]]
             }
             _ => c.point,
         });

@@ -6,22 +6,24 @@
 //! A body's spheres have consecutive ids, the first of which is the body's id: sphere k
 //! of body b is particle b + k. Each particle names its body (`Particles::body`).
 
-use std::num::NonZeroU32;
+use std::num::NonZeroU64;
+
+use crate::model::particles::Id;
 
 use glam::{DQuat, DVec3};
 
 /// The body a particle is a sphere of: the id of the body's first sphere.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct BodyId(NonZeroU32);
+pub struct BodyId(NonZeroU64);
 
 impl BodyId {
     /// The body whose first sphere is particle `first`.
-    pub fn new(first: u32) -> BodyId {
-        BodyId(NonZeroU32::new(first.wrapping_add(1)).expect("ids below u32::MAX"))
+    pub fn new(first: Id) -> BodyId {
+        BodyId(NonZeroU64::new(first.wrapping_add(1)).expect("ids below u64::MAX"))
     }
 
     /// The id of its first sphere (the body's id in frames).
-    pub fn first(self) -> u32 {
+    pub fn first(self) -> Id {
         self.0.get() - 1
     }
 }
@@ -124,7 +126,7 @@ impl Bodies {
     /// Finds every body's spheres in storage (ids `id`, bodies `body`), after particles
     /// were added, removed or reordered; bodies none of whose spheres remain are dropped.
     /// Panics if a body lost only some of its spheres (a body is removed whole).
-    pub fn locate(&mut self, id: &[u32], body: &[Option<BodyId>]) {
+    pub fn locate(&mut self, id: &[Id], body: &[Option<BodyId>]) {
         let mut found: Vec<Vec<u32>> = self
             .list
             .iter()
@@ -212,7 +214,7 @@ impl<'a> Members<'a> {
 mod tests {
     use super::*;
 
-    fn body(first: u32, n: usize) -> Body {
+    fn body(first: Id, n: usize) -> Body {
         Body {
             id: BodyId::new(first),
             template: 0,
@@ -236,7 +238,7 @@ mod tests {
         assert_eq!(bodies.members(1), &[3, 4, 5]);
         // Stored as ids 5, 3, 0, 2, 1, 4; then body 1 removed.
         let ids = [5, 3, 0, 2, 1, 4];
-        let of = |id: u32| match id {
+        let of = |id: Id| match id {
             1 | 2 => Some(BodyId::new(1)),
             3..=5 => Some(BodyId::new(3)),
             _ => None,

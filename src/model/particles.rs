@@ -9,13 +9,21 @@ use glam::{DQuat, DVec3};
 
 use crate::model::bodies::{Bodies, Body, BodyId};
 
+/// A particle's id: 64 bits, so that a long run may create more than 4.29e9 particles
+/// (files and checkpoints carry them whole).
+pub type Id = u64;
+
+/// The ids a file may give its particles are below this (2^62): far beyond any run, with
+/// room above for the ids the run gives new ones.
+pub const MAX_ID: Id = 1 << 62;
+
 /// The state of every particle.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Particles {
     /// The id of the particle stored at each index.
-    pub id: Vec<u32>,
+    pub id: Vec<Id>,
     /// The id the next particle created gets.
-    pub next_id: u32,
+    pub next_id: Id,
     /// R \[L\]
     pub radius: Vec<f64>,
     /// x \[L\]
@@ -73,7 +81,7 @@ impl Particles {
 
     /// Adds a particle that has its id already (one made elsewhere: by another process of a
     /// split run); `next_id` stays.
-    pub fn insert(&mut self, id: u32, p: Particle) {
+    pub fn insert(&mut self, id: Id, p: Particle) {
         self.id.push(id);
         self.radius.push(p.radius);
         self.x.push(p.x);
@@ -176,7 +184,7 @@ impl Particles {
     }
 
     /// The particles in id order, with their ids.
-    pub fn iter_by_id(&self) -> impl Iterator<Item = (u32, Particle)> + '_ {
+    pub fn iter_by_id(&self) -> impl Iterator<Item = (Id, Particle)> + '_ {
         self.id_order()
             .into_iter()
             .map(|i| (self.id[i], self.get(i)))

@@ -97,8 +97,8 @@ impl Neighbours {
         &mut self,
         particles: &mut Particles,
         at: Option<Vec<DVec3>>,
-        pairs: &[(u32, u32, Springs)],
-        faces_history: &[(u32, u32, Springs)],
+        pairs: &[Entry],
+        faces_history: &[Entry],
         faces: &[Face],
         face_grid: &CellGrid,
     ) -> Vec<u32> {

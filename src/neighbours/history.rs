@@ -62,7 +62,7 @@ impl History {
     /// particle that `particles` lacks is an error.
     pub fn in_storage(
         particles: &Particles,
-        entries: &[(u32, u32, Springs)],
+        entries: &[Entry],
         pairs: bool,
     ) -> Result<History, String> {
         Self::keyed(
@@ -76,25 +76,20 @@ impl History {
 
     /// [`History::in_storage`] for `n` particles, whose storage indices by id are `index`
     /// ([`IdIndex::of`]), of the entries that name only them; the others are left out.
-    pub(crate) fn of_present(
-        index: &IdIndex,
-        n: usize,
-        entries: &[(u32, u32, Springs)],
-        pairs: bool,
-    ) -> History {
+    pub(crate) fn of_present(index: &IdIndex, n: usize, entries: &[Entry], pairs: bool) -> History {
         Self::keyed(index, n, entries, pairs, true).expect("entries of absent particles left out")
     }
 
     pub(crate) fn keyed(
         index: &IdIndex,
         n: usize,
-        entries: &[(u32, u32, Springs)],
+        entries: &[Entry],
         pairs: bool,
         skip_absent: bool,
     ) -> Result<History, String> {
-        let at = |id: u32| index.get(id);
+        let at = |id: Id| index.get(id);
         if !skip_absent {
-            let named = |e: &(u32, u32, Springs)| [Some(e.0), pairs.then_some(e.1)];
+            let named = |e: &Entry| [Some(e.0), pairs.then_some(e.1)];
             if let Some(id) = entries
                 .iter()
                 .flat_map(named)
@@ -113,7 +108,7 @@ impl History {
                     let Some(b) = at(b) else { continue };
                     f(a.min(b), a.max(b), s);
                 } else {
-                    f(a, b, s);
+                    f(a, u32::try_from(b).expect("a face index"), s);
                 }
             }
         }))
@@ -148,8 +143,12 @@ impl History {
     }
 }
 
+/// A saved contact's springs by id: of a particle pair (lower id, higher id, springs), or of
+/// a particle-face contact (id, face index, springs).
+pub type Entry = (Id, Id, Springs);
+
 /// Contact histories as lists of entries: particle pairs and particle-face contacts.
-pub type Entries = (Vec<(u32, u32, Springs)>, Vec<(u32, u32, Springs)>);
+pub type Entries = (Vec<Entry>, Vec<Entry>);
 
 /// The contact histories of both lists.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -165,7 +164,7 @@ pub(crate) enum IdIndex {
     /// The storage index at each id ([`NONE`] for ids the set lacks).
     Table(Vec<u32>),
     /// (id, storage index), by id.
-    Sorted(Vec<(u32, u32)>),
+    Sorted(Vec<(Id, u32)>),
 }
 
 impl IdIndex {
@@ -183,7 +182,7 @@ impl IdIndex {
             }
             return IdIndex::Table(index);
         }
-        let mut index: Vec<(u32, u32)> = (0..particles.len() as u32)
+        let mut index: Vec<(Id, u32)> = (0..particles.len() as u32)
             .map(|k| (particles.id[k as usize], k))
             .collect();
         index.sort_unstable();
@@ -192,21 +191,17 @@ impl IdIndex {
 
     /// Where the particle of id `id` is stored, if the set holds it.
     #[inline]
-    pub(crate) fn get(&self, id: u32) -> Option<u32> {
+    pub(crate) fn get(&self, id: Id) -> Option<u32> {
         match self {
-            IdIndex::Table(index) => index.get(id as usize).copied().filter(|&k| k != NONE),
+            IdIndex::Table(index) => usize::try_from(id)
+                .ok()
+                .and_then(|id| index.get(id))
+                .copied()
+                .filter(|&k| k != NONE),
             IdIndex::Sorted(index) => index
                 .binary_search_by_key(&id, |e| e.0)
                 .ok()
                 .map(|at| index[at].1),
         }
-    }
-}
-
-/// The history of particle pairs of a list, by (lower id, higher id).
-pub(crate) fn pair_key(ids: &[u32]) -> impl Fn(usize, u32) -> Option<(u32, u32)> + Sync + '_ {
-    move |i, j| {
-        let (a, b) = (ids[i], ids[j as usize]);
-        Some((a.min(b), a.max(b)))
     }
 }

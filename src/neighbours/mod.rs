@@ -17,7 +17,7 @@ use glam::{DVec3, IVec3};
 use rayon::prelude::*;
 
 use crate::geometry::mesh::Face;
-use crate::model::particles::Particles;
+use crate::model::particles::{Id, Particles};
 use crate::model::springs::Springs;
 
 mod build;
@@ -71,7 +71,7 @@ impl Layout {
 impl Layout {
     /// Each particle's (cell key, id) for particles at `x` of ids `id`: the order the
     /// lists keep them in.
-    fn keys(&self, x: &[DVec3], id: &[u32]) -> Vec<(u64, u32)> {
+    fn keys(&self, x: &[DVec3], id: &[Id]) -> Vec<(u64, Id)> {
         let inv_h = 1.0 / self.h;
         x.par_iter()
             .zip(id.par_iter())
@@ -172,13 +172,7 @@ impl Neighbours {
     /// indices), as the law sees it: body i the particle of the lower id, body j the other,
     /// and where j's image is relative to j (shift, added velocity).
     #[inline]
-    pub fn across(
-        &self,
-        ids: &[u32],
-        a: usize,
-        b: usize,
-        k: usize,
-    ) -> (usize, usize, DVec3, DVec3) {
+    pub fn across(&self, ids: &[Id], a: usize, b: usize, k: usize) -> (usize, usize, DVec3, DVec3) {
         let (shift, dv) = self.image(k);
         if ids[a] < ids[b] {
             (a, b, shift, dv)
@@ -334,14 +328,6 @@ impl Neighbours {
             .collect();
     }
 
-    /// The contact histories of the current lists by id.
-    pub fn history(&self, ids: &[u32], id_count: usize) -> Histories {
-        Histories {
-            pairs: ContactList::history_of(&[&self.pairs, &self.wrapped], id_count, pair_key(ids)),
-            faces: self.faces.history(id_count, |i, f| Some((ids[i], f))),
-        }
-    }
-
     /// Drops the lists (their memory), until the next rebuild.
     pub fn clear_lists(&mut self) {
         self.pairs = ContactList::default();
@@ -351,7 +337,7 @@ impl Neighbours {
 
     /// The contact histories of the current lists by id, unsorted: particle pairs as
     /// (lower id, higher id, springs), particle-face contacts as (id, face, springs).
-    pub fn entries_by_id(&self, ids: &[u32]) -> Entries {
+    pub fn entries_by_id(&self, ids: &[Id]) -> Entries {
         let mut pairs = Vec::with_capacity(self.pairs.contacts() + self.wrapped.contacts());
         for list in [&self.pairs, &self.wrapped] {
             list.for_each_live(|i, k, s| {
@@ -361,7 +347,7 @@ impl Neighbours {
         }
         let mut faces = Vec::with_capacity(self.faces.contacts());
         self.faces
-            .for_each_live(|i, k, s| faces.push((ids[i], self.faces.partner[k], s)));
+            .for_each_live(|i, k, s| faces.push((ids[i], self.faces.partner[k] as Id, s)));
         (pairs, faces)
     }
 
@@ -448,7 +434,7 @@ mod tests {
 
     /// The listed particle pairs by id, (lower, higher), sorted; and a check that every
     /// owner's partners follow it, in order, within the next slab.
-    fn listed(nb: &Neighbours, p: &Particles) -> Vec<(u32, u32)> {
+    fn listed(nb: &Neighbours, p: &Particles) -> Vec<(Id, Id)> {
         let list = &nb.pairs;
         let mut pairs = Vec::new();
         let slabs = &nb.pairs.pieces;
@@ -469,12 +455,12 @@ mod tests {
     }
 
     /// Brute-force pairs within reach, as (i, j) with i < j.
-    fn brute(x: &[DVec3], radius: &[f64], skin: f64) -> Vec<(u32, u32)> {
+    fn brute(x: &[DVec3], radius: &[f64], skin: f64) -> Vec<(Id, Id)> {
         let mut v = Vec::new();
         for i in 0..x.len() {
             for j in i + 1..x.len() {
                 if x[i].distance(x[j]) < radius[i] + radius[j] + skin {
-                    v.push((i as u32, j as u32));
+                    v.push((i as Id, j as Id));
                 }
             }
         }
@@ -572,7 +558,7 @@ mod tests {
             }
             IdIndex::Table(_) => unreachable!("4 of 900,001 ids"),
         };
-        for id in [0, 5, 17, 18, 12_345, 899_999, 900_000, 900_001, u32::MAX] {
+        for id in [0, 5, 17, 18, 12_345, 899_999, 900_000, 900_001, u64::MAX] {
             assert_eq!(sorted.get(id), table.get(id), "id {id}");
         }
         assert_eq!(sorted.get(12_345), Some(2));
@@ -612,10 +598,10 @@ mod tests {
         }
         nb.rebuild(&mut p, &[], &CellGrid::default());
         assert_eq!(p.id, vec![3, 0, 2, 1]);
-        let pairs = nb.history(&p.id, 4).pairs;
+        let (mut pairs, _) = nb.entries_by_id(&p.id);
+        pairs.sort_unstable_by_key(|e| (e.0, e.1));
         assert_eq!(
             pairs
-                .entries()
                 .iter()
                 .map(|e| (e.0, e.1, e.2.u_t))
                 .collect::<Vec<_>>(),
@@ -624,7 +610,7 @@ mod tests {
     }
 
     /// The storage index of the particle with id `id`.
-    fn at(p: &Particles, id: u32) -> usize {
+    fn at(p: &Particles, id: Id) -> usize {
         p.id.iter().position(|&i| i == id).expect("present")
     }
 

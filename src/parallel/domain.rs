@@ -39,8 +39,9 @@ use anyhow::{Result, bail};
 use glam::DVec3;
 
 use crate::model::bodies::{Body, BodyId};
-use crate::model::particles::{Particle, Particles};
+use crate::model::particles::{Id, Particle, Particles};
 use crate::model::springs::Springs;
+use crate::neighbours::Entry;
 use crate::parallel::comm::{Comm, Reach, Reader, Writer};
 
 /// Past this ratio of the largest process's particle count to the mean, the boxes are cut
@@ -314,8 +315,8 @@ impl Domain {
     }
 }
 
-pub(crate) fn put_particle(w: &mut Writer, id: u32, p: &Particle) {
-    w.u32(id);
+pub(crate) fn put_particle(w: &mut Writer, id: Id, p: &Particle) {
+    w.u64(id);
     w.f64(p.radius);
     w.vec3(p.x);
     w.vec3(p.v);
@@ -324,12 +325,12 @@ pub(crate) fn put_particle(w: &mut Writer, id: u32, p: &Particle) {
     w.u32(p.tag);
     w.u16(p.material);
     w.u8(p.fixed as u8);
-    w.u32(p.body.map_or(0, |b| b.first() + 1));
+    w.u64(p.body.map_or(0, |b| b.first() + 1));
 }
 
 /// A rigid body's record in a message (beside its spheres, which name it).
 pub(crate) fn put_body(w: &mut Writer, b: &Body) {
-    w.u32(b.id.first());
+    w.u64(b.id.first());
     w.u16(b.template);
     w.f64(b.scale);
     w.vec3(b.x);
@@ -345,7 +346,7 @@ pub(crate) fn put_body(w: &mut Writer, b: &Body) {
 
 pub(crate) fn get_body(r: &mut Reader) -> Body {
     Body {
-        id: BodyId::new(r.u32()),
+        id: BodyId::new(r.u64()),
         template: r.u16(),
         scale: r.f64(),
         x: r.vec3(),
@@ -359,8 +360,8 @@ pub(crate) fn get_body(r: &mut Reader) -> Body {
     }
 }
 
-pub(crate) fn get_particle(r: &mut Reader) -> (u32, Particle) {
-    let id = r.u32();
+pub(crate) fn get_particle(r: &mut Reader) -> (Id, Particle) {
+    let id = r.u64();
     let p = Particle {
         radius: r.f64(),
         x: r.vec3(),
@@ -370,23 +371,23 @@ pub(crate) fn get_particle(r: &mut Reader) -> (u32, Particle) {
         tag: r.u32(),
         material: r.u16(),
         fixed: r.u8() != 0,
-        body: r.u32().checked_sub(1).map(BodyId::new),
+        body: r.u64().checked_sub(1).map(BodyId::new),
     };
     (id, p)
 }
 
-pub(crate) fn put_entry(w: &mut Writer, (a, b, s): &(u32, u32, Springs)) {
-    w.u32(*a);
-    w.u32(*b);
+pub(crate) fn put_entry(w: &mut Writer, (a, b, s): &Entry) {
+    w.u64(*a);
+    w.u64(*b);
     w.vec3(s.u_s);
     w.vec3(s.u_r);
     w.f64(s.u_t);
 }
 
-pub(crate) fn get_entry(r: &mut Reader) -> (u32, u32, Springs) {
+pub(crate) fn get_entry(r: &mut Reader) -> Entry {
     (
-        r.u32(),
-        r.u32(),
+        r.u64(),
+        r.u64(),
         Springs {
             u_s: r.vec3(),
             u_r: r.vec3(),
@@ -415,7 +416,7 @@ pub(crate) fn gather_by_id(
     bodies
         .iter()
         .for_each(|&b| put_body(&mut w, &p.bodies.list[b]));
-    let mut all: Vec<(u32, Particle)> = Vec::new();
+    let mut all: Vec<(Id, Particle)> = Vec::new();
     let mut all_bodies = Vec::new();
     for m in comm.gather_to(reach, w.0) {
         let mut r = Reader::new(&m);

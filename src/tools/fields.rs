@@ -25,7 +25,7 @@ use glam::{DMat3, DVec3};
 use rustc_hash::FxHashMap;
 
 use crate::engine::records::{ContactRecord, Partner};
-use crate::model::particles::Particles;
+use crate::model::particles::{Id, Particles};
 
 /// The coarse-graining function φ, normalised to a unit integral.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -256,7 +256,7 @@ impl Sums {
             });
         }
         if let Some(contacts) = contacts {
-            let index: FxHashMap<u32, usize> =
+            let index: FxHashMap<Id, usize> =
                 p.id.iter().enumerate().map(|(k, &id)| (id, k)).collect();
             for c in contacts {
                 self.add_contact(p, &index, c);
@@ -265,7 +265,7 @@ impl Sums {
     }
 
     /// One contact's f ⊗ b, spread along its branch.
-    fn add_contact(&mut self, p: &Particles, index: &FxHashMap<u32, usize>, c: &ContactRecord) {
+    fn add_contact(&mut self, p: &Particles, index: &FxHashMap<Id, usize>, c: &ContactRecord) {
         let Some(&i) = index.get(&c.id) else {
             return;
         };
@@ -274,7 +274,7 @@ impl Sums {
         let branch = match c.with {
             Partner::Face(_) => to_centre,
             Partner::Particle(j) => {
-                let Some(&j) = index.get(&(j as u32)) else {
+                let Some(&j) = index.get(&(j as Id)) else {
                     return;
                 };
                 let reach = p.radius[i] + p.radius[j] - c.overlap;

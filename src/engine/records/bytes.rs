@@ -4,17 +4,18 @@
 //!
 //! Layout (little endian): magic `TINYDEM CKPT`, format version (u32), scenario fingerprint
 //! (u64), step (u64), step of the last neighbour-list rebuild (u64), spawner word position
-//! (u128), pending radius flag (u8) and value (f64), the next particle id (u32), particle
-//! count (u64) and per particle, in storage order: its id (u32), 14 f64 (x, y, z, R, vx, vy,
+//! (u128), pending radius flag (u8) and value (f64), the next particle id (u64; u32 before
+//! format 7, as every id below), particle
+//! count (u64) and per particle, in storage order: its id (u64), 14 f64 (x, y, z, R, vx, vy,
 //! vz, q0..q3, wx, wy, wz), its tag (u32), material (u16) and, from format 5, whether it is fixed (u8); whether the lists were built (u8) and if so
 //! each particle's position at the last rebuild (3 f64); the lonely particles of the last
 //! rebuild: count (u64) and per entry storage index (u32) and allowance (f64); then the particle-pair and particle-face histories: count (u64) and per
-//! entry the ids (lower, higher) or the id and face (u32, u32) and the springs u_s, u_r (3 f64
+//! entry the ids (lower, higher) or the id and face (u64, u64) and the springs u_s, u_r (3 f64
 //! each), u_t (f64); from format 3 the removed particles, wall sums, scenario, mesh files and
 //! spawn regions (`Cursor::rest`); from format 4 whether the spawn box is off (u8) and the servos' states (count, and per servo its
 //! mesh file (u32), position, speed, position at the last rebuild and last load (4 f64)); from
 //! format 6 the rigid bodies (clumps): count (u64) and per body the id of its first sphere
-//! (u32; its spheres are the particles of the next ids), template (u16), scale, x, v,
+//! (u64; its spheres are the particles of the next ids), template (u16), scale, x, v,
 //! q0..q3, w, mass, principal moments, bounding radius (19 f64) and its spheres' offsets
 //! (count u32, 3 f64 each); last a CRC-32 of everything before it.
 //!
@@ -28,12 +29,13 @@ use glam::{DQuat, DVec3};
 use super::{Outflow, Removed, Snapshot, Wrench};
 use crate::engine::spawn::{RegionState, SpawnerState};
 use crate::model::bodies::{Body, BodyId};
-use crate::model::particles::{Particle, Particles};
+use crate::model::particles::{Id, Particle, Particles};
 use crate::model::servo::State;
 use crate::model::springs::Springs;
+use crate::neighbours::Entry;
 
 const MAGIC: &[u8; 12] = b"TINYDEM CKPT";
-const VERSION: u32 = 6;
+const VERSION: u32 = 7;
 /// The oldest version this program reads.
 const OLDEST: u32 = 2;
 
@@ -43,16 +45,33 @@ fn put_f64s(out: &mut Vec<u8>, values: &[f64]) {
     }
 }
 
-fn put_history(out: &mut Vec<u8>, h: &[(u32, u32, Springs)]) {
+/// An id: 8 bytes, or 4 in the formats before 7 (`wide` false; for the tests that make
+/// files of older formats).
+fn put_id(out: &mut Vec<u8>, id: Id, wide: bool) {
+    match wide {
+        true => out.extend_from_slice(&id.to_le_bytes()),
+        false => out.extend_from_slice(&u32::try_from(id).expect("a 32-bit id").to_le_bytes()),
+    }
+}
+
+fn put_history(out: &mut Vec<u8>, h: &[Entry], wide: bool) {
     out.extend_from_slice(&(h.len() as u64).to_le_bytes());
-    for (i, j, s) in h {
-        out.extend_from_slice(&i.to_le_bytes());
-        out.extend_from_slice(&j.to_le_bytes());
+    for &(i, j, s) in h {
+        put_id(out, i, wide);
+        put_id(out, j, wide);
         put_f64s(
             out,
             &[s.u_s.x, s.u_s.y, s.u_s.z, s.u_r.x, s.u_r.y, s.u_r.z, s.u_t],
         );
     }
+}
+
+/// Encodes a snapshot in format 6 (ids of 4 bytes), for the tests of the older formats.
+#[cfg(test)]
+pub(crate) fn encode_v6(snapshot: &Snapshot, fingerprint: u64) -> Vec<u8> {
+    let mut out = Vec::new();
+    encode_as(&mut out, snapshot, fingerprint, 6);
+    out
 }
 
 /// Encodes a snapshot.
@@ -64,9 +83,9 @@ pub fn encode(snapshot: &Snapshot, fingerprint: u64) -> Vec<u8> {
 
 /// The bytes a checkpoint of `snapshot` takes (a bound).
 fn encoded_size(s: &Snapshot) -> usize {
-    let records = s.particles.len() * (122 + 24)
+    let records = s.particles.len() * (126 + 24)
         + s.lonely.len() * 12
-        + (s.pair_history.len() + s.face_history.len()) * 64;
+        + (s.pair_history.len() + s.face_history.len()) * 72;
     256 + records
         + s.scenario.len()
         + 16 * s.mesh_files.len()
@@ -79,21 +98,28 @@ fn encoded_size(s: &Snapshot) -> usize {
 
 /// Appends the checkpoint of `snapshot` to `out` (its checksum covers what it appends).
 pub fn encode_into(out: &mut Vec<u8>, snapshot: &Snapshot, fingerprint: u64) {
+    encode_as(out, snapshot, fingerprint, VERSION);
+}
+
+/// The checkpoint of `snapshot` in format `version`: the newest, or 6 (ids of 4 bytes;
+/// for the tests of older formats, which cut the rest).
+fn encode_as(out: &mut Vec<u8>, snapshot: &Snapshot, fingerprint: u64, version: u32) {
+    let wide = version >= 7;
     let start = out.len();
     out.reserve(encoded_size(snapshot));
     let p = &snapshot.particles;
     out.extend_from_slice(MAGIC);
-    out.extend_from_slice(&VERSION.to_le_bytes());
+    out.extend_from_slice(&version.to_le_bytes());
     out.extend_from_slice(&fingerprint.to_le_bytes());
     out.extend_from_slice(&snapshot.steps.to_le_bytes());
     out.extend_from_slice(&snapshot.built_at.to_le_bytes());
     out.extend_from_slice(&snapshot.spawner.word_pos.to_le_bytes());
     out.push(snapshot.spawner.pending_radius.is_some() as u8);
     put_f64s(out, &[snapshot.spawner.pending_radius.unwrap_or(0.0)]);
-    out.extend_from_slice(&p.next_id.to_le_bytes());
+    put_id(out, p.next_id, wide);
     out.extend_from_slice(&(p.len() as u64).to_le_bytes());
     for (k, q) in p.iter().enumerate() {
-        out.extend_from_slice(&p.id[k].to_le_bytes());
+        put_id(out, p.id[k], wide);
         put_f64s(
             out,
             &[
@@ -117,8 +143,8 @@ pub fn encode_into(out: &mut Vec<u8>, snapshot: &Snapshot, fingerprint: u64) {
         out.extend_from_slice(&i.to_le_bytes());
         put_f64s(out, &[allowance]);
     }
-    put_history(out, &snapshot.pair_history);
-    put_history(out, &snapshot.face_history);
+    put_history(out, &snapshot.pair_history, wide);
+    put_history(out, &snapshot.face_history, wide);
     let removed = &snapshot.removed;
     let put_outflow = |out: &mut Vec<u8>, o: &Outflow| {
         out.extend_from_slice(&o.count.to_le_bytes());
@@ -153,15 +179,15 @@ pub fn encode_into(out: &mut Vec<u8>, snapshot: &Snapshot, fingerprint: u64) {
         out.extend_from_slice(&file.to_le_bytes());
         put_f64s(out, &[s.position, s.speed, s.built, s.load]);
     }
-    put_bodies(out, &p.bodies.list);
+    put_bodies(out, &p.bodies.list, wide);
     let crc = crc32fast::hash(&out[start..]);
     out.extend_from_slice(&crc.to_le_bytes());
 }
 
-fn put_bodies(out: &mut Vec<u8>, bodies: &[Body]) {
+fn put_bodies(out: &mut Vec<u8>, bodies: &[Body], wide: bool) {
     out.extend_from_slice(&(bodies.len() as u64).to_le_bytes());
     for b in bodies {
-        out.extend_from_slice(&b.id.first().to_le_bytes());
+        put_id(out, b.id.first(), wide);
         out.extend_from_slice(&b.template.to_le_bytes());
         let (x, v, q, w, i) = (b.x, b.v, b.q, b.w, b.inertia);
         put_f64s(
@@ -199,6 +225,8 @@ fn put_bodies(out: &mut Vec<u8>, bodies: &[Body]) {
 struct Cursor<'a> {
     bytes: &'a [u8],
     at: usize,
+    /// Whether ids take 8 bytes (format 7 on) or 4.
+    wide: bool,
 }
 
 impl Cursor<'_> {
@@ -224,6 +252,17 @@ impl Cursor<'_> {
     fn u64(&mut self) -> Result<u64> {
         Ok(u64::from_le_bytes(self.take(8)?.try_into()?))
     }
+    /// A particle id: 8 bytes from format 7 on, 4 before.
+    fn id(&mut self) -> Result<Id> {
+        match self.wide {
+            true => self.u64(),
+            false => self.u32().map(Id::from),
+        }
+    }
+    /// The bytes of an id in this format.
+    fn id_size(&self) -> usize {
+        if self.wide { 8 } else { 4 }
+    }
     fn u128(&mut self) -> Result<u128> {
         Ok(u128::from_le_bytes(self.take(16)?.try_into()?))
     }
@@ -241,11 +280,11 @@ impl Cursor<'_> {
         }
         Ok(n as usize)
     }
-    fn history(&mut self) -> Result<Vec<(u32, u32, Springs)>> {
-        let n = self.count(8 + 56)?;
+    fn history(&mut self) -> Result<Vec<Entry>> {
+        let n = self.count(2 * self.id_size() + 56)?;
         (0..n)
             .map(|_| {
-                let (i, j) = (self.u32()?, self.u32()?);
+                let (i, j) = (self.id()?, self.id()?);
                 let s = Springs {
                     u_s: self.vec3()?,
                     u_r: self.vec3()?,
@@ -274,7 +313,7 @@ fn bounded(x: DVec3) -> bool {
 /// Checks the particles of a checkpoint as any input is checked: finite states within
 /// [`STATE_BOUND`], radii > 0, unit quaternions. A checksum only says the bytes are those
 /// written, not that what was written is a state.
-fn check_states(ids: &[u32], p: &Particles) -> Result<()> {
+fn check_states(ids: &[Id], p: &Particles) -> Result<()> {
     for (k, &id) in ids.iter().enumerate() {
         let fields = [
             ("position", p.x[k]),
@@ -312,7 +351,7 @@ pub fn decode(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<Snapsho
     let word_pos = r.u128()?;
     let has_pending = r.u8()? != 0;
     let pending = r.f64()?;
-    let next_id = r.u32()?;
+    let next_id = r.id()?;
     let v3 = version >= 3;
     let (particles, anchors) = r.particles(version, next_id)?;
     let lonely = r.lonely(particles.len())?;
@@ -377,6 +416,7 @@ fn checked_body(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<(u32,
     let mut r = Cursor {
         bytes: body,
         at: 16,
+        wide: version >= 7,
     };
     let fingerprint = r.u64()?;
     if expected_fingerprint.is_some_and(|f| f != fingerprint) {
@@ -403,14 +443,14 @@ impl Cursor<'_> {
     /// The particles of a checkpoint of format `version` (material indices from format 3
     /// on, fixed from 5), checked, with their ids below `next_id`; and their anchors, if the
     /// lists were built.
-    fn particles(&mut self, version: u32, next_id: u32) -> Result<(Particles, Vec<DVec3>)> {
+    fn particles(&mut self, version: u32, next_id: Id) -> Result<(Particles, Vec<DVec3>)> {
         let r = self;
         let (v3, v5) = (version >= 3, version >= 5);
-        let n = r.count(4 + 14 * 8 + 4 + 2 * v3 as usize + v5 as usize)?;
+        let n = r.count(r.id_size() + 14 * 8 + 4 + 2 * v3 as usize + v5 as usize)?;
         let mut particles = Particles::default();
         let mut ids = Vec::with_capacity(n);
         for _ in 0..n {
-            ids.push(r.u32()?);
+            ids.push(r.id()?);
             let x = r.vec3()?;
             let radius = r.f64()?;
             let v = r.vec3()?;
@@ -448,14 +488,14 @@ impl Cursor<'_> {
     /// The rigid bodies (format 6), finite, ascending by id.
     fn bodies(&mut self) -> Result<Vec<Body>> {
         let r = self;
-        let count = r.count(4 + 2 + 19 * 8 + 4)?;
+        let count = r.count(r.id_size() + 2 + 19 * 8 + 4)?;
         let mut bodies = Vec::with_capacity(count);
         for _ in 0..count {
-            let id = r.u32()?;
+            let id = r.id()?;
             let template = r.u16()?;
             let f: Vec<f64> = (0..19).map(|_| r.f64()).collect::<Result<_>>()?;
             let n = r.u32()? as usize;
-            if n > (r.bytes.len() - r.at) / 24 || n < 2 || id.checked_add(n as u32).is_none() {
+            if n > (r.bytes.len() - r.at) / 24 || n < 2 || id.checked_add(n as Id).is_none() {
                 bail!("corrupt checkpoint: a body of {n} spheres");
             }
             let offsets = (0..n).map(|_| r.vec3()).collect::<Result<Vec<_>>>()?;
@@ -585,7 +625,7 @@ fn join_bodies(particles: &mut Particles, bodies: Vec<Body>) -> Result<()> {
         at.insert(id, k);
     }
     for b in &bodies {
-        for id in b.id.first()..b.id.first() + b.offsets.len() as u32 {
+        for id in b.id.first()..b.id.first() + b.offsets.len() as Id {
             let Some(&k) = at.get(&id) else {
                 bail!(
                     "corrupt checkpoint: sphere {id} of body {} is missing",

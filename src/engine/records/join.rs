@@ -5,8 +5,8 @@ use anyhow::{Result, bail, ensure};
 use glam::DVec3;
 
 use super::Snapshot;
-use crate::model::particles::{Particle, Particles};
-use crate::model::springs::Springs;
+use crate::model::particles::{Id, Particle, Particles};
+use crate::neighbours::Entry;
 
 /// The snapshot the pieces of all processes make (each the state of one process's
 /// particles, the springs of the contacts it holds one of, and the state all share): all
@@ -38,7 +38,7 @@ pub fn join(pieces: Vec<Snapshot>) -> Result<Snapshot> {
             "corrupt: part {k} lacks the anchors of its particles"
         );
     }
-    let mut all: Vec<(u32, Particle, DVec3)> = Vec::new();
+    let mut all: Vec<(Id, Particle, DVec3)> = Vec::new();
     for p in &pieces {
         let q = &p.particles;
         all.extend((0..q.len()).map(|i| (q.id[i], q.get(i), p.anchors[i])));
@@ -65,7 +65,7 @@ pub fn join(pieces: Vec<Snapshot>) -> Result<Snapshot> {
             .for_each(|b| particles.bodies.insert(b.clone()));
     }
     particles.locate_bodies();
-    let springs = |of: fn(&Snapshot) -> &Vec<(u32, u32, Springs)>| {
+    let springs = |of: fn(&Snapshot) -> &Vec<Entry>| {
         dedup(pieces.iter().flat_map(|p| of(p).iter().copied()).collect())
     };
     Ok(Snapshot {
@@ -87,7 +87,7 @@ pub fn join(pieces: Vec<Snapshot>) -> Result<Snapshot> {
 
 /// Entries sorted by their pair of keys, each once (the copies two processes hold of a
 /// contact are the same bits: both evaluated it from the same states).
-fn dedup(mut entries: Vec<(u32, u32, Springs)>) -> Vec<(u32, u32, Springs)> {
+fn dedup(mut entries: Vec<Entry>) -> Vec<Entry> {
     entries.sort_unstable_by_key(|e| (e.0, e.1));
     entries.dedup_by_key(|e| (e.0, e.1));
     entries

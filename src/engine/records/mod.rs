@@ -10,8 +10,8 @@ pub use bytes::{decode, encode, encode_into};
 pub use join::join;
 
 use crate::engine::spawn::SpawnerState;
-use crate::model::particles::Particles;
-use crate::model::springs::Springs;
+use crate::model::particles::{Id, Particles};
+use crate::neighbours::Entry;
 
 /// Everything needed to continue a run bit for bit: particles (in storage order, with their
 /// ids), step count, the spawner's place in its random stream, the contact history (the
@@ -27,8 +27,8 @@ pub struct Snapshot {
     pub anchors: Vec<DVec3>,
     pub lonely: Vec<(u32, f64)>,
     /// Particle pairs by (lower id, higher id) and particle-face contacts by (id, face).
-    pub pair_history: Vec<(u32, u32, Springs)>,
-    pub face_history: Vec<(u32, u32, Springs)>,
+    pub pair_history: Vec<Entry>,
+    pub face_history: Vec<Entry>,
     /// The particles removed so far.
     pub removed: Removed,
     /// The loads on the mesh files summed since the last frame (`[output] wall_forces`).
@@ -46,7 +46,7 @@ pub struct Snapshot {
 /// The partner of a particle in a contact.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Partner {
-    Particle(usize),
+    Particle(Id),
     Face(usize),
 }
 
@@ -92,7 +92,7 @@ impl std::ops::AddAssign for Wrench {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ContactRecord {
     /// The particle (its id; the lower one of a pair).
-    pub id: u32,
+    pub id: Id,
     /// The other particle (its id) or the face (its index in the mesh).
     pub with: Partner,
     /// Where the two touch: x_i - r_i n (Eq. 29).
@@ -107,10 +107,10 @@ pub struct ContactRecord {
 impl ContactRecord {
     /// Where it stands in a network: pairs by (lower id, higher id), then contacts with
     /// faces by (id, face).
-    pub fn network_order(&self) -> (u8, u32, usize) {
+    pub fn network_order(&self) -> (u8, Id, Id) {
         match self.with {
             Partner::Particle(j) => (0, self.id, j),
-            Partner::Face(f) => (1, self.id, f),
+            Partner::Face(f) => (1, self.id, f as Id),
         }
     }
 }

@@ -33,7 +33,7 @@ pub(super) fn migrate(
     d: &mut Domain,
     (p, periodic): (Particles, Option<Periodic>),
     anchors: Option<Vec<DVec3>>,
-    gone: &FxHashSet<u32>,
+    gone: &FxHashSet<Id>,
     entries: Entries,
 ) -> (Particles, Option<Vec<DVec3>>, Entries) {
     let carry = anchors.is_some();
@@ -152,19 +152,19 @@ impl Destinations {
         d: &Domain,
         p: &Particles,
         place: &[DVec3],
-        gone: &FxHashSet<u32>,
+        gone: &FxHashSet<Id>,
         (pairs, faces): &Entries,
     ) -> Destinations {
         let k = d.comm.size();
-        let index: FxHashMap<u32, u32> =
+        let index: FxHashMap<Id, u32> =
             p.id.iter()
                 .enumerate()
                 .map(|(i, &id)| (id, i as u32))
                 .collect();
         let tree = d.tree.as_ref().expect("cut");
-        let owner = |id: u32| tree.owner(place[index[&id] as usize]);
+        let owner = |id: Id| tree.owner(place[index[&id] as usize]);
         // (A share of a checkpoint's parts has springs of particles it does not hold.)
-        let mine = |id: u32| index.get(&id).is_some_and(|&i| d.owned[i as usize]);
+        let mine = |id: Id| index.get(&id).is_some_and(|&i| d.owned[i as usize]);
         let mut to = Destinations {
             particles: vec![Vec::new(); k],
             bodies: vec![Vec::new(); k],
@@ -267,7 +267,7 @@ pub(super) fn exchange_ghosts(
     held: &mut Particles,
     held_at: &mut Option<Vec<DVec3>>,
     reach: (f64, f64, Option<Periodic>),
-) -> (Vec<Vec<u32>>, Vec<Vec<u32>>) {
+) -> (Vec<Vec<Id>>, Vec<Vec<Id>>) {
     let k = d.comm.size();
     let (ghosts_to, bodies_to) = ghost_destinations(d, held, held_at.as_deref(), reach);
     let messages: Vec<Vec<u8>> = (0..k)
@@ -287,11 +287,11 @@ pub(super) fn exchange_ghosts(
             w.0
         })
         .collect();
-    let ghosts_to: Vec<Vec<u32>> = ghosts_to
+    let ghosts_to: Vec<Vec<Id>> = ghosts_to
         .into_iter()
         .map(|list| list.into_iter().map(|i| held.id[i as usize]).collect())
         .collect();
-    let mut ghosts_from: Vec<Vec<u32>> = vec![Vec::new(); k];
+    let mut ghosts_from: Vec<Vec<Id>> = vec![Vec::new(); k];
     for (q, m) in d.comm.all_to_all(messages).into_iter().enumerate() {
         let mut r = Reader::new(&m);
         for _ in 0..r.u64() {

@@ -100,6 +100,7 @@ pub fn load(path: &Path, fingerprint: Option<u64>) -> Result<Snapshot> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::engine::records::bytes::encode_v6;
     use crate::engine::records::{Outflow, Removed, Wrench};
     use crate::engine::spawn::{RegionState, SpawnerState};
     use crate::model::particles::{Particle, Particles};
@@ -206,6 +207,14 @@ mod tests {
         assert_eq!(decode(&encode(&s, 7), Some(7)).unwrap(), s);
         s.particles.fixed[0] = true;
         assert_eq!(decode(&encode(&s, 7), Some(7)).unwrap(), s);
+        // Ids past 2^32 (a long run's), in the particles, the springs and the next id.
+        let big = 5_000_000_000;
+        s.particles.id[0] += big;
+        s.particles.next_id += big;
+        s.pair_history[0].0 += big;
+        s.pair_history[0].1 += big;
+        s.face_history[0].0 += big;
+        assert_eq!(decode(&encode(&s, 7), Some(7)).unwrap(), s);
     }
 
     /// A snapshot's bytes with format `version` for `bytes` of the newest format whose
@@ -233,7 +242,7 @@ mod tests {
         (s.scenario, s.mesh_files) = (String::new(), Vec::new());
         (s.spawner.regions, s.servos) = (Vec::new(), Vec::new());
         s.spawner.box_off = false;
-        let v6 = encode(&s, 7);
+        let v6 = encode_v6(&s, 7);
         let n = v6.len() - 4;
         // The one particle's record starts at byte 77 (after the header and the count); its
         // material and fixed flag are the last 3 of its 123 bytes; the counts of removals,
@@ -244,9 +253,10 @@ mod tests {
     }
 
     #[test]
-    fn versions_3_to_5_are_read() {
+    fn versions_3_to_6_are_read() {
         let mut s = snapshot();
-        let v6 = encode(&s, 7);
+        let v6 = encode_v6(&s, 7);
+        assert_eq!(decode(&v6, Some(7)).unwrap(), s, "format 6: ids of 4 bytes");
         let n = v6.len() - 4;
         // Format 5 has no bodies (their count ends format 6).
         let v5 = older(&v6, 5, &[(n - 8, n)]);
@@ -256,7 +266,7 @@ mod tests {
         assert_eq!(decode(&v4, Some(7)).unwrap(), s);
         // Format 3 ends before the spawn box's flag and the count of servos.
         (s.servos, s.spawner.box_off) = (Vec::new(), false);
-        let v6 = encode(&s, 7);
+        let v6 = encode_v6(&s, 7);
         let n = v6.len() - 4;
         let v3 = older(&v6, 3, &[(77 + 122, 77 + 123), (n - 17, n)]);
         assert_eq!(decode(&v3, Some(7)).unwrap(), s);

@@ -395,7 +395,7 @@ mod tests {
         assert_eq!(share(0, 1), whole, "one share: all parts");
         for count in [2, 3] {
             let shares: Vec<Snapshot> = (0..count).map(|j| share(j, count)).collect();
-            let ids: Vec<u32> = shares.iter().flat_map(|s| s.particles.id.clone()).collect();
+            let ids: Vec<u64> = shares.iter().flat_map(|s| s.particles.id.clone()).collect();
             assert_eq!(ids, [4, 3], "{count} shares: each part once, in order");
             for s in &shares {
                 assert_eq!(
