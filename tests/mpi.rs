@@ -469,6 +469,46 @@ fn a_checkpoint_in_parts_of_3_processes_resumes_in_shares_on_4_2_and_1_with_the_
             std::fs::copy(e.path(), dir.path().join(to).join(e.file_name())).unwrap();
         }
     };
+    // Parts of two runs mixed (another run's part 0, of the same step): refused, on 3
+    // processes that each read one part and in one that reads all.
+    let tagged = dir.path().join("tagged.toml");
+    let other = std::fs::read_to_string(&short).unwrap()
+        + "[[tags]]\nmin = [-1.0, -1.0, -1.0]\nmax = [0.0, 1.0, 1.0]\ntag = 3\n";
+    std::fs::write(&tagged, other).unwrap();
+    run(
+        3,
+        &["run", tagged.to_str().unwrap(), "-o", "other", "-q"],
+        dir.path(),
+    );
+    copy("mixed");
+    let part0 = std::fs::read_dir(dir.path().join("other"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .find(|n| n.contains(".part-0-of-3"))
+        .unwrap();
+    let from = dir.path().join("other").join(&part0);
+    std::fs::copy(from, dir.path().join("mixed").join(&part0)).unwrap();
+    let args = [
+        "run",
+        name,
+        "-o",
+        "mixed",
+        "-q",
+        "--resume",
+        "mixed/checkpoint.bin",
+    ];
+    for np in [3, 1] {
+        let out = match np {
+            1 => common::tinydem(&args, dir.path()),
+            _ => mpirun(np, &args, dir.path()).output().unwrap(),
+        };
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{np}: mixed parts resumed");
+        assert!(
+            err.contains("not of one state") || err.contains("not of the state of part 0"),
+            "{np}: {err}"
+        );
+    }
     // And the parts joined into one file by `tinydem checkpoint merge`, resumed in one.
     copy("merged");
     run(

@@ -344,16 +344,7 @@ fn open_on(
     }
     if let Some(path) = options.resume {
         // Each process reads its share of a checkpoint in parts, none them all.
-        let share = resume_share(&scenario, path, &*comm);
-        let share = crate::parallel::domain::agree(&*comm, share)?;
-        let parts = share.is_some();
-        if comm.any(parts) && comm.any(!parts) {
-            anyhow::bail!(
-                "the processes found different checkpoints at {}",
-                path.display()
-            );
-        }
-        if let Some((sim, pending)) = share {
+        if let Some((sim, pending)) = resume_share(&scenario, path, &*comm)? {
             return Ok((sim.split_shares_with(comm, pending)?, Vec::new()));
         }
     }
@@ -363,22 +354,42 @@ fn open_on(
 }
 
 /// This process's share of the checkpoint at `path` restored, with the springs its
-/// particles share with others' (`None` if it is one file, which every process reads).
+/// particles share with others' (collective; `None` on all if it is one file, which every
+/// process reads).
 fn resume_share(
     scenario: &Scenario,
     path: &Path,
     comm: &dyn Comm,
 ) -> Result<Option<(Simulation, Entries)>> {
-    let fresh = Simulation::new(Scenario {
-        particles: None,
-        ..scenario.clone()
-    })?;
-    let fingerprint = Some(fingerprint(&fresh));
-    let share = (comm.rank(), comm.size());
-    let Some(snapshot) = checkpoint::load_share(path, fingerprint, share)? else {
+    let load = || {
+        let fresh = Simulation::new(Scenario {
+            particles: None,
+            ..scenario.clone()
+        })?;
+        let share = (comm.rank(), comm.size());
+        checkpoint::load_share(path, Some(fingerprint(&fresh)), share)
+    };
+    let loaded = crate::parallel::domain::agree(comm, load())?;
+    let (some, none) = (comm.any(loaded.is_some()), comm.any(loaded.is_none()));
+    let Some(snapshot) = loaded.filter(|_| !none) else {
+        anyhow::ensure!(
+            !some,
+            "the processes found different checkpoints at {}",
+            path.display()
+        );
         return Ok(None);
     };
-    Simulation::restore_share(scenario.clone(), snapshot).map(Some)
+    // Every share of one state: the parts each process read hold the same shared state (a
+    // part of another run or step among them would not).
+    let mine = checkpoint::encode(&checkpoint::shared_part(&snapshot), 0);
+    let all = comm.all_gather(mine);
+    anyhow::ensure!(
+        all.iter().all(|s| *s == all[0]),
+        "the parts of {} are not of one state (a part of another run or step among them?)",
+        path.display()
+    );
+    let restored = Simulation::restore_share(scenario.clone(), snapshot);
+    crate::parallel::domain::agree(comm, restored).map(Some)
 }
 
 /// What `tinydem check` would refuse the run for (collective): an error naming it all.

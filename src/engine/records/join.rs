@@ -8,6 +8,22 @@ use super::Snapshot;
 use crate::model::particles::{Id, Particle, Particles};
 use crate::neighbours::Entry;
 
+/// The state all pieces of a snapshot share: `piece` without its particles, anchors and
+/// springs (the piece of a process that holds none).
+pub fn shared_part(piece: &Snapshot) -> Snapshot {
+    Snapshot {
+        particles: Particles {
+            next_id: piece.particles.next_id,
+            ..Particles::default()
+        },
+        anchors: Vec::new(),
+        lonely: Vec::new(),
+        pair_history: Vec::new(),
+        face_history: Vec::new(),
+        ..piece.clone()
+    }
+}
+
 /// The snapshot the pieces of all processes make (each the state of one process's
 /// particles, the springs of the contacts it holds one of, and the state all share): all
 /// particles in id order with their anchors, and every contact's springs once.

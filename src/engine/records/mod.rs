@@ -7,7 +7,7 @@ use glam::DVec3;
 pub mod bytes;
 mod join;
 pub use bytes::{decode, encode, encode_into};
-pub use join::join;
+pub use join::{join, shared_part};
 
 use crate::engine::spawn::SpawnerState;
 use crate::model::particles::{Id, Particles};

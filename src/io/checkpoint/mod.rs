@@ -6,7 +6,7 @@
 use std::path::Path;
 
 use crate::engine::records::Snapshot;
-pub use crate::engine::records::{decode, encode, encode_into, hash, join};
+pub use crate::engine::records::{decode, encode, encode_into, hash, join, shared_part};
 use crate::geometry::mesh::Mesh;
 use crate::scenario::{FrictionSprings, Scenario};
 use anyhow::{Context, Result};

@@ -18,9 +18,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail, ensure};
 
-use super::{decode, encode_into, join};
+use super::{decode, encode_into, join, shared_part};
 use crate::engine::records::Snapshot;
-use crate::model::particles::Particles;
 
 const MAGIC: &[u8; 12] = b"TINYDEM PART";
 /// The bytes before a part's checkpoint.
@@ -239,16 +238,7 @@ pub fn load_share(
         return join_parts(&paths, share, fingerprint).map(Some);
     }
     let first = read_nth(&paths, 0, fingerprint)?;
-    Ok(Some(Snapshot {
-        particles: Particles {
-            next_id: first.particles.next_id,
-            ..Particles::default()
-        },
-        anchors: Vec::new(),
-        pair_history: Vec::new(),
-        face_history: Vec::new(),
-        ..first
-    }))
+    Ok(Some(shared_part(&first)))
 }
 
 fn read_part(bytes: &[u8], k: usize, n: usize, fingerprint: Option<u64>) -> Result<Snapshot> {
@@ -284,6 +274,7 @@ fn of_its_step(path: &Path, piece: &Snapshot) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::particles::Particles;
 
     /// Two pieces of one state (particles 3 and 4, their contact in both) and their join.
     fn pieces() -> (Vec<Snapshot>, Snapshot) {
