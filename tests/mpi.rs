@@ -432,6 +432,37 @@ fn frames_in_pieces_on_2_and_3_processes_are_the_gathered_frames() {
     }
 }
 
+/// The filling silo of 10 frames (its path), run to frame 6 in pieces on 3 processes into
+/// `dir/cut`: its checkpoint is in 3 parts. Returns the scenarios of 10 and 6 frames.
+fn silo_in_parts(dir: &Path) -> (PathBuf, PathBuf) {
+    let path = silo(dir, 10);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let short = dir.join("short.toml");
+    let in_pieces = text.replace("frames = 10", "frames = 6") + "gather = \"never\"\n";
+    std::fs::write(&short, in_pieces).unwrap();
+    run(3, &["run", short.to_str().unwrap(), "-o", "cut", "-q"], dir);
+    let names = file_names(&dir.join("cut"));
+    let parts = names.iter().filter(|n| n.contains(".part-")).count();
+    assert_eq!(parts, 3, "the checkpoint in a part per process");
+    (path, short)
+}
+
+/// The names of the files in `dir`.
+fn file_names(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect()
+}
+
+/// A copy of the directory `dir/from` at `dir/to`.
+fn copy_dir(dir: &Path, from: &str, to: &str) {
+    std::fs::create_dir(dir.join(to)).unwrap();
+    for name in file_names(&dir.join(from)) {
+        std::fs::copy(dir.join(from).join(&name), dir.join(to).join(&name)).unwrap();
+    }
+}
+
 #[test]
 fn a_checkpoint_in_parts_of_3_processes_resumes_in_shares_on_4_2_and_1_with_the_same_bytes() {
     // A run in pieces on 3 processes ends with its checkpoint in 3 parts; extended to more
@@ -439,78 +470,11 @@ fn a_checkpoint_in_parts_of_3_processes_resumes_in_shares_on_4_2_and_1_with_the_
     // reads all), on 2 and in one, the new frames are those of the run never cut. On 4,
     // every collective goes in rounds of a few kB (MPI's 32-bit counts for big messages).
     let dir = tempfile::tempdir().unwrap();
-    let path = silo(dir.path(), 10);
-    let text = std::fs::read_to_string(&path).unwrap();
+    let (path, _) = silo_in_parts(dir.path());
     let name = path.to_str().unwrap();
     run(1, &["run", name, "-o", "one", "-q"], dir.path());
-    let short = dir.path().join("short.toml");
-    let in_pieces = text.replace("frames = 10", "frames = 6") + "gather = \"never\"\n";
-    std::fs::write(&short, in_pieces).unwrap();
-    run(
-        3,
-        &["run", short.to_str().unwrap(), "-o", "cut", "-q"],
-        dir.path(),
-    );
-    let parts = std::fs::read_dir(dir.path().join("cut"))
-        .unwrap()
-        .filter(|e| {
-            e.as_ref()
-                .unwrap()
-                .file_name()
-                .to_string_lossy()
-                .contains(".part-")
-        })
-        .count();
-    assert_eq!(parts, 3, "the checkpoint in a part per process");
-    let copy = |to: &str| {
-        std::fs::create_dir(dir.path().join(to)).unwrap();
-        for e in std::fs::read_dir(dir.path().join("cut")).unwrap() {
-            let e = e.unwrap();
-            std::fs::copy(e.path(), dir.path().join(to).join(e.file_name())).unwrap();
-        }
-    };
-    // Parts of two runs mixed (another run's part 0, of the same step): refused, on 3
-    // processes that each read one part and in one that reads all.
-    let tagged = dir.path().join("tagged.toml");
-    let other = std::fs::read_to_string(&short).unwrap()
-        + "[[tags]]\nmin = [-1.0, -1.0, -1.0]\nmax = [0.0, 1.0, 1.0]\ntag = 3\n";
-    std::fs::write(&tagged, other).unwrap();
-    run(
-        3,
-        &["run", tagged.to_str().unwrap(), "-o", "other", "-q"],
-        dir.path(),
-    );
-    copy("mixed");
-    let part0 = std::fs::read_dir(dir.path().join("other"))
-        .unwrap()
-        .map(|e| e.unwrap().file_name().into_string().unwrap())
-        .find(|n| n.contains(".part-0-of-3"))
-        .unwrap();
-    let from = dir.path().join("other").join(&part0);
-    std::fs::copy(from, dir.path().join("mixed").join(&part0)).unwrap();
-    let args = [
-        "run",
-        name,
-        "-o",
-        "mixed",
-        "-q",
-        "--resume",
-        "mixed/checkpoint.bin",
-    ];
-    for np in [3, 1] {
-        let out = match np {
-            1 => common::tinydem(&args, dir.path()),
-            _ => mpirun(np, &args, dir.path()).output().unwrap(),
-        };
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert!(!out.status.success(), "{np}: mixed parts resumed");
-        assert!(
-            err.contains("not of one state") || err.contains("not of the state of part 0"),
-            "{np}: {err}"
-        );
-    }
     // And the parts joined into one file by `tinydem checkpoint merge`, resumed in one.
-    copy("merged");
+    copy_dir(dir.path(), "cut", "merged");
     run(
         1,
         &["checkpoint", "merge", "merged/checkpoint.bin"],
@@ -524,7 +488,7 @@ fn a_checkpoint_in_parts_of_3_processes_resumes_in_shares_on_4_2_and_1_with_the_
         ("merged", 1),
     ] {
         if out != "merged" {
-            copy(out);
+            copy_dir(dir.path(), "cut", out);
         }
         let checkpoint = format!("{out}/checkpoint.bin");
         let args = ["run", name, "-o", out, "-q", "--resume", &checkpoint];
@@ -552,6 +516,47 @@ fn a_checkpoint_in_parts_of_3_processes_resumes_in_shares_on_4_2_and_1_with_the_
                 assert!(read("one") == read(out), "{out}: {file} differs");
             }
         }
+    }
+}
+
+#[test]
+fn parts_of_two_runs_mixed_are_refused_on_any_process_count() {
+    // Another run's part 0, of the same step (the same silo with its grains tagged): on 3
+    // processes that each read one part, and in one that reads all.
+    let dir = tempfile::tempdir().unwrap();
+    let (path, short) = silo_in_parts(dir.path());
+    let tagged = dir.path().join("tagged.toml");
+    let other = std::fs::read_to_string(&short).unwrap()
+        + "[[tags]]\nmin = [-1.0, -1.0, -1.0]\nmax = [0.0, 1.0, 1.0]\ntag = 3\n";
+    std::fs::write(&tagged, other).unwrap();
+    run(
+        3,
+        &["run", tagged.to_str().unwrap(), "-o", "other", "-q"],
+        dir.path(),
+    );
+    copy_dir(dir.path(), "cut", "mixed");
+    let names = file_names(&dir.path().join("other"));
+    let part0 = names.iter().find(|n| n.contains(".part-0-of-3")).unwrap();
+    let from = dir.path().join("other").join(part0);
+    std::fs::copy(from, dir.path().join("mixed").join(part0)).unwrap();
+    let name = path.to_str().unwrap();
+    let args = [
+        "run",
+        name,
+        "-o",
+        "mixed",
+        "-q",
+        "--resume",
+        "mixed/checkpoint.bin",
+    ];
+    for (np, says) in [(3, "not of one state"), (1, "not of the state of part 0")] {
+        let out = match np {
+            1 => common::tinydem(&args, dir.path()),
+            _ => mpirun(np, &args, dir.path()).output().unwrap(),
+        };
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{np}: mixed parts resumed");
+        assert!(err.contains(says), "{np}: {err}");
     }
 }
 
