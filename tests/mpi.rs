@@ -297,6 +297,35 @@ fn ctrl_c_on_2_processes_checkpoints_and_3_resume_with_the_same_bytes() {
 }
 
 #[test]
+fn a_panic_on_one_process_ends_the_job_instead_of_leaving_the_others_waiting() {
+    // Process 1 panics at the start; the others wait in the run's first collective. MPI_Abort
+    // from the panic hook ends them all, with the message.
+    let dir = tempfile::tempdir().unwrap();
+    let path = silo(dir.path(), 2);
+    let mut child = mpirun(
+        3,
+        &["run", path.to_str().unwrap(), "-o", "out", "-q"],
+        dir.path(),
+    )
+    .env("TINYDEM_TEST_PANIC_RANK", "1")
+    .stderr(std::process::Stdio::piped())
+    .spawn()
+    .unwrap();
+    let start = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > Duration::from_secs(60) {
+            child.kill().unwrap();
+            panic!("the other processes still wait after 60 s");
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(err.contains("a panic on process 1 for the test"), "{err}");
+}
+
+#[test]
 fn a_bad_scenario_on_3_processes_gives_one_error() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("bad.toml"), "[geometry]\nradius_min = -1\n").unwrap();

@@ -8,9 +8,9 @@
 
 use std::num::NonZeroU64;
 
-use crate::model::particles::Id;
-
 use glam::{DQuat, DVec3};
+
+use crate::model::id::Id;
 
 /// The body a particle is a sphere of: the id of the body's first sphere.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]

@@ -9,13 +9,7 @@ use glam::{DQuat, DVec3};
 
 use crate::model::bodies::{Bodies, Body, BodyId};
 
-/// A particle's id: 64 bits, so that a long run may create more than 4.29e9 particles
-/// (files and checkpoints carry them whole).
-pub type Id = u64;
-
-/// The ids a file may give its particles are below this (2^62): far beyond any run, with
-/// room above for the ids the run gives new ones.
-pub const MAX_ID: Id = 1 << 62;
+pub use crate::model::id::{Id, MAX_ID};
 
 /// The state of every particle.
 #[derive(Clone, Debug, Default, PartialEq)]

@@ -211,6 +211,9 @@ mod over_mpi {
     /// The tag of [`super::Comm::exchange`]'s messages (the only point-to-point ones).
     const EXCHANGE: mpi::Tag = 7;
 
+    /// The error code a panic aborts the job with (`MPI_Abort`).
+    const PANICKED: i32 = 70;
+
     /// The processes of `mpirun`, over the system's MPI (the `mpi` feature).
     pub struct Mpi {
         world: mpi::topology::SimpleCommunicator,
@@ -239,6 +242,13 @@ mod over_mpi {
                 threading >= mpi::Threading::Serialized,
                 "this MPI library does not allow calls from a thread other than the first"
             );
+            // A panic on one process would leave the others waiting in a collective for
+            // ever (and the job its allocation): after its message it ends the whole job.
+            let message = std::panic::take_hook();
+            std::panic::set_hook(Box::new(move |info| {
+                message(info);
+                mpi::topology::SimpleCommunicator::world().abort(PANICKED);
+            }));
             Ok((
                 Mpi {
                     world: universe.world(),

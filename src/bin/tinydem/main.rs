@@ -169,6 +169,11 @@ fn world() -> Result<(Option<Box<dyn Comm>>, Finalize)> {
     {
         let _ = size;
         let (comm, finalize) = tinydem::comm::Mpi::init()?;
+        // (For the test that a panic on one process ends them all, tests/mpi.rs.)
+        let panic_on = std::env::var("TINYDEM_TEST_PANIC_RANK").ok();
+        if panic_on.and_then(|r| r.parse().ok()) == Some(comm.rank()) {
+            panic!("a panic on process {} for the test", comm.rank());
+        }
         let comm: Box<dyn Comm> = Box::new(comm);
         Ok((Some(comm), Some(finalize)))
     }
