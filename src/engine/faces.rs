@@ -274,7 +274,7 @@ impl FaceStage<'_> {
                     if near.kin.delta > radius {
                         found.deep.lock().expect("not poisoned").push(Deep {
                             i,
-                            other: Partner::Face(self.partner[first + k] as usize),
+                            other: Against::Face(self.partner[first + k] as usize),
                             delta: near.kin.delta,
                             limit: radius,
                         });

@@ -273,13 +273,20 @@ impl StageTimes {
     }
 }
 
+/// What a particle overlaps too deeply: another particle (its storage index) or a face.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Against {
+    Particle(usize),
+    Face(usize),
+}
+
 /// An overlap deeper than `limit`, the smaller radius (the particle's, against a face):
 /// a warning; deeper than twice that, a sign of instability.
 #[derive(Clone, Copy, Debug)]
 pub struct Deep {
-    /// The particle's storage index, and its partner's (not its id) or the face.
+    /// The particle's storage index.
     i: usize,
-    other: Partner,
+    other: Against,
     delta: f64,
     limit: f64,
 }
@@ -301,15 +308,15 @@ impl Deep {
         };
         let i = ids[self.i];
         match self.other {
-            Partner::Particle(j) => {
-                let j = ids[j as usize];
+            Against::Particle(j) => {
+                let j = ids[j];
                 let (a, b) = (i.min(j), i.max(j));
                 format!(
                     "particles {a} and {b} overlap by {:.3e} m, more than the smaller {bound} {size:.3e} m",
                     self.delta
                 )
             }
-            Partner::Face(f) => format!(
+            Against::Face(f) => format!(
                 "particle {i} overlaps mesh face {f} by {:.3e} m, more than its {bound} {size:.3e} m",
                 self.delta
             ),
@@ -320,11 +327,11 @@ impl Deep {
     fn key(&self, ids: &[Id]) -> (Id, Partner) {
         let i = ids[self.i];
         match self.other {
-            Partner::Particle(j) => {
-                let j = ids[j as usize];
+            Against::Particle(j) => {
+                let j = ids[j];
                 (i.min(j), Partner::Particle(i.max(j)))
             }
-            face => (i, face),
+            Against::Face(f) => (i, Partner::Face(f)),
         }
     }
 }

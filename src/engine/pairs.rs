@@ -162,7 +162,7 @@ fn wrapped(
                 if kin.delta > limit {
                     found.deep.push(Deep {
                         i,
-                        other: Partner::Particle(j as Id),
+                        other: Against::Particle(j),
                         delta: kin.delta,
                         limit,
                     });
@@ -322,7 +322,7 @@ impl PairStage<'_> {
                 if delta[l] > limit {
                     found.deep.lock().expect("not poisoned").push(Deep {
                         i: i[l],
-                        other: Partner::Particle(j[l] as Id),
+                        other: Against::Particle(j[l]),
                         delta: delta[l],
                         limit,
                     });

@@ -106,6 +106,13 @@ pub struct Neighbours {
     /// Particles with nothing within reach at the last rebuild, each with how far it may
     /// move before the lists can miss a contact (half its clearance, at least skin / 2).
     lonely: Vec<(u32, f64)>,
+    /// Whether the allowances put off a rebuild since the last one (a particle past skin / 2
+    /// that did not make the lists stale).
+    lonely_paid: bool,
+    /// Whether the last rebuild came when it would have come without allowances: the next
+    /// rebuild then finds no lonely particles (their clearances, by brute force, cost more
+    /// than they save where grains in contact set the pace, as in the paper's hourglass).
+    lonely_idle: bool,
     /// Number of rebuilds so far.
     pub rebuilds: u64,
 }
@@ -219,8 +226,29 @@ impl Neighbours {
             return false;
         }
         if self.lonely.is_empty() {
+            // Allowances would have put this rebuild off only if every particle past
+            // skin / 2 has nothing listed.
+            if self.periodic.is_none() {
+                self.lonely_idle = !self.only_unlisted_beyond(x, limit);
+            }
             return true;
         }
+        let stale = self.stale_with_lonely(x, (radius, faces), (limit, mesh_drift));
+        self.lonely_paid |= !stale;
+        if stale {
+            self.lonely_idle = !self.lonely_paid;
+        }
+        stale
+    }
+
+    /// [`Neighbours::stale`] once some particle moved more than skin / 2 (its square `limit`).
+    fn stale_with_lonely(
+        &mut self,
+        x: &[DVec3],
+        (radius, faces): (&[f64], &[Face]),
+        (limit, mesh_drift): (f64, f64),
+    ) -> bool {
+        let moved = |a: DVec3, b: DVec3| (a - b).length_squared();
         // Some particle moved more than skin / 2: stale unless every such particle is a
         // lonely one within its own allowance, or one that can be re-anchored.
         let mut k = 0;
@@ -246,6 +274,27 @@ impl Neighbours {
             }
         }
         false
+    }
+
+    /// Whether every particle that moved more than skin / 2 (its square `limit`) since the
+    /// last rebuild has nothing listed: neither partners nor faces.
+    fn only_unlisted_beyond(&self, x: &[DVec3], limit: f64) -> bool {
+        let listed = self.listed(x.len());
+        (0..x.len())
+            .filter(|&i| (x[i] - self.x_at_build[i]).length_squared() > limit)
+            .all(|i| !listed[i])
+    }
+
+    /// Whether each of `n` particles has something in the lists: a partner or a face.
+    fn listed(&self, n: usize) -> Vec<bool> {
+        let mut listed = vec![false; n];
+        for &j in &self.pairs.partner {
+            listed[j as usize] = true;
+        }
+        for (i, l) in listed.iter_mut().enumerate() {
+            *l |= !self.pairs.run(i).is_empty() || !self.faces.run(i).is_empty();
+        }
+        listed
     }
 
     /// Re-anchors lonely particle `self.lonely[k]` at its current position if it is still
@@ -296,20 +345,16 @@ impl Neighbours {
     /// <= c_i. Clearances are found by brute force, so only while that stays cheap.
     fn find_lonely(&mut self, x: &[DVec3], radius: &[f64], faces: &[Face]) {
         let n = x.len();
-        let mut partnered = vec![false; n];
-        for &j in &self.pairs.partner {
-            partnered[j as usize] = true;
-        }
-        let listed = |i: usize| {
-            !self.pairs.run(i).is_empty() || partnered[i] || !self.faces.run(i).is_empty()
-        };
-        let candidates: Vec<usize> = (0..n).filter(|&i| !listed(i)).collect();
+        let listed = self.listed(n);
+        let candidates: Vec<usize> = (0..n).filter(|&i| !listed[i]).collect();
         let r_max = radius.iter().copied().fold(0.0, f64::max);
         const BUDGET: usize = 4_000_000;
+        self.lonely_paid = false;
         // Clearances by brute force do not see periodic images: no lonely particles then.
         if candidates.is_empty()
             || candidates.len() * (n + faces.len()) > BUDGET
             || self.periodic.is_some()
+            || self.lonely_idle
         {
             self.lonely = Vec::new();
             return;
@@ -655,6 +700,42 @@ mod tests {
         let k = at(&p, 2);
         p.x[k].x += 0.6 * skin;
         assert!(nb.stale(&p.x, &p.radius, &[], 0.0));
+    }
+
+    #[test]
+    fn lonely_clearances_are_skipped_while_listed_grains_set_the_pace() {
+        let radius = vec![0.01; 3];
+        let x = vec![
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(0.0199, 0.0, 0.0),
+            DVec3::new(0.0, 0.0, 0.5),
+        ];
+        let skin = 0.005;
+        let mut nb = Neighbours::new(skin);
+        let mut p = particles(&x, &radius);
+        nb.rebuild(&mut p, &[], &CellGrid::default());
+        assert_eq!(nb.lonely.len(), 1, "the grain far from the pair");
+        // The touching pair moves on together past skin / 2: a rebuild no allowance puts off.
+        for id in [0, 1] {
+            let k = at(&p, id);
+            p.x[k].y += 0.6 * skin;
+        }
+        assert!(nb.stale(&p.x, &p.radius, &[], 0.0));
+        nb.rebuild(&mut p, &[], &CellGrid::default());
+        assert!(
+            nb.lonely.is_empty(),
+            "no clearances while listed grains set the pace"
+        );
+        // The lone grain alone moves past skin / 2: an allowance would have put that off.
+        let k = at(&p, 2);
+        p.x[k].z -= 0.6 * skin;
+        assert!(nb.stale(&p.x, &p.radius, &[], 0.0));
+        nb.rebuild(&mut p, &[], &CellGrid::default());
+        assert_eq!(nb.lonely.len(), 1, "found again");
+        // And then it does: the grain moves on within its allowance, no rebuild.
+        let k = at(&p, 2);
+        p.x[k].z -= 0.6 * skin;
+        assert!(!nb.stale(&p.x, &p.radius, &[], 0.0));
     }
 
     #[test]
