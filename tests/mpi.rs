@@ -545,6 +545,15 @@ fn a_checkpoint_in_parts_of_3_processes_resumes_in_shares_on_4_2_and_1_with_the_
                 assert!(read("one") == read(out), "{out}: {file} differs");
             }
         }
+        // The collection lists each frame's file: the pieces' listings, then whole files.
+        let pvd = std::fs::read_to_string(dir.path().join(out).join("particles.pvd")).unwrap();
+        let files: Vec<&str> = (pvd.split("file=\"").skip(1))
+            .map(|t| &t[..t.find('"').unwrap()])
+            .collect();
+        let expected: Vec<String> = (0..=10)
+            .map(|k| format!("particles{k:06}.{}", if k <= 6 { "pvtu" } else { "vtu" }))
+            .collect();
+        assert_eq!(files, expected, "{out}");
     }
 }
 

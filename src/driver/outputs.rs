@@ -23,6 +23,8 @@ pub(super) struct Frames<'a> {
     /// Whether each process of a split run writes its own piece of each frame
     /// (`[output] gather`): `particlesNNNNNN_K.*`, listed by `particlesNNNNNN.pvtu`.
     pieces: bool,
+    /// The files each ParaView collection lists so far, frame by frame, by its stem.
+    listed: std::cell::RefCell<std::collections::HashMap<String, Vec<String>>>,
 }
 
 impl<'a> Frames<'a> {
@@ -40,6 +42,7 @@ impl<'a> Frames<'a> {
             },
             frame_time: sim.scenario.simulation.steps_per_frame as f64
                 * sim.scenario.simulation.timestep,
+            listed: Default::default(),
         }
     }
 
@@ -151,19 +154,22 @@ impl<'a> Frames<'a> {
     /// The ParaView collection `stem.pvd` of frames 0 to `k`: frame k's file of extension
     /// `ext`; an earlier frame's listing of pieces if it was written in pieces (a run
     /// resumed on another number of processes may change), else its one file.
+    /// Each earlier frame's file is looked for once (those this run did not write).
     fn collection(&self, stem: &str, k: u64, ext: &str) -> Result<()> {
         let one = if stem == "contacts" { "vtp" } else { "vtu" };
         let listing = if stem == "contacts" { "pvtp" } else { "pvtu" };
-        let entries: Vec<(f64, String)> = (0..=k)
-            .map(|f| {
-                let name = |e: &str| format!("{stem}{f:06}.{e}");
-                let file = match f == k {
-                    true => name(ext),
-                    false if self.dir.join(name(listing)).exists() => name(listing),
-                    false => name(one),
-                };
-                (f as f64 * self.frame_time, file)
-            })
+        let mut listed = self.listed.borrow_mut();
+        let files = listed.entry(stem.to_string()).or_default();
+        let k = k as usize;
+        files.truncate(k);
+        for f in files.len()..k {
+            let name = |e: &str| format!("{stem}{f:06}.{e}");
+            let written_in_pieces = self.dir.join(name(listing)).exists();
+            files.push(name(if written_in_pieces { listing } else { one }));
+        }
+        files.push(format!("{stem}{k:06}.{ext}"));
+        let entries: Vec<(f64, String)> = (files.iter().enumerate())
+            .map(|(f, file)| (f as f64 * self.frame_time, file.clone()))
             .collect();
         vtk::write_collection(&self.dir.join(format!("{stem}.pvd")), &entries)
     }
