@@ -115,7 +115,8 @@ impl History {
     }
 
     /// Every entry, ordered by the first key and then by the other.
-    pub fn entries(&self) -> Vec<(u32, u32, Springs)> {
+    #[cfg(test)]
+    pub(crate) fn entries(&self) -> Vec<(u32, u32, Springs)> {
         (0..self.start.len().saturating_sub(1))
             .flat_map(|a| {
                 (self.start[a] as usize..self.start[a + 1] as usize)

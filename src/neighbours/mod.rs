@@ -226,9 +226,10 @@ impl Neighbours {
             return false;
         }
         if self.lonely.is_empty() {
-            // Allowances would have put this rebuild off only if every particle past
-            // skin / 2 has nothing listed.
-            if self.periodic.is_none() {
+            // Skipped: allowances would have put this rebuild off only if every particle
+            // past skin / 2 has nothing listed. (None found otherwise: the next rebuild
+            // looks again; a split run's lists never have them.)
+            if self.lonely_idle {
                 self.lonely_idle = !self.only_unlisted_beyond(x, limit);
             }
             return true;
