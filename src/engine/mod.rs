@@ -697,6 +697,9 @@ impl Simulation {
         if regrid_faces || self.particles.max_radius() > self.face_grid_radius {
             self.regrid_faces();
         }
+        // The loads hold nothing between steps: their room is given back while the
+        // rebuild needs its own (the history of the contacts), and taken again after.
+        self.loads = Vec::new();
         self.neighbours
             .rebuild(&mut self.particles, &self.walls.mesh.faces, &self.face_grid);
         self.built();

@@ -61,6 +61,8 @@ impl Neighbours {
             }
             None => new.iter_mut().enumerate().for_each(|(k, v)| *v = k as u32),
         }
+        // The anchors go before the history is made, the old lists after.
+        self.x_at_build = Vec::new();
         let kept = |a: u32| (a != NONE).then_some(a);
         let history = Histories {
             pairs: ContactList::history_of(&[&self.pairs, &self.wrapped], n, |i, j| {
@@ -70,18 +72,17 @@ impl Neighbours {
             faces: self.faces.history(n, |i, f| kept(new[i]).map(|a| (a, f))),
         };
         drop(new);
-        // The old lists and anchors go before the new ones are made.
+        // The old lists go before the new ones are made.
         self.pairs = ContactList::default();
         self.faces = ContactList::default();
         self.wrapped = ContactList::default();
-        self.x_at_build = Vec::new();
         if let Some(order) = order {
             particles.permute(&order);
         }
-        let x = particles.x.clone();
-        self.build(&x, particles, faces, face_grid, layout, &history);
-        self.find_lonely(&x, &particles.radius, faces);
-        self.x_at_build = x;
+        self.build(&particles.x, particles, faces, face_grid, layout, &history);
+        drop(history);
+        self.find_lonely(&particles.x, &particles.radius, faces);
+        self.x_at_build = particles.x.clone();
         self.rebuilds += 1;
     }
 
