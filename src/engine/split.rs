@@ -289,8 +289,7 @@ impl Simulation {
             }
         }
         let mut d = self.domain.take().expect("a split run");
-        // The old lists and particles go as soon as what they hold is out; the loads hold
-        // nothing between steps (taken again by `built`).
+        // The old lists and particles go as soon as what they hold is out; the loads too.
         self.loads = Vec::new();
         let mut springs = self.neighbours.entries_by_id(&self.particles.id);
         springs.0.extend(pending.0);

@@ -15,6 +15,9 @@
 //! `Simulation`), so the resolution lies some 90 binary orders below it: far below the
 //! rounding of a float sum of the small forces.
 
+// With `plain-sums` the exact sums stand unused beside the float ones.
+#![cfg_attr(feature = "plain-sums", allow(dead_code, unused_imports))]
+
 use wide::{f64x8, i64x4, i64x8};
 
 /// Terms up to this many resolutions (2^104).
@@ -69,15 +72,23 @@ impl Scales8 {
     }
 }
 
+// Float sums in their place, to measure what exactness costs (`bench/exact.sh`).
+#[cfg(feature = "plain-sums")]
+mod plain;
+#[cfg(feature = "plain-sums")]
+pub use plain::Sum6;
+
 /// An exact sum of 6 components (a force and a torque in lanes 0-2 and 3-5 of the terms):
 /// each term `x` becomes `a = x 2^s` cut towards zero to whole resolutions, kept as `hi`
 /// units of 2^52 resolutions (words 0-5) and `lo` resolutions (words 6-11), two integers
 /// that add exactly in any order.
+#[cfg(not(feature = "plain-sums"))]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Sum6 {
     words: [i64; 12],
 }
 
+#[cfg(not(feature = "plain-sums"))]
 impl Sum6 {
     /// Adds components 0-5 of `x`, each in its scale; false if some component was beyond
     /// its range or not finite (the sum is then meaningless).
@@ -164,8 +175,25 @@ fn whole(x: f64x8) -> i64x8 {
     }
     #[cfg(not(all(target_arch = "x86_64", target_feature = "avx512dq")))]
     {
-        x.trunc_int()
+        whole_by_bits(x)
     }
+}
+
+/// [`whole`] where there is no vector conversion to 64-bit integers (AVX2, SSE, NEON; `wide`
+/// would convert lane by lane, which made the exact sums 30 % of an AVX2 build's step): for a
+/// whole `t` below 2^52 in magnitude, `|t| + 2^52` is exact and its bits are those of 2^52
+/// plus `|t|`; the sign is put back in two's complement. The same integers as the conversion
+/// for every lane below 2^52 in magnitude (cut towards zero first); lanes beyond it are
+/// garbage, as they are beyond the range of the sum anyway.
+#[cfg(any(test, not(all(target_arch = "x86_64", target_feature = "avx512dq"))))]
+#[inline(always)]
+fn whole_by_bits(x: f64x8) -> i64x8 {
+    use wide::bytemuck::cast;
+    let t = x.trunc();
+    let biased: i64x8 = cast(t.abs() + f64x8::splat(SPLIT));
+    let magnitude = biased - i64x8::splat(SPLIT.to_bits() as i64);
+    let negative: i64x8 = cast(t.simd_lt(f64x8::ZERO)); // all ones where t < 0
+    (magnitude ^ negative) - negative
 }
 
 /// A force and a torque in the lanes of one vector (components 0-2 and 3-5).
@@ -174,7 +202,7 @@ pub fn pack(f: glam::DVec3, tau: glam::DVec3) -> f64x8 {
     f64x8::from([f.x, f.y, f.z, tau.x, tau.y, tau.z, 0.0, 0.0])
 }
 
-#[cfg(test)]
+#[cfg(all(test, not(feature = "plain-sums")))]
 mod tests {
     use super::*;
     use glam::DVec3;
@@ -222,6 +250,35 @@ mod tests {
         assert_eq!(a, b);
         let float: f64 = (0..3000).map(|k| 0.999 - (k % 7) as f64).sum();
         assert!((a.value(&s)[0] - float).abs() < 1e-9 * float.abs());
+    }
+
+    #[test]
+    fn the_conversion_by_bits_cuts_towards_zero_as_a_plain_conversion_below_2_to_the_52() {
+        let big = SPLIT - 1.0;
+        let mut values = vec![0.0, -0.0, 0.5, -0.5, 1.0, -1.0, 2.7, -2.7, big, -big];
+        values.extend([
+            big - 0.5,
+            -(big - 0.5),
+            2f64.powi(51) + 0.5,
+            -(2f64.powi(51) + 0.5),
+        ]);
+        let mut r = 0x2545f4914f6cdd1du64;
+        for _ in 0..4000 {
+            r ^= r << 13;
+            r ^= r >> 7;
+            r ^= r << 17;
+            let scale = 2f64.powi((r % 53) as i32);
+            let unit = (r >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0;
+            values.push((unit * scale).clamp(-big, big));
+        }
+        for chunk in values.chunks(8) {
+            let mut lanes = [0.0; 8];
+            lanes[..chunk.len()].copy_from_slice(chunk);
+            let got = whole_by_bits(f64x8::from(lanes)).to_array();
+            for (x, g) in lanes.iter().zip(got) {
+                assert_eq!(g, *x as i64, "{x}");
+            }
+        }
     }
 
     proptest! {
