@@ -650,6 +650,32 @@ fn start_run(dir: &Path, first: &str) -> std::process::Child {
     child
 }
 
+/// Waits until a thread of `child` waits in the opening of a FIFO for a reader (the kernel
+/// names that wait `wait_for_partner`, `fifo_open` in older kernels): not a guess of how
+/// long the steps before it take, which a busy machine stretches.
+fn wait_until_blocked_on_a_fifo(child: &std::process::Child) {
+    let tasks = format!("/proc/{}/task", child.id());
+    // Where the kernel hides wait channels (`0`), a thread asleep in openat (257) will do.
+    let blocked = || {
+        std::fs::read_dir(&tasks).into_iter().flatten().any(|t| {
+            let t = t.unwrap().path();
+            let read = |f: &str| std::fs::read_to_string(t.join(f)).unwrap_or_default();
+            let wchan = read("wchan");
+            wchan.contains("wait_for_partner")
+                || wchan.contains("fifo_open")
+                || (wchan == "0" && read("syscall").starts_with("257 "))
+        })
+    };
+    let start = Instant::now();
+    while !blocked() {
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "the run never blocked on the FIFO"
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+}
+
 fn signal(child: &std::process::Child, signal: i32) {
     // SAFETY: kill sends a signal to the child's process id; nothing else.
     assert_eq!(unsafe { libc::kill(child.id() as i32, signal) }, 0);
@@ -715,8 +741,9 @@ fn a_second_signal_ends_a_blocked_run_at_once() {
         assert!(start.elapsed() < Duration::from_secs(60), "run too slow");
         std::thread::sleep(Duration::from_millis(2));
     }
-    // Frame 2 is out; frame 3 cannot be written.
-    std::thread::sleep(Duration::from_millis(500));
+    // Frame 2 is out; frame 3 cannot be written: wait until the run is stuck in it (on a
+    // loaded machine the steps up to frame 3 may take seconds).
+    wait_until_blocked_on_a_fifo(&child);
     signal(&child, libc::SIGTERM);
     std::thread::sleep(Duration::from_millis(500));
     let mut child = child;
