@@ -70,6 +70,15 @@ fn the_readmes_scenario_parses() {
     assert_eq!(found.len(), 1, "the README shows one scenario");
     let s = parse(&readme, found[0].0, &found[0].1);
     assert_eq!(s.simulation.max_particles, 2000);
+    // As a newcomer saves it: it runs, with no file the repository lacks, and pours.
+    let t = tempfile::tempdir().unwrap();
+    let path = t.path().join("pour.toml");
+    std::fs::write(&path, &found[0].1).unwrap();
+    let mut sim = tinydem::simulation::Simulation::new(Scenario::load(&path).unwrap()).unwrap();
+    for _ in 0..2000 {
+        sim.step().unwrap();
+    }
+    assert!(sim.particles.len() > 100, "{} grains", sim.particles.len());
 }
 
 #[test]

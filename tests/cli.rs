@@ -44,15 +44,55 @@ fn missing_scenario_file() {
 #[test]
 fn missing_mesh_and_particle_files() {
     let t = tempfile::tempdir().unwrap();
+    let dir = std::path::absolute(t.path()).unwrap();
+    let tried = |name: &str| dir.join(name).display().to_string();
+    // The scenario, the key and the path tried, before anything runs.
     write(t.path(), "m.toml", "[geometry]\nmesh = \"absent.off\"\n");
     fails_with(
         &tinydem(&["run", "m.toml"], t.path()),
-        &["cannot read mesh file", "absent.off"],
+        &["m.toml: [geometry] mesh: cannot read", &tried("absent.off")],
+    );
+    let shapes = "[[meshes]]\nshape = { type = \"plane\", point = [0.0, 0.0, 0.0], normal = [0.0, 0.0, 1.0], size = 1.0 }\n";
+    write(
+        t.path(),
+        "k.toml",
+        &format!("{shapes}[[meshes]]\nfile = \"sub/box.stl\"\n"),
+    );
+    fails_with(
+        &tinydem(&["check", "k.toml"], t.path()),
+        &["k.toml: [[meshes]] #2 file: cannot read", &tried("sub/box.stl")],
     );
     write(t.path(), "p.toml", "[input]\nparticles = \"absent.csv\"\n");
     fails_with(
         &tinydem(&["run", "p.toml"], t.path()),
-        &["cannot read particle file", "absent.csv"],
+        &["p.toml: [input] particles: cannot read", &tried("absent.csv")],
+    );
+}
+
+#[test]
+fn the_default_run_takes_the_run_options_and_misplaced_ones_are_explained() {
+    let t = tempfile::tempdir().unwrap();
+    // The hint of a refused second run works as written.
+    let o = tinydem(&["--output", "first", "--quiet"], t.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(t.path().join("first/particles000001.csv").exists());
+    fails_with(
+        &tinydem(&["-o", "first", "-q"], t.path()),
+        &["or --output another directory"],
+    );
+    fails_with(
+        &tinydem(&["--output", "x", "render", "first"], t.path()),
+        &["go after the command: tinydem render ... --output DIR"],
+    );
+    // A run killed before its first checkpoint: --resume says why there is none.
+    std::fs::remove_file(t.path().join("first/checkpoint.bin")).unwrap();
+    fails_with(
+        &tinydem(&["-o", "first", "--resume", "first/checkpoint.bin"], t.path()),
+        &[
+            "holds frames up to particles000100.csv but no checkpoint",
+            "checkpoint_minutes",
+            "--overwrite",
+        ],
     );
 }
 

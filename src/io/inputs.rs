@@ -23,7 +23,41 @@ impl Scenario {
     pub fn load(path: &Path) -> Result<Scenario> {
         let text = files::read_to_string(path)
             .with_context(|| format!("cannot read scenario file {}", path.display()))?;
-        Scenario::parse(&text, path)
+        let s = Scenario::parse(&text, path)?;
+        s.check_files(path)?;
+        Ok(s)
+    }
+
+    /// The files the scenario names (meshes, the particle file) are there to read: else an
+    /// error naming the scenario, the key and the path tried, before anything runs.
+    fn check_files(&self, path: &Path) -> Result<()> {
+        let mut named: Vec<(String, &Path)> = Vec::new();
+        if let MeshSource::File(f) = &self.geometry.mesh {
+            named.push(("[geometry] mesh".into(), f));
+        }
+        for (k, m) in self.meshes.iter().enumerate() {
+            if let MeshInput::File(f) = &m.input {
+                named.push((format!("[[meshes]] #{} file", k + 1), f));
+            }
+        }
+        if let Some(f) = &self.particles {
+            named.push(("[input] particles".into(), f));
+        }
+        for (key, file) in named {
+            if let Err(e) = files::open(file) {
+                let absolute = |p: &Path| std::path::absolute(p).unwrap_or(p.to_path_buf());
+                let dir = path.parent().filter(|d| !d.as_os_str().is_empty());
+                let dir = dir.unwrap_or(Path::new("."));
+                bail!(
+                    "{}: {key}: cannot read {}: {e} (a relative path is taken from the \
+                     scenario's directory, {})",
+                    path.display(),
+                    absolute(file).display(),
+                    absolute(dir).display()
+                );
+            }
+        }
+        Ok(())
     }
 }
 

@@ -443,7 +443,8 @@ pub struct Scenario {
     /// Write a checkpoint every this many frames (0: only when interrupted).
     pub checkpoint_every: u64,
     /// Also write one when this many minutes of wall time have passed since the last (0:
-    /// never), so that a job killed without warning loses at most that.
+    /// never; default [`DEFAULT_CHECKPOINT_MINUTES`]), so that a job killed without warning
+    /// loses at most that.
     pub checkpoint_minutes: f64,
     /// Frame formats to write.
     pub formats: Formats,
@@ -454,6 +455,10 @@ pub struct Scenario {
     /// Whether a split run gathers each frame into one file or writes a piece per process.
     pub gather: Gather,
 }
+
+/// `[output] checkpoint_minutes` unless the scenario says: a run killed without warning
+/// (SIGKILL, a lost node) loses at most this much wall time.
+pub const DEFAULT_CHECKPOINT_MINUTES: f64 = 10.0;
 
 /// Default time step, Eq. (50): Δt = R_min sqrt(ρ (1 - ν²) / E).
 pub fn default_timestep(radius_min: f64, material: &Material) -> f64 {

@@ -233,7 +233,7 @@ impl Scenario {
             checkpoint_every: raw.output.checkpoint_every.unwrap_or(0),
             checkpoint_minutes: check(
                 "[output] checkpoint_minutes",
-                raw.output.checkpoint_minutes.unwrap_or(0.0),
+                raw.output.checkpoint_minutes.unwrap_or(DEFAULT_CHECKPOINT_MINUTES),
                 Range::NonNegative,
             )?,
             formats: Formats::parse(raw.output.formats)?,

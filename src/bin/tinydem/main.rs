@@ -18,10 +18,11 @@ use tinydem::comm::Comm;
 use tinydem::run::Interrupted;
 use tinydem::scenario::Scenario;
 
-use run::DefaultRun;
+use run::RunOptions;
 
-/// A granular DEM simulator (the model of the TinyDEM paper). With no arguments, runs the
-/// paper's default simulation: 1000 particles falling through an hourglass, into ./output.
+/// A granular DEM simulator (the model of the TinyDEM paper). With no command, runs the
+/// paper's default simulation: 1000 particles falling through an hourglass, into ./output
+/// (the options of `tinydem run` apply to it: --output, --quiet, --resume, --overwrite, ...).
 #[derive(Parser)]
 #[command(version, about)]
 struct Cli {
@@ -31,15 +32,9 @@ struct Cli {
     /// the processes of this machine).
     #[arg(long, global = true)]
     threads: Option<usize>,
-    /// Continue the interrupted default run from its checkpoint.
-    #[arg(long)]
-    resume: Option<PathBuf>,
-    /// Replace the output of an earlier default run in ./output.
-    #[arg(long)]
-    overwrite: bool,
-    /// Run the default simulation even if `check` would refuse it.
-    #[arg(long)]
-    force: bool,
+    /// The default run's options (as `tinydem run`'s).
+    #[command(flatten)]
+    default: RunOptions,
 }
 
 #[derive(Subcommand)]
@@ -63,6 +58,21 @@ enum Command {
     /// The dense-packing benchmark of the paper's Section 5: timed steps in settled
     /// packings; each size and thread count runs in its own process.
     Bench(bench::BenchArgs),
+}
+
+impl Command {
+    /// The command's name on the command line.
+    fn name(&self) -> &'static str {
+        match self {
+            Command::Run(_) => "run SCENARIO",
+            Command::Check(_) => "check",
+            Command::Analyze(_) => "analyze",
+            Command::Render(_) => "render",
+            Command::Plot(_) => "plot",
+            Command::Checkpoint(_) => "checkpoint",
+            Command::Bench(_) => "bench",
+        }
+    }
 }
 
 #[derive(Subcommand)]
@@ -201,18 +211,22 @@ fn real_main(cli: Cli, world: Option<Box<dyn Comm>>) -> Result<()> {
     // The time loop runs on a worker of the pool, so that small parallel loops run inline
     // instead of waking another thread for every stage.
     let pool = pool.build().context("cannot start the thread pool")?;
-    let default = DefaultRun {
-        resume: cli.resume,
-        overwrite: cli.overwrite,
-        force: cli.force,
-    };
-    pool.install(|| execute(cli.command, default, world))
+    if let Some(command) = &cli.command
+        && cli.default.any()
+    {
+        anyhow::bail!(
+            "the run options (--output, --quiet, --resume, --from, --overwrite, --force) go \
+             after the command: tinydem {} ... --output DIR",
+            command.name()
+        );
+    }
+    pool.install(|| execute(cli.command, cli.default, world))
 }
 
 /// Runs `command` (the default run when there is none) on the processes of `world`.
 fn execute(
     command: Option<Command>,
-    default: DefaultRun,
+    default: RunOptions,
     world: Option<Box<dyn Comm>>,
 ) -> Result<()> {
     let first = world.as_ref().is_none_or(|c| c.rank() == 0);
@@ -227,7 +241,7 @@ fn execute(
         return Ok(());
     }
     match command {
-        None => default.execute(world, first),
+        None => default.execute(Scenario::default(), world, first),
         Some(Command::Run(args)) => args.execute(world, first),
         Some(Command::Bench(args)) => args.execute(world, first),
         Some(Command::Render(args)) => args.execute(),

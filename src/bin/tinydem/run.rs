@@ -12,9 +12,10 @@ use tinydem::run::{Options, Requests, Summary, Verbosity, run_on};
 use tinydem::scenario::Scenario;
 use tinydem::simulation::Stage;
 
+/// How a run goes: where it writes, what it says, what it continues. The same for
+/// `tinydem run SCENARIO` and the default run (`tinydem` with no command).
 #[derive(Args)]
-pub struct RunArgs {
-    scenario: PathBuf,
+pub struct RunOptions {
     /// Output directory (overrides [output] dir).
     #[arg(long, short)]
     output: Option<PathBuf>,
@@ -22,11 +23,12 @@ pub struct RunArgs {
     #[arg(long, short)]
     quiet: bool,
     /// Continue an interrupted run from its checkpoint (written to the output
-    /// directory on Ctrl-C/SIGTERM and every `[output] checkpoint_every` frames).
+    /// directory on Ctrl-C/SIGTERM, every `[output] checkpoint_minutes` of wall time and
+    /// every `checkpoint_every` frames).
     #[arg(long, conflicts_with = "from")]
     resume: Option<PathBuf>,
     /// Start a new stage of a study from the checkpoint of another run (its particles
-    /// and contact history; the rest from SCENARIO, whose clock starts at 0).
+    /// and contact history; the rest from the scenario, whose clock starts at 0).
     #[arg(long)]
     from: Option<PathBuf>,
     /// Replace the output of an earlier run in the output directory (its frames, logs
@@ -39,10 +41,34 @@ pub struct RunArgs {
     force: bool,
 }
 
+#[derive(Args)]
+pub struct RunArgs {
+    scenario: PathBuf,
+    #[command(flatten)]
+    options: RunOptions,
+}
+
 impl RunArgs {
     /// Runs the scenario (on every process under mpirun; the `first` reports).
     pub fn execute(self, world: Option<Box<dyn Comm>>, first: bool) -> Result<()> {
-        let s = Scenario::load(&self.scenario)?;
+        self.options
+            .execute(Scenario::load(&self.scenario)?, world, first)
+    }
+}
+
+impl RunOptions {
+    /// Whether any option was given (they belong after `run SCENARIO` when a command is).
+    pub fn any(&self) -> bool {
+        self.output.is_some()
+            || self.quiet
+            || self.resume.is_some()
+            || self.from.is_some()
+            || self.overwrite
+            || self.force
+    }
+
+    /// Runs scenario `s` (on every process under mpirun; the `first` reports).
+    pub fn execute(self, s: Scenario, world: Option<Box<dyn Comm>>, first: bool) -> Result<()> {
         let out = self.output.unwrap_or_else(|| s.output_dir.clone());
         let verbosity = if self.quiet {
             Verbosity::Quiet
@@ -63,36 +89,6 @@ impl RunArgs {
             (true, false) => report(&summary, &out),
             (true, true) => warn(&summary),
             (false, _) => {}
-        }
-        Ok(())
-    }
-}
-
-/// The run without a command: the paper's default simulation into ./output, with the
-/// options given before any command.
-pub struct DefaultRun {
-    pub resume: Option<PathBuf>,
-    pub overwrite: bool,
-    pub force: bool,
-}
-
-impl DefaultRun {
-    /// Runs the default scenario (on every process under mpirun; the `first` reports).
-    pub fn execute(self, world: Option<Box<dyn Comm>>, first: bool) -> Result<()> {
-        let s = Scenario::default();
-        let out = s.output_dir.clone();
-        catch_signals()?;
-        let options = Options {
-            verbosity: Verbosity::Normal,
-            resume: self.resume.as_deref(),
-            from: None,
-            overwrite: self.overwrite,
-            force: self.force,
-            requests: Some(&REQUESTS),
-        };
-        let summary = run_on(s, &out, options, world)?;
-        if first {
-            report(&summary, &out);
         }
         Ok(())
     }

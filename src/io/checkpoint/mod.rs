@@ -88,13 +88,41 @@ pub fn load(path: &Path, fingerprint: Option<u64>) -> Result<Snapshot> {
     if let Some(parts) = newer_parts(path) {
         return load_parts(&parts, fingerprint);
     }
-    let bytes = crate::io::files::read(path).with_context(|| {
+    let bytes = crate::io::files::read(path).map_err(|e| {
         let lacking = parts::missing_parts(path).map_or(String::new(), |m| {
             format!(" (nor its parts of a split run: {m} missing)")
         });
-        format!("cannot read checkpoint {}{lacking}", path.display())
+        let why = match e.kind() {
+            std::io::ErrorKind::NotFound => never_written(path),
+            _ => String::new(),
+        };
+        anyhow::anyhow!("cannot read checkpoint {}{lacking}: {e}{why}", path.display())
     })?;
     decode(&bytes, fingerprint).with_context(|| format!("cannot resume from {}", path.display()))
+}
+
+/// Why a checkpoint that is not there may be missing, from what its directory holds.
+fn never_written(path: &Path) -> String {
+    let dir = path.parent().filter(|d| !d.as_os_str().is_empty());
+    let dir = dir.unwrap_or(Path::new("."));
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return format!(". There is no directory {}", dir.display());
+    };
+    let frames = entries
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter(|n| n.starts_with("particles") && n.ends_with(".csv"))
+        .max();
+    match frames {
+        Some(last) => format!(
+            ". {} holds frames up to {last} but no checkpoint: the run ended before it wrote \
+             one (a run writes its checkpoint every [output] checkpoint_minutes of wall time, \
+             10 unless the scenario says otherwise, every checkpoint_every frames, on Ctrl-C or \
+             SIGTERM and at its end; a kill -9 before the first leaves none). Start the run \
+             again with --overwrite",
+            dir.display()
+        ),
+        None => format!(". {} holds no frames of a run either", dir.display()),
+    }
 }
 
 #[cfg(test)]
