@@ -60,12 +60,18 @@ fn missing_mesh_and_particle_files() {
     );
     fails_with(
         &tinydem(&["check", "k.toml"], t.path()),
-        &["k.toml: [[meshes]] #2 file: cannot read", &tried("sub/box.stl")],
+        &[
+            "k.toml: [[meshes]] #2 file: cannot read",
+            &tried("sub/box.stl"),
+        ],
     );
     write(t.path(), "p.toml", "[input]\nparticles = \"absent.csv\"\n");
     fails_with(
         &tinydem(&["run", "p.toml"], t.path()),
-        &["p.toml: [input] particles: cannot read", &tried("absent.csv")],
+        &[
+            "p.toml: [input] particles: cannot read",
+            &tried("absent.csv"),
+        ],
     );
 }
 
@@ -87,7 +93,10 @@ fn the_default_run_takes_the_run_options_and_misplaced_ones_are_explained() {
     // A run killed before its first checkpoint: --resume says why there is none.
     std::fs::remove_file(t.path().join("first/checkpoint.bin")).unwrap();
     fails_with(
-        &tinydem(&["-o", "first", "--resume", "first/checkpoint.bin"], t.path()),
+        &tinydem(
+            &["-o", "first", "--resume", "first/checkpoint.bin"],
+            t.path(),
+        ),
         &[
             "holds frames up to particles000100.csv but no checkpoint",
             "checkpoint_minutes",

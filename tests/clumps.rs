@@ -580,3 +580,29 @@ fn a_stage_keeps_the_clump_templates_of_the_run_it_continues() {
         );
     }
 }
+
+#[test]
+fn a_clump_whose_spheres_would_take_ids_past_the_largest_is_refused() {
+    let t = tempfile::tempdir().unwrap();
+    std::fs::write(
+        t.path().join("p.csv"),
+        "x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz,id,clump\n\
+         0,0,0,0.003,0,0,0,1,0,0,0,0,0,0,4611686018427387903,0\n",
+    )
+    .unwrap();
+    std::fs::write(
+        t.path().join("s.toml"),
+        "[geometry]\nradius_min = 0.002\nradius_max = 0.003\n\
+         [[clumps]]\nname = \"dimer\"\nspheres = [[-0.001, 0.0, 0.0, 0.002], [0.001, 0.0, 0.0, 0.002]]\n\
+         [input]\nparticles = \"p.csv\"\n[simulation]\nmax_particles = 0\n",
+    )
+    .unwrap();
+    let o = common::tinydem(&["run", "s.toml", "-q"], t.path());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{err}");
+    assert!(err.contains("p.csv"), "{err}");
+    assert!(
+        err.contains("row 1: the clump of id 4611686018427387903 takes the ids 4611686018427387903 to 4611686018427387904"),
+        "{err}"
+    );
+}

@@ -46,6 +46,7 @@ fn full_scenario_sets_every_key() {
         time: Some(1.0),
         removed_at_least: Some(3),
         servo_within: None,
+        all: false,
     };
     assert_eq!(s.simulation.until, until);
     assert_eq!(s.particles, Some(dir.join("two.csv")));

@@ -162,3 +162,51 @@ fn a_lid_on_a_sheared_periodic_layer_keeps_its_normal_stress() {
     let mean = means[1..].iter().sum::<f64>() / (means.len() - 1) as f64;
     assert!((mean - 1.6).abs() < 0.003 * 1.6, "mean {mean} N");
 }
+
+#[test]
+fn a_stress_on_a_plate_edge_on_to_its_direction_is_refused() {
+    // Its area normal to the direction is 0: the target force would be 0 and the gain NaN,
+    // and the lid would plough through the bed at full speed.
+    let text = "[[meshes]]\n\
+        shape = { type = \"plane\", point = [0.0, 0.0, 0.05], normal = [1.0, 0.0, 0.0], size = 0.04 }\n\
+        motion = { type = \"servo\", direction = [0.0, 0.0, -1.0], stress = 1000.0, max_speed = 0.05 }\n";
+    let err = format!(
+        "{:#}",
+        Simulation::new(common::scenario(text)).err().unwrap()
+    );
+    assert!(
+        err.contains("[[meshes]] #1 motion: stress = 1000 Pa"),
+        "{err}"
+    );
+    assert!(err.contains("edge-on"), "{err}");
+}
+
+#[test]
+fn a_servo_direction_whose_squares_overflow_keeps_its_direction() {
+    for (given, expected) in [
+        ("[1e-320, 0.0, -1e308]", [0.0, 0.0, -1.0]),
+        (
+            "[1e300, 0.0, -1e300]",
+            [0.5f64.sqrt(), 0.0, -(0.5f64.sqrt())],
+        ),
+        ("[0.0, -0.0, -1e-300]", [0.0, 0.0, -1.0]),
+    ] {
+        let text = format!(
+            "[[meshes]]\n\
+             shape = {{ type = \"plane\", point = [0.0, 0.0, 0.05], normal = [0.0, 0.0, 1.0], size = 0.04 }}\n\
+             motion = {{ type = \"servo\", direction = {given}, force = 1.0, max_speed = 0.05 }}\n"
+        );
+        let sim = Simulation::new(common::scenario(&text)).unwrap();
+        let d = servo(&sim).0.direction;
+        assert!(
+            (d - glam::DVec3::from_array(expected)).length() < 1e-15,
+            "{given}: {d}"
+        );
+        assert!(
+            d.to_array()
+                .iter()
+                .all(|c| !(c == &0.0 && c.is_sign_negative())),
+            "{d}"
+        );
+    }
+}

@@ -90,6 +90,21 @@ fn rests(what: &str, (x, v, load): (DVec3, DVec3, DVec3), expected: DVec3, withi
 }
 
 #[test]
+fn a_grain_rests_on_a_plane_a_kilometre_wide_in_little_memory() {
+    // Binned in cells of 2 R_max + skin, the plane would fill 10^9 cells (it took 24 GB and
+    // was killed): it goes to a coarser level of the face grid instead.
+    let plane =
+        "{ type = \"plane\", point = [0.0, 0.0, 0.0], normal = [0.0, 0.0, 1.0], size = 1000.0 }";
+    let at = DVec3::new(0.01, -0.02, R - sag());
+    rests(
+        "kilometre plane",
+        drop_into(plane, DVec3::new(0.01, -0.02, 0.02), 0.6),
+        at,
+        0.02 * sag(),
+    );
+}
+
+#[test]
 fn a_grain_rests_on_a_plane_and_on_the_floor_of_a_box() {
     let plane =
         "{ type = \"plane\", point = [0.0, 0.0, 0.0], normal = [0.0, 0.0, 1.0], size = 0.1 }";

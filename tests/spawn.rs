@@ -165,3 +165,48 @@ fn spawning_is_over_past_every_regions_stop_or_count() {
     assert_eq!(s.particles.len(), 30);
     assert!(!spawning(&s));
 }
+
+#[test]
+fn a_region_that_cannot_place_its_grains_is_reported() {
+    // A flat region on the floor: every try overlaps it.
+    let t = tempfile::tempdir().unwrap();
+    std::fs::write(
+        t.path().join("s.toml"),
+        "[geometry]\nradius_min = 0.002\nradius_max = 0.003\n\
+         [[meshes]]\nshape = { type = \"plane\", point = [0.0, 0.0, 0.0], normal = [0.0, 0.0, 1.0], size = 1.0 }\n\
+         [[clumps]]\nname = \"dimer\"\nspheres = [[-0.002, 0.0, 0.0, 0.002], [0.002, 0.0, 0.0, 0.002]]\n\
+         [[spawn]]\nmin = [-0.03, -0.03, 0.0]\nmax = [0.03, 0.03, 0.0]\nclump = \"dimer\"\ncount = 10\n\
+         [[spawn]]\nmin = [-0.03, -0.03, 0.05]\nmax = [0.03, 0.03, 0.06]\ncount = 5\n\
+         [simulation]\nframes = 2\nsteps_per_frame = 50\n",
+    )
+    .unwrap();
+    for quiet in [true, false] {
+        let mut args = vec!["run", "s.toml", "--overwrite"];
+        if quiet {
+            args.push("-q");
+        }
+        let o = common::tinydem(&args, t.path());
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{err}");
+        assert!(
+            err.contains("warning: [[spawn]] #1 made 0 of 10 clumps: its tries overlapped a wall"),
+            "{err}"
+        );
+        // The second region made its five.
+        assert!(!err.contains("[[spawn]] #2"), "{err}");
+    }
+    // max_particles stops a region short: said so.
+    let mut sim = common::simulate(
+        "[geometry]\nradius_min = 0.001\nradius_max = 0.002\n\
+         [simulation]\nmax_particles = 20\n\
+         [[spawn]]\nmin = [-0.05, -0.05, -0.05]\nmax = [0.05, 0.05, 0.05]\ncount = 50\n",
+        0,
+    );
+    for _ in 0..10 {
+        sim.step().unwrap();
+    }
+    assert_eq!(
+        sim.spawn_shortfalls(),
+        vec!["[[spawn]] #1 made 20 of 50 particles: [simulation] max_particles = 20 was reached"]
+    );
+}

@@ -236,3 +236,24 @@ fn a_press_ends_when_its_servo_holds_its_load_and_so_does_its_resume() {
         "{err}"
     );
 }
+
+#[test]
+fn removals_beyond_the_particles_a_run_can_make_are_refused() {
+    let t = tempfile::tempdir().unwrap();
+    std::fs::write(
+        t.path().join("s.toml"),
+        "[simulation]\nmax_particles = 100\nuntil = { removed_at_least = 500 }\n\
+         [[outlets]]\nmin = [-1.0, -1.0, -1.0]\nmax = [1.0, 1.0, -0.5]\n",
+    )
+    .unwrap();
+    let o = common::tinydem(&["run", "s.toml", "-q"], t.path());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{err}");
+    assert!(
+        err.contains("until.removed_at_least = 500 can never hold: this run makes at most 100"),
+        "{err}"
+    );
+    let o = common::tinydem(&["check", "s.toml"], t.path());
+    let out = String::from_utf8_lossy(&o.stderr) + String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("can never hold"), "{out}");
+}

@@ -70,9 +70,10 @@ fn assert_frame_matches_csv(out: &Path, frame: usize) {
     let csv = read_csv_columns(&out.join(format!("particles{frame:06}.csv")));
     let n = csv["x"].len();
     let rows = |names: &[&str]| -> Vec<f64> {
+        let columns: Vec<&Vec<f64>> = names.iter().map(|c| &csv[*c]).collect();
         let mut v = Vec::with_capacity(n * names.len());
         for k in 0..n {
-            v.extend(names.iter().map(|c| csv[*c][k]));
+            v.extend(columns.iter().map(|c| c[k]));
         }
         v
     };
@@ -92,7 +93,10 @@ fn assert_frame_matches_csv(out: &Path, frame: usize) {
         }
     }
     assert_eq!(vtu["types"], vec![1.0; n], "one vertex cell per particle");
-    assert_eq!(vtu["connectivity"], (0..n).map(|k| k as f64).collect::<Vec<_>>());
+    assert_eq!(
+        vtu["connectivity"],
+        (0..n).map(|k| k as f64).collect::<Vec<_>>()
+    );
 }
 
 #[test]

@@ -112,10 +112,12 @@ fn until_line(s: &Scenario) -> String {
     if any.is_empty() {
         return String::new();
     }
-    format!(
-        "ends early             at the first frame with {}\n",
+    let joined = if u.all {
+        any.join(", and ")
+    } else {
         any.join(", or ")
-    )
+    };
+    format!("ends early             at the first frame with {joined}\n")
 }
 
 /// A line per mesh file: its faces, contact mode (and surfaces) and material.
@@ -499,6 +501,7 @@ pub fn most_particles(s: &Scenario, initial: usize) -> usize {
 /// step past [`TIMESTEP_TOLERANCE`] times Eq. 50, more output than the free space.
 pub fn refusals(s: &Scenario, n: usize, out: &Path) -> Vec<String> {
     let mut why: Vec<String> = timestep_refusal(s).into_iter().collect();
+    why.extend(until_refusal(s, n as u64));
     let need = OutputEstimate::of(s, n, 0).total;
     if let Some(free) = free_space(out)
         && need > free
@@ -512,6 +515,20 @@ pub fn refusals(s: &Scenario, n: usize, out: &Path) -> Vec<String> {
         ));
     }
     why
+}
+
+/// Why `[simulation] until` can never end the run: more removals asked for than the `n`
+/// particles the run can ever hold (those removed before a resume counted in).
+pub fn until_refusal(s: &Scenario, n: u64) -> Option<String> {
+    let asked = s.simulation.until.removed_at_least?;
+    (asked > n).then(|| {
+        format!(
+            "[simulation] until.removed_at_least = {asked} can never hold: this run makes at \
+             most {n} particles ([simulation] max_particles = {}, and those it starts with), \
+             so it would run all its {} frames",
+            s.simulation.max_particles, s.simulation.frames
+        )
+    })
 }
 
 /// The largest time step (as a fraction of Eq. 50's) at which a grain seated on `n` faces

@@ -78,6 +78,8 @@ pub struct Summary {
     /// the likely cause.
     pub warnings: usize,
     pub advice: String,
+    /// The `[[spawn]]` regions that made fewer particles than asked, with the likely cause.
+    pub spawn_shortfalls: Vec<String>,
     /// Particles removed by the outlets and the domain bounds.
     pub removed: crate::engine::records::Removed,
     /// The condition of `[simulation] until` that ended the run before its last frame, and
@@ -315,6 +317,7 @@ impl<'a> Record<'a> {
             checkpoint_seconds,
             warnings: sim.warnings().count(),
             advice: sim.advice(),
+            spawn_shortfalls: sim.spawn_shortfalls(),
             removed: sim.removed.clone(),
             ended_by: self.ended_by,
         })
@@ -395,6 +398,8 @@ fn resume_share(
 /// What `tinydem check` would refuse the run for (collective): an error naming it all.
 fn refuse(sim: &Simulation, output_dir: &Path) -> Result<()> {
     let n = crate::driver::check::most_particles(&sim.scenario, sim.particle_count());
+    // (A resumed run's removals so far count toward until.removed_at_least.)
+    let n = n + sim.removed.count() as usize;
     let why = if sim.is_writer() {
         crate::driver::check::refusals(&sim.scenario, n, output_dir)
     } else {

@@ -23,8 +23,8 @@ use crate::model::motion::{Motion, Pose, RigidVelocity};
 use crate::model::particles::{Id, Particles};
 use crate::model::servo;
 use crate::neighbours::{
-    CellGrid, ContactList, Entries, Entry, FACE_PIECE, Histories, History, IdIndex,
-    MIN_PARALLEL_LEN, NONE, Neighbours, Store, cut, face_grid,
+    ContactList, Entries, Entry, FACE_PIECE, FaceGrid, Histories, History, IdIndex,
+    MIN_PARALLEL_LEN, NONE, Neighbours, Store, cut,
 };
 use crate::parallel::domain::Domain;
 
@@ -455,7 +455,7 @@ pub struct Simulation {
     /// The contact law, densities and load scales.
     pub(crate) model: Model,
     pub(crate) neighbours: Neighbours,
-    pub(crate) face_grid: CellGrid,
+    pub(crate) face_grid: FaceGrid,
     pub(crate) spawner: Spawner,
     /// Force and torque on each particle (storage order), summed by stages 3 and 4 and used
     /// up by stage 5.
@@ -622,6 +622,12 @@ impl Simulation {
         let mut n = self.spawner.inserted();
         n.resize(self.scenario.spawn.len(), 0);
         n
+    }
+
+    /// The `[[spawn]]` regions that have made fewer particles than they were asked for so
+    /// far, each said with its likely cause (see [`Spawner::shortfalls`]).
+    pub fn spawn_shortfalls(&self) -> Vec<String> {
+        (self.spawner).shortfalls(&self.scenario, self.particles.next_id, self.time)
     }
 
     /// The state `[simulation] until` is checked on at a frame (collective in a split run).

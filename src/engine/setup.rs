@@ -4,6 +4,7 @@
 //! (`new`, `restore`, `stage`) are in `io/inputs.rs`.
 
 use super::*;
+use anyhow::Context;
 
 /// What the files a scenario names hold, read (`io::inputs`): the main mesh (`[geometry]
 /// mesh`) and each `[[meshes]]` file in order, each with its name, and the initial
@@ -36,7 +37,8 @@ impl Simulation {
                 moving.push((faces.clone(), Drive::Prescribed(motion)));
             }
             if let Some(servo) = spec.servo {
-                let control = servo_control(&scenario, servo, spec.material, &part.faces);
+                let control = servo_control(&scenario, servo, spec.material, &part.faces)
+                    .with_context(|| format!("[[meshes]] #{} motion", k + 1))?;
                 let state = servo::State::default();
                 let file = k + 1;
                 moving.push((
@@ -422,7 +424,7 @@ impl Simulation {
             }
         }
         let skin = scenario.simulation.skin * g.radius_max;
-        let face_grid = face_grid(&mesh.faces, max_radius, skin);
+        let face_grid = FaceGrid::of(&mesh.faces, max_radius, skin);
         let mut sim = Simulation {
             model: Model {
                 law: contact_law(&scenario),
@@ -460,31 +462,50 @@ impl Simulation {
 /// A servo's control law on the faces `faces` of material `wall`: the target as a force
 /// (a stress times [`servo_area`]), the gain given or [`servo::default_gain`] for grains of
 /// R_min against the stiffest material.
+/// A stress on faces that show no area normal to the direction (a plate edge-on to it) is
+/// refused: its target force would be 0 and its gain not a number.
 pub(super) fn servo_control(
     s: &Scenario,
     servo: crate::scenario::Servo,
     wall: u16,
     faces: &[Face],
-) -> servo::Control {
+) -> Result<servo::Control> {
     let d = servo.direction;
     let area = servo_area(s, d, faces);
     let force = match servo.target {
         crate::scenario::Target::Force(f) => f,
-        crate::scenario::Target::Stress(p) => p * area,
+        crate::scenario::Target::Stress(p) => {
+            let whole: f64 = faces.iter().map(Face::area).sum();
+            if area.partial_cmp(&(1e-9 * whole)) != Some(std::cmp::Ordering::Greater) {
+                bail!(
+                    "stress = {p} Pa acts on the faces' area projected normal to direction \
+                     {:?}, and that is {area:.3e} m^2 (of {whole:.3e} m^2 of faces: they lie along \
+                     the direction, as a plate edge-on to it): turn the faces or the direction, \
+                     or give a force [N]",
+                    d.to_array()
+                );
+            }
+            p * area
+        }
     };
     let law = contact_law(s);
     let e_star = (0..s.materials.len() as u16)
         .map(|a| law.with_wall(a, wall).e_star)
         .fold(0.0, f64::max);
     let (r, dt) = (s.geometry.radius_min, s.simulation.timestep);
-    servo::Control {
+    let gain = servo
+        .gain
+        .unwrap_or_else(|| servo::default_gain(force, area, r, e_star, dt));
+    anyhow::ensure!(
+        gain.is_finite() && gain > 0.0,
+        "the servo's gain {gain:e} m/(s N) is not a positive number: give gain"
+    );
+    Ok(servo::Control {
         direction: d,
         force,
         max_speed: servo.max_speed,
-        gain: servo
-            .gain
-            .unwrap_or_else(|| servo::default_gain(force, area, r, e_star, dt)),
-    }
+        gain,
+    })
 }
 
 /// The area a servo's stress acts on: its faces' area projected normal to its direction

@@ -10,7 +10,7 @@ use rustc_hash::FxHashMap;
 use crate::geometry::mesh::Face;
 use crate::model::bodies::{Body, BodyId};
 use crate::model::particles::{Id, Particle, Particles};
-use crate::neighbours::{CellGrid, Periodic, cell_of, key};
+use crate::neighbours::{FaceGrid, Periodic, cell_of, key};
 use crate::scenario::{
     ClumpTemplate, RadiusDistribution, Region, Scenario, SpawnClump, SpawnRegion,
 };
@@ -169,6 +169,42 @@ impl Spawner {
         self.regions.iter().map(|r| r.inserted).collect()
     }
 
+    /// The `[[spawn]]` regions that made fewer than they were asked for by time `t`, its
+    /// count or its rate over its window, `next_id` particles having been made: said, with
+    /// the likely cause (every try overlapped a wall or a grain, or `max_particles` ran out).
+    pub fn shortfalls(&self, s: &Scenario, next_id: Id, t: f64) -> Vec<String> {
+        let dt = s.simulation.timestep;
+        (s.spawn.iter().enumerate())
+            .filter(|(_, r)| t >= r.start)
+            .filter_map(|(k, r)| {
+                let made = self.regions.get(k).map_or(0, |st| st.inserted);
+                let asked = due(r, dt, t.min(r.stop) - dt);
+                let spheres = r
+                    .clump
+                    .map_or(1, |c| s.clumps[c.template as usize].spheres.len());
+                let capped = next_id + spheres as u64 > s.simulation.max_particles;
+                (made < asked).then(|| {
+                    let what = if r.clump.is_some() {
+                        "clumps"
+                    } else {
+                        "particles"
+                    };
+                    let why = if capped {
+                        format!(
+                            "[simulation] max_particles = {} was reached",
+                            s.simulation.max_particles
+                        )
+                    } else {
+                        "its tries overlapped a wall or other grains (a region on a wall, or \
+                         full?)"
+                            .to_string()
+                    };
+                    format!("[[spawn]] #{} made {made} of {asked} {what}: {why}", k + 1)
+                })
+            })
+            .collect()
+    }
+
     /// Whether a step at time `t` would try to spawn, `next_id` particles having been made.
     pub fn active(&self, s: &Scenario, next_id: Id, t: f64) -> bool {
         if s.simulation.spawn_attempts == 0 || next_id >= s.simulation.max_particles {
@@ -227,7 +263,7 @@ impl Spawner {
         s: &Scenario,
         particles: &mut Particles,
         faces: &[Face],
-        face_grid: &CellGrid,
+        face_grid: &FaceGrid,
         t: f64,
         present: f64,
     ) -> usize {
@@ -291,7 +327,7 @@ impl Spawner {
         s: &Scenario,
         particles: &mut Particles,
         faces: &[Face],
-        face_grid: &CellGrid,
+        face_grid: &FaceGrid,
         present: f64,
     ) -> usize {
         let (g, attempts) = (&s.geometry, s.simulation.spawn_attempts);
@@ -337,7 +373,7 @@ impl Spawner {
         pending: &mut Option<f64>,
         (particles, present): (&mut Particles, f64),
         faces: &[Face],
-        face_grid: &CellGrid,
+        face_grid: &FaceGrid,
     ) -> u64 {
         let max = s.simulation.max_particles;
         // A grid of the particles that a sphere in the region could touch, grown as
@@ -401,7 +437,7 @@ impl Spawner {
         pending: &mut Option<f64>,
         (particles, present): (&mut Particles, f64),
         faces: &[Face],
-        face_grid: &CellGrid,
+        face_grid: &FaceGrid,
     ) -> u64 {
         let clump = source.clump.expect("a clump region");
         let t = &s.clumps[clump.template as usize];
@@ -500,7 +536,7 @@ pub(crate) fn place_clump(
 }
 
 /// Whether a sphere at `x` of `radius` keeps clear of the `faces` (binned in `face_grid`).
-fn clear_of_faces((faces, face_grid): (&[Face], &CellGrid), x: DVec3, radius: f64) -> bool {
+fn clear_of_faces((faces, face_grid): (&[Face], &FaceGrid), x: DVec3, radius: f64) -> bool {
     face_grid.at(x).iter().all(|&f| {
         let face = &faces[f as usize];
         let reach = radius + face.radius;

@@ -517,7 +517,7 @@ impl Simulation {
 
     /// Bins the faces for particles up to radius `max_radius`.
     pub(crate) fn regrid_faces_for(&mut self, max_radius: f64) {
-        self.face_grid = face_grid(&self.walls.mesh.faces, max_radius, self.neighbours.skin);
+        self.face_grid = FaceGrid::of(&self.walls.mesh.faces, max_radius, self.neighbours.skin);
         self.face_grid_radius = max_radius;
     }
 }

@@ -262,23 +262,31 @@ impl Mesh {
 
     /// A mesh of polygons given as indices into `vertices` (one to four corners each, as
     /// `primitive` takes them), all of radius `radius`; faces that share a vertex form
-    /// one surface. For meshes made in code (`shapes.rs`): a bad polygon is a bug there.
-    pub fn from_polygons(vertices: Vec<DVec3>, polygons: &[Vec<usize>], radius: f64) -> Mesh {
+    /// one surface. For meshes made in code (`shapes.rs`): a polygon is refused only where
+    /// the numbers it was made of are beyond double precision (an axis of 1e200).
+    pub fn from_polygons(
+        vertices: Vec<DVec3>,
+        polygons: &[Vec<usize>],
+        radius: f64,
+    ) -> std::result::Result<Mesh, &'static str> {
         let corners: Vec<Vec<DVec3>> = polygons
             .iter()
             .map(|p| p.iter().map(|&k| vertices[k]).collect())
             .collect();
-        let mut faces: Vec<Face> = corners
-            .iter()
-            .map(|c| Face {
-                shape: primitive(c).expect("a built-in shape's polygon is a valid face"),
+        let mut faces = Vec::with_capacity(corners.len());
+        for c in &corners {
+            if !c.iter().all(|v| v.is_finite()) {
+                return Err("a corner is not a finite point (its coordinates overflow)");
+            }
+            faces.push(Face {
+                shape: primitive(c)?,
                 radius,
                 surface: 0,
                 contacts: Contacts::Merged,
-            })
-            .collect();
+            });
+        }
         connect(&mut faces, |f| &corners[f]);
-        Mesh { faces, vertices }
+        Ok(Mesh { faces, vertices })
     }
 
     /// Number of surfaces (one more than the largest label).
@@ -452,7 +460,7 @@ pub(crate) fn primitive(v: &[DVec3]) -> std::result::Result<Primitive, &'static 
                 a,
                 b,
                 c,
-                n: normal.normalize(),
+                n: unit_normal(normal)?,
             })
         }
         [v0, v1, v2, v3] => rectangle([v0, v1, v2, v3]),
@@ -464,6 +472,9 @@ pub(crate) fn primitive(v: &[DVec3]) -> std::result::Result<Primitive, &'static 
 fn rectangle(v: [DVec3; 4]) -> std::result::Result<Primitive, &'static str> {
     let (o, e1, e2) = (v[0], v[1] - v[0], v[3] - v[0]);
     let scale = e1.length().max(e2.length());
+    if !scale.is_finite() {
+        return Err(TOO_LARGE);
+    }
     let tol = 1e-9 * scale;
     if scale == 0.0 || e1.length() <= tol || e2.length() <= tol {
         return Err("degenerate rectangle (two corners coincide)");
@@ -477,9 +488,22 @@ fn rectangle(v: [DVec3; 4]) -> std::result::Result<Primitive, &'static str> {
         o,
         e1,
         e2,
-        n: e1.cross(e2).normalize(),
+        n: unit_normal(e1.cross(e2))?,
     })
 }
+
+/// The unit vector along a face's normal, refused where the face's size is beyond what
+/// double precision squares (lengths above about 1e150) and no direction comes out.
+fn unit_normal(normal: DVec3) -> std::result::Result<DVec3, &'static str> {
+    let n = normal.normalize();
+    match n.is_finite() && (n.length() - 1.0).abs() < 1e-6 {
+        true => Ok(n),
+        false => Err(TOO_LARGE),
+    }
+}
+
+const TOO_LARGE: &str =
+    "a face too large or too far out for double precision (its squared lengths overflow)";
 
 /// The numbers of vertices and faces of an OFF file of `size` bytes, from its header lines.
 fn off_counts<'a>(

@@ -56,7 +56,8 @@ pub enum Shape {
         size: f64,
     },
     /// A cone frustum open at both ends: the circle of `outlet_radius` about `center`,
-    /// and `height` along `axis` the circle of `top_radius`.
+    /// and `height` along `axis` the wider circle of `top_radius` (an outlet of 0: a cone
+    /// closed at its apex).
     Hopper {
         center: DVec3,
         axis: DVec3,
@@ -193,8 +194,10 @@ impl Shape {
         }
     }
 
-    /// The shape's faces, all of radius `radius` (R_j), one connected surface.
-    pub fn mesh(&self, radius: f64) -> Mesh {
+    /// The shape's faces, all of radius `radius` (R_j), one connected surface; an error
+    /// where its sizes or places are beyond double precision (validation makes the mesh
+    /// once to find out: [`Shape::mesh`] then holds).
+    pub fn try_mesh(&self, radius: f64) -> Result<Mesh, &'static str> {
         let mut p = Polygons::default();
         match *self {
             Shape::Box { min, max, open } => box_faces(&mut p, min, max, open),
@@ -253,6 +256,13 @@ impl Shape {
         Mesh::from_polygons(p.vertices, &p.polygons, radius)
     }
 
+    /// The shape's faces, all of radius `radius` (R_j), one connected surface, for a shape
+    /// that validation made once ([`Shape::try_mesh`]).
+    pub fn mesh(&self, radius: f64) -> Mesh {
+        self.try_mesh(radius)
+            .expect("a validated shape makes its faces")
+    }
+
     /// A hopper's faces: a band between its two circles, or a cone where one is a point.
     fn hopper_faces(&self, p: &mut Polygons) {
         let Shape::Hopper {
@@ -267,24 +277,14 @@ impl Shape {
             unreachable!("hopper_faces is called for hoppers")
         };
         let (f, top_center) = (frame(axis), center + height * axis);
-        match (outlet_radius > 0.0, top_radius > 0.0) {
-            (true, true) => {
-                let low = p.ring(center, f, outlet_radius, n);
-                let high = p.ring(top_center, f, top_radius, n);
-                p.band(&low, &high, false);
-            }
+        let high = p.ring(top_center, f, top_radius, n);
+        if outlet_radius > 0.0 {
+            let low = p.ring(center, f, outlet_radius, n);
+            p.band(&low, &high, false);
+        } else {
             // A cone pointing down: its apex is the outlet (it holds everything).
-            (false, _) => {
-                let high = p.ring(top_center, f, top_radius, n);
-                let apex = p.vertex(center);
-                p.cap(&high, Cap::Apex(apex), false);
-            }
-            // Pointing up.
-            (true, false) => {
-                let low = p.ring(center, f, outlet_radius, n);
-                let apex = p.vertex(top_center);
-                p.cap(&low, Cap::Apex(apex), true);
-            }
+            let apex = p.vertex(center);
+            p.cap(&high, Cap::Apex(apex), false);
         }
     }
 }

@@ -21,6 +21,18 @@ use crate::scenario::{ClumpTemplate, MeshInput, MeshSource, Scenario};
 impl Scenario {
     /// Reads and validates a scenario file.
     pub fn load(path: &Path) -> Result<Scenario> {
+        // (Refused unread: a file of gigabytes would take many times its size to parse.)
+        if let Ok(m) = std::fs::metadata(path)
+            && m.len() > crate::scenario::MOST_SCENARIO_BYTES as u64
+        {
+            bail!(
+                "{}: {} bytes, more than a scenario's {}: put long lists in files of their own \
+                 ([input] particles, [[clumps]] file)",
+                path.display(),
+                m.len(),
+                crate::scenario::MOST_SCENARIO_BYTES
+            );
+        }
         let text = files::read_to_string(path)
             .with_context(|| format!("cannot read scenario file {}", path.display()))?;
         let s = Scenario::parse(&text, path)?;
@@ -228,6 +240,15 @@ fn with_clumps_from(
                     place_row(&mut particles, (template, t), id, row);
                 }
             }
+        }
+        if particles.next_id > crate::model::particles::MAX_ID {
+            bail!(
+                "row {}: the clump of id {id} takes the ids {id} to {} for its spheres, but ids \
+                 must be below {}",
+                k + 1,
+                particles.next_id - 1,
+                crate::model::particles::MAX_ID
+            );
         }
         for id in id..particles.next_id {
             if !taken.insert(id) {

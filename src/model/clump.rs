@@ -97,7 +97,12 @@ fn quadrature(spheres: &[Sphere], n: usize) -> Moments {
     let (mut volume, mut first, mut second) = (0.0, DVec3::ZERO, DMat3::ZERO);
     let nodes = gauss_legendre(n);
     let mut covered = Vec::new();
+    let overlapping = earlier_overlapping(spheres);
+    let mut earlier = Vec::new();
     for (k, s) in spheres.iter().enumerate() {
+        // Only the earlier spheres that reach into this one can cover its rays.
+        earlier.clear();
+        earlier.extend(overlapping[k].iter().map(|&j| spheres[j as usize]));
         let c = s.centre;
         for &(mu, weight) in &nodes {
             let cell = weight * std::f64::consts::PI / n as f64; // w Δφ
@@ -105,7 +110,7 @@ fn quadrature(spheres: &[Sphere], n: usize) -> Moments {
             for b in 0..2 * n {
                 let phi = (b as f64 + 0.5) * std::f64::consts::PI / n as f64;
                 let u = DVec3::new(sin * phi.cos(), sin * phi.sin(), mu);
-                let [m0, m1, m2] = radial(u, s, &spheres[..k], &mut covered);
+                let [m0, m1, m2] = radial(u, s, &earlier, &mut covered);
                 volume += cell * m0;
                 first += cell * (c * m0 + u * m1);
                 let cu = outer(c, u);
@@ -123,6 +128,38 @@ fn quadrature(spheres: &[Sphere], n: usize) -> Moments {
         inertia: DMat3::from_diagonal(DVec3::splat(trace)) - central,
         error: f64::NAN,
     }
+}
+
+/// For each sphere, the earlier ones that overlap or touch it, ascending, found through a
+/// grid of cells as wide as the largest sphere's diameter (so that a clump of many spheres
+/// costs about as many tests as it has neighbouring pairs, not its count squared).
+pub fn earlier_overlapping(spheres: &[Sphere]) -> Vec<Vec<u32>> {
+    let h = 2.0 * spheres.iter().map(|s| s.radius).fold(0.0, f64::max);
+    let cell = |x: DVec3| (x / h).floor().as_i64vec3();
+    let mut grid: std::collections::HashMap<glam::I64Vec3, Vec<u32>> = Default::default();
+    let mut out = Vec::with_capacity(spheres.len());
+    for (k, s) in spheres.iter().enumerate() {
+        let c = cell(s.centre);
+        let mut near: Vec<u32> = Vec::new();
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    let Some(items) = grid.get(&(c + glam::I64Vec3::new(dx, dy, dz))) else {
+                        continue;
+                    };
+                    near.extend(items.iter().copied().filter(|&j| {
+                        let e = &spheres[j as usize];
+                        let reach = (s.radius + e.radius) * (1.0 + 1e-12);
+                        (s.centre - e.centre).length_squared() <= reach * reach
+                    }));
+                }
+            }
+        }
+        near.sort_unstable();
+        out.push(near);
+        grid.entry(c).or_default().push(k as u32);
+    }
+    out
 }
 
 /// ∫ t² dt, ∫ t³ dt, ∫ t⁴ dt over the part of the ray from the centre of `s` along `u`

@@ -14,7 +14,7 @@ impl Neighbours {
     /// carried to their slots in the new lists (keyed by the particles' new storage
     /// indices, so that carrying them runs in spatial order too), and the lists are built
     /// from the positions (see `Neighbours::build`).
-    pub fn rebuild(&mut self, particles: &mut Particles, faces: &[Face], face_grid: &CellGrid) {
+    pub fn rebuild(&mut self, particles: &mut Particles, faces: &[Face], face_grid: &FaceGrid) {
         self.rebuild_without(particles, &[], faces, face_grid);
     }
 
@@ -25,7 +25,7 @@ impl Neighbours {
         particles: &mut Particles,
         gone: &[u32],
         faces: &[Face],
-        face_grid: &CellGrid,
+        face_grid: &FaceGrid,
     ) {
         if let Some(periodic) = self.periodic {
             // Between rebuilds particles move freely across periodic sides; here they are
@@ -101,7 +101,7 @@ impl Neighbours {
         pairs: &[Entry],
         faces_history: &[Entry],
         faces: &[Face],
-        face_grid: &CellGrid,
+        face_grid: &FaceGrid,
     ) -> Vec<u32> {
         let layout = Layout::of(&particles.radius, self.skin);
         let keys = layout.keys(at.as_deref().unwrap_or(&particles.x), &particles.id);
@@ -149,7 +149,7 @@ impl Neighbours {
         anchors: Vec<DVec3>,
         lonely: Vec<(u32, f64)>,
         faces: &[Face],
-        face_grid: &CellGrid,
+        face_grid: &FaceGrid,
         history: &Histories,
     ) {
         let layout = Layout::of(&particles.radius, self.skin);
@@ -172,7 +172,7 @@ impl Neighbours {
         x: &[DVec3],
         particles: &Particles,
         faces: &[Face],
-        face_grid: &CellGrid,
+        face_grid: &FaceGrid,
         layout: Layout,
         history: &Histories,
     ) {
@@ -398,7 +398,7 @@ fn face_pairs(
     radius: &[f64],
     skin: f64,
     faces: &[Face],
-    face_grid: &CellGrid,
+    face_grid: &FaceGrid,
 ) -> (Vec<u32>, Vec<u32>) {
     let n = x.len();
     let face_pairs: Vec<(u32, u32)> = (0..n)
@@ -406,12 +406,25 @@ fn face_pairs(
         .with_min_len(MIN_PARALLEL_LEN / 8)
         .flat_map_iter(|i| {
             let (xi, ri) = (x[i], radius[i]);
-            face_grid.at(xi).iter().copied().filter_map(move |f| {
+            let pair = move |&f: &u32| {
                 let face = &faces[f as usize];
                 let reach = ri + face.radius + skin;
                 let near = face.separation(xi).length_squared() < reach * reach;
                 near.then_some((i as u32, f))
-            })
+            };
+            // (Borrowed from the grid, unless faces of several levels were merged.)
+            match face_grid.at(xi) {
+                std::borrow::Cow::Borrowed(listed) => {
+                    rayon::iter::Either::Left(listed.iter().filter_map(pair))
+                }
+                std::borrow::Cow::Owned(listed) => rayon::iter::Either::Right(
+                    listed
+                        .iter()
+                        .filter_map(pair)
+                        .collect::<Vec<_>>()
+                        .into_iter(),
+                ),
+            }
         })
         .collect();
     compress(n, face_pairs.iter().copied())

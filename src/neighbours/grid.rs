@@ -168,18 +168,70 @@ impl CellGrid {
     }
 }
 
-/// The grid of mesh faces for particles up to radius `max_radius`: each face is binned into
-/// every cell its bounding box, grown by `max_radius + skin`, overlaps, so the cell of a
-/// particle's centre lists every face it can reach before the next rebuild.
-pub fn face_grid(faces: &[Face], max_radius: f64, skin: f64) -> CellGrid {
-    let grow = DVec3::splat(max_radius + skin);
-    let boxes: Vec<(DVec3, DVec3)> = faces
-        .iter()
-        .map(|f| {
+/// The cells a face may span in its level of the [`FaceGrid`]: a face that would span more
+/// goes to a level of cells 4 times as wide.
+const MAX_CELLS_PER_FACE: f64 = 4096.0;
+
+/// The grid of mesh faces: each face binned into every cell its bounding box, grown by the
+/// reach of a particle, overlaps, so the cell of a particle's centre lists every face it can
+/// reach before the next rebuild. Cells are 2 R_max + skin wide; a face that would span more
+/// than [`MAX_CELLS_PER_FACE`] of them (a floor of a kilometre under millimetre grains would
+/// span 10^9) is binned in a level of cells 4, 16, ... times as wide, so that no face costs
+/// more than that many entries. Usually every face is in the first level.
+#[derive(Clone, Debug, Default)]
+pub struct FaceGrid {
+    /// The levels that hold faces, with their cell widths, finest first.
+    levels: Vec<CellGrid>,
+}
+
+impl FaceGrid {
+    /// The grid of `faces` for particles up to radius `max_radius` with `skin`.
+    pub fn of(faces: &[Face], max_radius: f64, skin: f64) -> FaceGrid {
+        let grow = DVec3::splat(max_radius + skin);
+        let h = (2.0 * max_radius + skin).max(f64::MIN_POSITIVE);
+        let mut by_level: Vec<Vec<(DVec3, DVec3)>> = Vec::new();
+        let mut faces_of: Vec<Vec<u32>> = Vec::new();
+        for (k, f) in faces.iter().enumerate() {
             let (lo, hi) = f.bounding_box();
-            (lo - grow, hi + grow)
-        })
-        .collect();
-    let h = (2.0 * max_radius + skin).max(f64::MIN_POSITIVE);
-    CellGrid::of_boxes(&boxes, h)
+            let (lo, hi) = (lo - grow, hi + grow);
+            let cells = |h: f64| {
+                let (a, b) = (cell_of(lo, 1.0 / h), cell_of(hi, 1.0 / h));
+                let n = (b - a + IVec3::ONE).as_dvec3();
+                n.x * n.y * n.z
+            };
+            let mut level = 0;
+            while cells(h * 4f64.powi(level as i32)) > MAX_CELLS_PER_FACE {
+                level += 1;
+            }
+            if by_level.len() <= level {
+                by_level.resize(level + 1, Vec::new());
+                faces_of.resize(level + 1, Vec::new());
+            }
+            by_level[level].push((lo, hi));
+            faces_of[level].push(k as u32);
+        }
+        let levels = (by_level.iter().zip(&faces_of).enumerate())
+            .filter(|(_, (boxes, _))| !boxes.is_empty())
+            .map(|(level, (boxes, ids))| {
+                let mut grid = CellGrid::of_boxes(boxes, h * 4f64.powi(level as i32));
+                grid.items.iter_mut().for_each(|i| *i = ids[*i as usize]);
+                grid
+            })
+            .collect();
+        FaceGrid { levels }
+    }
+
+    /// The faces listed in the cells of `x`, ascending.
+    #[inline]
+    pub fn at(&self, x: DVec3) -> std::borrow::Cow<'_, [u32]> {
+        match self.levels.as_slice() {
+            [] => std::borrow::Cow::Borrowed(&[]),
+            [one] => std::borrow::Cow::Borrowed(one.at(x)),
+            all => {
+                let mut faces: Vec<u32> = all.iter().flat_map(|g| g.at(x)).copied().collect();
+                faces.sort_unstable();
+                std::borrow::Cow::Owned(faces)
+            }
+        }
+    }
 }

@@ -529,7 +529,7 @@ mod tests {
             .collect();
         let mut nb = Neighbours::new(0.001);
         let mut p = particles(&x, &radius);
-        nb.rebuild(&mut p, &[], &CellGrid::default());
+        nb.rebuild(&mut p, &[], &FaceGrid::default());
         assert_eq!(listed(&nb, &p), brute(&x, &radius, 0.001));
     }
 
@@ -550,7 +550,7 @@ mod tests {
             .collect();
         let mut nb = Neighbours::new(0.002);
         let mut p = particles(&x, &radius);
-        nb.rebuild(&mut p, &[], &CellGrid::default());
+        nb.rebuild(&mut p, &[], &FaceGrid::default());
         assert_eq!(listed(&nb, &p), brute(&x, &radius, 0.002));
         // The particles are stored in the order of their cells, each one unchanged.
         let h = 2.0 * 0.007 + 0.002;
@@ -626,7 +626,7 @@ mod tests {
         let radius = vec![0.005; 4];
         let mut p = particles(&x, &radius);
         let mut nb = Neighbours::new(0.002);
-        nb.rebuild(&mut p, &[], &CellGrid::default());
+        nb.rebuild(&mut p, &[], &FaceGrid::default());
         assert_eq!(listed(&nb, &p), vec![(0, 3), (1, 2)]);
         // Give each pair springs that name it, then move the pairs past each other.
         let list = &mut nb.pairs;
@@ -642,7 +642,7 @@ mod tests {
         for x in &mut p.x {
             x.x = 1.0 - x.x;
         }
-        nb.rebuild(&mut p, &[], &CellGrid::default());
+        nb.rebuild(&mut p, &[], &FaceGrid::default());
         assert_eq!(p.id, vec![3, 0, 2, 1]);
         let (mut pairs, _) = nb.entries_by_id(&p.id);
         pairs.sort_unstable_by_key(|e| (e.0, e.1));
@@ -673,14 +673,14 @@ mod tests {
         let skin = 0.005;
         let mut nb = Neighbours::new(skin);
         let mut p = particles(&x, &radius);
-        nb.rebuild(&mut p, &[], &CellGrid::default());
+        nb.rebuild(&mut p, &[], &FaceGrid::default());
         assert_eq!(nb.lonely.len(), 1, "{:?}", nb.lonely);
         let mut rebuilds = 0;
         while p.x[at(&p, 0)].z > 0.015 {
             let k = at(&p, 0);
             p.x[k].z -= 0.001;
             if nb.stale(&p.x, &p.radius, &[], 0.0) {
-                nb.rebuild(&mut p, &[], &CellGrid::default());
+                nb.rebuild(&mut p, &[], &FaceGrid::default());
                 rebuilds += 1;
             }
             // Whatever touches is listed.
@@ -697,7 +697,7 @@ mod tests {
         assert!(rebuilds < 20, "{rebuilds} rebuilds");
         // An ordinary particle still triggers a rebuild after skin / 2.
         let mut nb = Neighbours::new(skin);
-        nb.rebuild(&mut p, &[], &CellGrid::default());
+        nb.rebuild(&mut p, &[], &FaceGrid::default());
         let k = at(&p, 2);
         p.x[k].x += 0.6 * skin;
         assert!(nb.stale(&p.x, &p.radius, &[], 0.0));
@@ -714,7 +714,7 @@ mod tests {
         let skin = 0.005;
         let mut nb = Neighbours::new(skin);
         let mut p = particles(&x, &radius);
-        nb.rebuild(&mut p, &[], &CellGrid::default());
+        nb.rebuild(&mut p, &[], &FaceGrid::default());
         assert_eq!(nb.lonely.len(), 1, "the grain far from the pair");
         // The touching pair moves on together past skin / 2: a rebuild no allowance puts off.
         for id in [0, 1] {
@@ -722,7 +722,7 @@ mod tests {
             p.x[k].y += 0.6 * skin;
         }
         assert!(nb.stale(&p.x, &p.radius, &[], 0.0));
-        nb.rebuild(&mut p, &[], &CellGrid::default());
+        nb.rebuild(&mut p, &[], &FaceGrid::default());
         assert!(
             nb.lonely.is_empty(),
             "no clearances while listed grains set the pace"
@@ -731,7 +731,7 @@ mod tests {
         let k = at(&p, 2);
         p.x[k].z -= 0.6 * skin;
         assert!(nb.stale(&p.x, &p.radius, &[], 0.0));
-        nb.rebuild(&mut p, &[], &CellGrid::default());
+        nb.rebuild(&mut p, &[], &FaceGrid::default());
         assert_eq!(nb.lonely.len(), 1, "found again");
         // And then it does: the grain moves on within its allowance, no rebuild.
         let k = at(&p, 2);
@@ -745,7 +745,7 @@ mod tests {
         let x = vec![DVec3::new(-0.5, 0.0, 0.0), DVec3::new(0.5, 0.0, 0.0)];
         let mut nb = Neighbours::new(0.005);
         let mut p = particles(&x, &radius);
-        nb.rebuild(&mut p, &[], &CellGrid::default());
+        nb.rebuild(&mut p, &[], &FaceGrid::default());
         assert_eq!(nb.lonely.len(), 2);
         let mut rebuilds = 0;
         for _ in 0..600 {
@@ -753,7 +753,7 @@ mod tests {
             p.x[a].x += 0.001;
             p.x[b].x -= 0.0013;
             if nb.stale(&p.x, &p.radius, &[], 0.0) {
-                nb.rebuild(&mut p, &[], &CellGrid::default());
+                nb.rebuild(&mut p, &[], &FaceGrid::default());
                 rebuilds += 1;
             }
             let (a, b) = (at(&p, 0), at(&p, 1));

@@ -62,6 +62,7 @@ pub(super) fn clumps(
             (None, Some(f)) => read_spheres(&base.join(f))?,
             _ => bail!("{key}: give either spheres = [[x, y, z, r], ...] or file = \"t.csv\""),
         };
+        check_count(&key, given.len(), c.mass.is_some())?;
         check_spheres(&key, &given, geometry)?;
         let material = match &c.material {
             Some(name) => index(&format!("{key} material"), name)?,
@@ -160,6 +161,33 @@ fn read_spheres(path: &Path) -> Result<Vec<Sphere>> {
         .collect()
 }
 
+/// The most spheres of a template whose mass properties the ray quadrature finds: its cost
+/// grows with the spheres and their neighbours (about 25 s for 1,000 on two cores).
+pub const MOST_SPHERES_COMPUTED: usize = 1_000;
+
+/// The most spheres of a template with its mass and inertia given: each clump of it is that
+/// many particles.
+pub const MOST_SPHERES: usize = 100_000;
+
+/// A template's sphere count within what its mass properties and its clumps can cost.
+fn check_count(key: &str, n: usize, mass_given: bool) -> Result<()> {
+    if n > MOST_SPHERES {
+        bail!(
+            "{key}: {n} spheres: a clump is one rigid body of at most {MOST_SPHERES} spheres \
+             (each clump of it is that many particles)"
+        );
+    }
+    if n > MOST_SPHERES_COMPUTED && !mass_given {
+        bail!(
+            "{key}: {n} spheres: the mass properties of more than {MOST_SPHERES_COMPUTED} \
+             spheres would take minutes to compute (about 25 s for 1,000): give mass and \
+             inertia = [I1, I2, I3] (the spheres then placed as given about the centre of mass \
+             at the origin, along the principal axes), or use fewer spheres"
+        );
+    }
+    Ok(())
+}
+
 /// At least one sphere, finite, radii within [R_min, R_max], and one connected body: every
 /// sphere reached from the first through spheres that overlap or touch.
 fn check_spheres(key: &str, spheres: &[Sphere], g: &Geometry) -> Result<()> {
@@ -180,17 +208,22 @@ fn check_spheres(key: &str, spheres: &[Sphere], g: &Geometry) -> Result<()> {
             );
         }
     }
-    let touch = |a: &Sphere, b: &Sphere| {
-        (a.centre - b.centre).length() <= (a.radius + b.radius) * (1.0 + 1e-12)
-    };
+    // Joined: every sphere reached from the first along pairs that overlap or touch.
+    let earlier = crate::model::clump::earlier_overlapping(spheres);
+    let mut touching: Vec<Vec<u32>> = vec![Vec::new(); spheres.len()];
+    for (k, before) in earlier.iter().enumerate() {
+        for &j in before {
+            touching[k].push(j);
+            touching[j as usize].push(k as u32);
+        }
+    }
     let mut reached = vec![false; spheres.len()];
     let mut todo = vec![0];
     reached[0] = true;
     while let Some(i) = todo.pop() {
-        for j in 0..spheres.len() {
-            if !reached[j] && touch(&spheres[i], &spheres[j]) {
-                reached[j] = true;
-                todo.push(j);
+        for &j in &touching[i] {
+            if !std::mem::replace(&mut reached[j as usize], true) {
+                todo.push(j as usize);
             }
         }
     }
@@ -245,6 +278,24 @@ fn given_mass(
     let i = DVec3::from_array(inertia);
     if !(mass > 0.0 && mass.is_finite() && i.cmpgt(DVec3::ZERO).all() && i.is_finite()) {
         bail!("{key}: mass and inertia must be finite and > 0");
+    }
+    // A body's centre of mass lies within it, so within the box of its spheres.
+    let lo = given
+        .iter()
+        .map(|s| s.centre - s.radius)
+        .fold(DVec3::INFINITY, DVec3::min);
+    let hi = given
+        .iter()
+        .map(|s| s.centre + s.radius)
+        .fold(DVec3::NEG_INFINITY, DVec3::max);
+    if !(lo.cmple(DVec3::ZERO).all() && hi.cmpge(DVec3::ZERO).all()) {
+        bail!(
+            "{key}: with mass and inertia given, the spheres are placed about the centre of \
+             mass at the origin, but the origin lies outside them (their box is {:?} .. {:?}): \
+             give the spheres relative to the centre of mass",
+            lo.to_array(),
+            hi.to_array()
+        );
     }
     // The moments of a body obey the triangle inequality: each at most the sum of the others.
     if (0..3).any(|a| i[a] > (i.element_sum() - i[a]) * (1.0 + 1e-12)) {

@@ -102,13 +102,16 @@ fn mesh_spec(k: usize, m: RawMesh, base: &Path) -> Result<MeshSpec> {
     })
 }
 
-/// A unit vector along `v`, which must not be zero.
-fn unit(key: &str, v: [f64; 3]) -> Result<DVec3> {
+/// A unit vector along `v`, which must not be zero: scaled by its largest component
+/// first, so that components whose squares overflow (1e200) or vanish (1e-200) still give
+/// their direction, and without negative zeros.
+pub(super) fn unit(key: &str, v: [f64; 3]) -> Result<DVec3> {
     let v = check_vec(key, v)?;
-    if v.length_squared() == 0.0 {
+    let largest = v.abs().max_element();
+    if largest == 0.0 {
         bail!("{key} must not be the zero vector");
     }
-    Ok(v.normalize())
+    Ok((v / largest).normalize() + DVec3::ZERO)
 }
 
 /// `motion = { type = ... }`.
@@ -168,8 +171,22 @@ impl Keys<'_> {
     }
 }
 
-/// `shape = { type = ... }`: lengths positive, axes not zero, open sides by name.
+/// `shape = { type = ... }`: lengths positive, axes not zero, open sides by name, and its
+/// faces within double precision (made once here, so that the run can make them).
 fn shape(key: &dyn Fn(&str) -> String, raw: RawShape) -> Result<Shape> {
+    let shape = shape_keys(key, raw)?;
+    if let Err(why) = shape.try_mesh(0.0) {
+        bail!(
+            "{}: the {} cannot be made: {why}; its lengths and places must be far below 1e150 m",
+            key("shape"),
+            shape.kind()
+        );
+    }
+    Ok(shape)
+}
+
+/// The keys of `shape = { type = ... }`, each checked.
+fn shape_keys(key: &dyn Fn(&str) -> String, raw: RawShape) -> Result<Shape> {
     let k = Keys { mesh: key };
     Ok(match raw {
         RawShape::Box { min, max, open } => box_shape(&k, min, max, open)?,
@@ -280,6 +297,15 @@ fn hopper(k: &Keys, raw: RawShape) -> Result<Shape> {
             "{} and {} are both 0: one of them must be > 0",
             k.key("top_radius"),
             k.key("outlet_radius")
+        );
+    }
+    if outlet >= top {
+        bail!(
+            "{} = {outlet} must be below {} = {top}: a hopper narrows from its top down to \
+             its outlet (for a funnel that widens along `axis`, turn the axis round and put \
+             `center` at the narrow end; outlet_radius = 0 closes it in a cone)",
+            k.key("outlet_radius"),
+            k.key("top_radius")
         );
     }
     Ok(Shape::Hopper {

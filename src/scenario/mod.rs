@@ -53,10 +53,12 @@ mod output;
 mod raw;
 mod resolved;
 mod spawn;
+mod text;
 mod validate;
 pub use clumps::{ClumpTemplate, MassSource};
 pub use output::{Formats, Gather};
 pub use resolved::changes;
+pub use text::MOST_SCENARIO_BYTES;
 
 /// The geometry of the paper's default hourglass (Fig. 5A), embedded so that `tinydem`
 /// runs with no files.
@@ -155,6 +157,9 @@ pub struct Until {
     pub removed_at_least: Option<u64>,
     /// Every servo's load (of its last step) is within this fraction of its target.
     pub servo_within: Option<f64>,
+    /// The run ends where all the conditions set hold at one frame (`combine = "all"`),
+    /// rather than any of them.
+    pub all: bool,
 }
 
 /// The state a frame's check of [`Until`] looks at.
@@ -173,17 +178,51 @@ pub struct FrameState {
 impl Until {
     /// Whether no condition is set.
     pub fn is_empty(&self) -> bool {
-        *self == Until::default()
+        self.conditions() == 0
     }
 
-    /// The first condition that holds in state `s`.
+    /// How many conditions are set.
+    pub fn conditions(&self) -> usize {
+        [
+            self.kinetic_energy_below.is_some(),
+            self.time.is_some(),
+            self.removed_at_least.is_some(),
+            self.servo_within.is_some(),
+        ]
+        .iter()
+        .filter(|&&set| set)
+        .count()
+    }
+
+    /// The condition that holds in state `s`: the first of them, or, with `all`, every one
+    /// set (said together, as `all`).
     pub fn met(&self, s: &FrameState) -> Option<Met> {
+        let held = self.holding(s);
+        if !self.all {
+            return held.into_iter().next();
+        }
+        if held.len() < self.conditions() || held.is_empty() {
+            return None;
+        }
+        let said: Vec<String> = held
+            .iter()
+            .map(|m| format!("{}: {}", m.key, m.said))
+            .collect();
+        Some(Met {
+            key: "all",
+            said: said.join("; "),
+        })
+    }
+
+    /// Each condition set that holds in state `s`, in the order of the keys.
+    fn holding(&self, s: &FrameState) -> Vec<Met> {
+        let mut held = Vec::new();
         if let Some(e) = self.kinetic_energy_below
             && s.particles > 0
             && !s.spawning
             && s.kinetic_energy < e
         {
-            return Some(Met {
+            held.push(Met {
                 key: "kinetic_energy_below",
                 said: format!("kinetic energy {:.4e} J below {e:e} J", s.kinetic_energy),
             });
@@ -191,7 +230,7 @@ impl Until {
         if let Some(t) = self.time
             && s.time >= t
         {
-            return Some(Met {
+            held.push(Met {
                 key: "time",
                 said: format!("t = {:.6e} s reached {t:e} s", s.time),
             });
@@ -199,7 +238,7 @@ impl Until {
         if let Some(n) = self.removed_at_least
             && s.removed >= n
         {
-            return Some(Met {
+            held.push(Met {
                 key: "removed_at_least",
                 said: format!("{} removed, at least {n}", s.removed),
             });
@@ -213,7 +252,7 @@ impl Until {
             let loads: Vec<String> = (s.servos.iter())
                 .map(|(k, load, target)| format!("mesh {k}: {load:.6e} N of {target:.6e} N"))
                 .collect();
-            return Some(Met {
+            held.push(Met {
                 key: "servo_within",
                 said: format!(
                     "every servo within {f:e} of its target ({})",
@@ -221,7 +260,7 @@ impl Until {
                 ),
             });
         }
-        None
+        held
     }
 }
 
@@ -602,6 +641,7 @@ mod tests {
             time: Some(2.0),
             removed_at_least: Some(5),
             servo_within: None,
+            all: false,
         };
         let still = FrameState {
             time: 1.0,
@@ -651,6 +691,51 @@ mod tests {
         assert_eq!(press.met(&servos(&[1.99])).unwrap().key, "servo_within");
         assert_eq!(press.met(&servos(&[1.99, 2.03])), None);
         assert_eq!(press.met(&servos(&[])), None);
+    }
+
+    #[test]
+    fn until_all_holds_where_every_condition_set_holds_at_once() {
+        let until = Until {
+            kinetic_energy_below: Some(1e-6),
+            time: Some(2.0),
+            all: true,
+            ..Until::default()
+        };
+        let state = |time: f64, kinetic_energy: f64| FrameState {
+            time,
+            kinetic_energy,
+            particles: 10,
+            spawning: false,
+            removed: 0,
+            servos: Vec::new(),
+        };
+        // Still but early, late but moving: neither ends it.
+        assert_eq!(until.met(&state(1.0, 1e-7)), None);
+        assert_eq!(until.met(&state(2.5, 1e-3)), None);
+        let met = until.met(&state(2.5, 1e-7)).unwrap();
+        assert_eq!(met.key, "all");
+        assert!(
+            met.to_string().starts_with(
+                "until.all: kinetic_energy_below: kinetic energy 1.0000e-7 J below 1e-6 J; time: t = "
+            ),
+            "{met}"
+        );
+        // Any of them (the default) ends it at the first.
+        let any = Until {
+            all: false,
+            ..until
+        };
+        assert_eq!(
+            any.met(&state(1.0, 1e-7)).unwrap().key,
+            "kinetic_energy_below"
+        );
+        assert!(
+            Until {
+                all: true,
+                ..Until::default()
+            }
+            .is_empty()
+        );
     }
 
     #[test]

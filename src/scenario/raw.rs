@@ -320,6 +320,7 @@ pub(super) struct RawUntil {
     pub(super) time: Option<f64>,
     pub(super) removed_at_least: Option<u64>,
     pub(super) servo_within: Option<f64>,
+    pub(super) combine: Option<String>,
 }
 
 #[derive(Deserialize, Default)]

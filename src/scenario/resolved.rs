@@ -140,6 +140,9 @@ impl Scenario {
             if let Some(f) = u.servo_within {
                 conditions.push(format!("servo_within = {}", num(f)));
             }
+            if u.all {
+                conditions.push(format!("combine = {}", text("all")));
+            }
             let _ = writeln!(o, "until = {{ {} }}", conditions.join(", "));
         }
     }

@@ -159,8 +159,7 @@ impl Scenario {
     /// Parses and validates scenario text; `path` names the file in messages and anchors
     /// relative paths.
     pub fn parse(text: &str, path: &Path) -> Result<Scenario> {
-        let raw: RawScenario = toml::from_str(text)
-            .map_err(|e| anyhow::anyhow!("{}: {}", path.display(), e.to_string().trim_end()))?;
+        let raw: RawScenario = super::text::raw_scenario(text, path)?;
         let base = path.parent().unwrap_or(Path::new("."));
         Scenario::from_raw(raw, base)
             .with_context(|| format!("{}: invalid scenario", path.display()))
@@ -181,11 +180,6 @@ impl Scenario {
             geometry.mesh_material = index("[geometry] mesh_material", name)?;
         }
         let meshes = meshes(raw.meshes, base, &index)?;
-        if simulation.until.servo_within.is_some() && meshes.iter().all(|m| m.servo.is_none()) {
-            bail!(
-                "[simulation] until.servo_within needs a servo: no [[meshes]] has motion = {{ type = \"servo\", ... }}"
-            );
-        }
         let tags = tags(raw.tags)?;
         let periodic = raw
             .domain
@@ -209,7 +203,7 @@ impl Scenario {
             &simulation,
             domain,
         )?;
-        Ok(Scenario {
+        let scenario = Scenario {
             clumps,
             geometry,
             material,
@@ -233,14 +227,53 @@ impl Scenario {
             checkpoint_every: raw.output.checkpoint_every.unwrap_or(0),
             checkpoint_minutes: check(
                 "[output] checkpoint_minutes",
-                raw.output.checkpoint_minutes.unwrap_or(DEFAULT_CHECKPOINT_MINUTES),
+                raw.output
+                    .checkpoint_minutes
+                    .unwrap_or(DEFAULT_CHECKPOINT_MINUTES),
                 Range::NonNegative,
             )?,
             formats: Formats::parse(raw.output.formats)?,
             wall_forces: raw.output.wall_forces.unwrap_or(false),
             contact_network: raw.output.contacts.unwrap_or(false),
             gather: Gather::parse(raw.output.gather)?,
-        })
+        };
+        scenario.consistent()?;
+        Ok(scenario)
+    }
+
+    /// What holds between tables: an `until` that can hold, clumps that can be spawned.
+    fn consistent(&self) -> Result<()> {
+        let until = &self.simulation.until;
+        if until.servo_within.is_some() && self.meshes.iter().all(|m| m.servo.is_none()) {
+            bail!(
+                "[simulation] until.servo_within needs a servo: no [[meshes]] has motion = {{ type = \"servo\", ... }}"
+            );
+        }
+        let removes =
+            !self.outlets.is_empty() || (self.domain.is_some() && self.periodic != [true; 3]);
+        if until.removed_at_least.is_some() && !removes {
+            bail!(
+                "[simulation] until.removed_at_least can never hold: nothing removes particles \
+                 (no [[outlets]], and no [domain] with a side that is not periodic)"
+            );
+        }
+        for (k, r) in self.spawn.iter().enumerate() {
+            let Some(c) = r.clump else { continue };
+            let (max, t) = (
+                self.simulation.max_particles,
+                &self.clumps[c.template as usize],
+            );
+            if max > 0 && (t.spheres.len() as u64) > max {
+                bail!(
+                    "[[spawn]] #{} clump = \"{}\" has {} spheres, more than [simulation] \
+                     max_particles = {max} (which counts spheres): not one clump could be made",
+                    k + 1,
+                    t.name,
+                    t.spheres.len()
+                );
+            }
+        }
+        Ok(())
     }
 }
 
@@ -479,6 +512,14 @@ fn until(raw: Option<RawUntil>) -> Result<Until> {
             .servo_within
             .map(|f| check("[simulation] until.servo_within", f, Range::Positive))
             .transpose()?,
+        all: match raw.combine.as_deref() {
+            None | Some("any") => false,
+            Some("all") => true,
+            Some(other) => bail!(
+                "[simulation] until.combine = \"{other}\" is not allowed: it must be \"any\" (the \
+                 run ends where one condition holds) or \"all\" (where all hold at one frame)"
+            ),
+        },
     };
     if until.servo_within.is_some_and(|f| f >= 1.0) {
         bail!(

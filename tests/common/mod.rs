@@ -110,7 +110,9 @@ pub fn has_meshio() -> bool {
             std::env::var_os("CI").is_none(),
             "CI must have meshio (pip install meshio)"
         );
-        eprintln!("SKIPPED (the part with a real VTK reader): python3 with meshio not found (pip install meshio)");
+        eprintln!(
+            "SKIPPED (the part with a real VTK reader): python3 with meshio not found (pip install meshio)"
+        );
     }
     found
 }

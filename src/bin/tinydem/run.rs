@@ -132,8 +132,12 @@ fn catch_signals() -> Result<()> {
     Ok(())
 }
 
-/// The end-of-run warning about overlaps past the smaller radius, if there were any.
+/// The end-of-run warnings: spawn regions that fell short, overlaps past the smaller
+/// radius.
 fn warn(summary: &Summary) {
+    for short in &summary.spawn_shortfalls {
+        eprintln!("warning: {short}");
+    }
     let n = summary.warnings;
     if n > 0 {
         eprintln!(

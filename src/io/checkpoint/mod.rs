@@ -96,7 +96,10 @@ pub fn load(path: &Path, fingerprint: Option<u64>) -> Result<Snapshot> {
             std::io::ErrorKind::NotFound => never_written(path),
             _ => String::new(),
         };
-        anyhow::anyhow!("cannot read checkpoint {}{lacking}: {e}{why}", path.display())
+        anyhow::anyhow!(
+            "cannot read checkpoint {}{lacking}: {e}{why}",
+            path.display()
+        )
     })?;
     decode(&bytes, fingerprint).with_context(|| format!("cannot resume from {}", path.display()))
 }

@@ -1,6 +1,7 @@
 use std::f64::consts::PI;
 use std::path::Path;
 
+use super::MOST_SPHERES_COMPUTED;
 use crate::scenario::{MassSource, Scenario};
 
 const HEAD: &str = "[geometry]\nradius_min = 0.002\nradius_max = 0.005\n\
@@ -106,4 +107,31 @@ fn bad_templates_are_refused_with_the_reason() {
         "[[clumps]]\nname = \"m\"\nspheres = [[0.0, 0.0, 0.0, 0.003]]\nmaterial = \"steel\"\n",
     );
     assert!(e.contains("material = \"steel\" is not a material"), "{e}");
+}
+
+#[test]
+fn a_template_of_more_spheres_than_its_mass_properties_can_take_is_refused_at_once() {
+    let chain = |n: usize| -> String {
+        let spheres: Vec<String> = (0..n)
+            .map(|k| format!("[{}, 0.0, 0.0, 0.002]", k as f64 * 0.003))
+            .collect();
+        format!(
+            "[geometry]\nradius_min = 0.002\nradius_max = 0.003\n\
+             [[clumps]]\nname = \"chain\"\nspheres = [{}]\n",
+            spheres.join(", ")
+        )
+    };
+    let start = std::time::Instant::now();
+    let err = format!(
+        "{:#}",
+        Scenario::parse(&chain(MOST_SPHERES_COMPUTED + 1), Path::new("s.toml"))
+            .err()
+            .unwrap()
+    );
+    assert!(
+        err.contains("1001 spheres: the mass properties of more than 1000"),
+        "{err}"
+    );
+    // Refused before any quadrature.
+    assert!(start.elapsed().as_secs_f64() < 5.0);
 }
