@@ -290,3 +290,125 @@ fn analyze_fields_averages_slices_and_needs_the_contact_networks() {
         "{err}"
     );
 }
+
+/// The `name` column of a CSV file's rows.
+fn csv_column(path: &std::path::Path, name: &str) -> Vec<f64> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let at = (lines.next().unwrap().split(','))
+        .position(|h| h == name)
+        .unwrap_or_else(|| panic!("{name} in {}", path.display()));
+    lines
+        .map(|l| l.split(',').nth(at).unwrap().parse().unwrap())
+        .collect()
+}
+
+#[test]
+fn slices_hold_the_mass_of_the_grains_within_their_box_and_no_more() {
+    // A bed in a ring of radius 35 mm; slices over a 5 x 5 cm box inside it. Before, a
+    // slice summed its whole plane and divided by the box's area: 0.88 packing fraction.
+    let t = tempfile::tempdir().unwrap();
+    std::fs::write(
+        t.path().join("s.toml"),
+        "[geometry]\nradius_min = 0.003\nradius_max = 0.004\n\
+         spawn_min = [-0.03, -0.03, 0.01]\nspawn_max = [0.03, 0.03, 0.08]\n\
+         [material]\ndensity = 2500.0\nyoungs_modulus = 1e7\n\
+         [simulation]\nmax_particles = 400\nframes = 1\nsteps_per_frame = 6000\n\
+         [output]\ncontacts = true\n\
+         [[meshes]]\nshape = { type = \"cylinder\", center = [0.0, 0.0, 0.0], axis = [0.0, 0.0, 1.0], radius = 0.035, height = 0.1, open = [\"top\"] }\n",
+    )
+    .unwrap();
+    let o = common::tinydem(&["run", "s.toml", "-o", "out", "-q"], t.path());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let frame = t.path().join("out/particles000001.csv");
+    let (x, y, z, r) = (
+        csv_column(&frame, "x"),
+        csv_column(&frame, "y"),
+        csv_column(&frame, "z"),
+        csv_column(&frame, "R"),
+    );
+    let inside = |k: usize| x[k].abs() < 0.025 && y[k].abs() < 0.025;
+    let counted: f64 = (0..x.len())
+        .filter(|&k| inside(k))
+        .map(|k| Inertia::mass(r[k], 2500.0))
+        .sum();
+    let outside = (0..x.len()).filter(|&k| !inside(k)).count();
+    assert!(
+        outside > 50,
+        "the ring holds grains outside the box: {outside}"
+    );
+    let top = z.iter().fold(0.0f64, |m, &z| m.max(z)) + 0.02;
+    let o = common::tinydem(
+        &[
+            "analyze",
+            "out",
+            "--fields",
+            "--slices",
+            "z",
+            "--spacing",
+            "0.002",
+            "--bounds",
+            &format!("-0.025,-0.025,-0.02,0.025,0.025,{top}"),
+        ],
+        t.path(),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let density = csv_column(&t.path().join("out/fields000001.csv"), "density");
+    let dz = (top + 0.02) / density.len() as f64;
+    let field_mass: f64 = density.iter().map(|rho| rho * dz * 0.05 * 0.05).sum();
+    assert!(
+        (field_mass / counted - 1.0).abs() < 1e-3,
+        "the slices hold {field_mass} kg, the grains in the box {counted} kg"
+    );
+}
+
+#[test]
+fn fields_refuse_kernels_wider_than_the_box_and_frames_the_run_lacks() {
+    let t = tempfile::tempdir().unwrap();
+    let _ = bed(t.path());
+    for (args, expected) in [
+        (
+            vec!["--width", "inf"],
+            "--width inf: it must be a finite length > 0",
+        ),
+        (vec!["--width", "1e9"], "beyond the box's largest side"),
+        (
+            vec!["--frames", "1,99"],
+            "asks for frames it does not hold: 4, 5, 6, 7, 8 and 91 more",
+        ),
+    ] {
+        let mut all = vec!["analyze", "out", "--fields", "--bounds", BOX];
+        all.extend(args);
+        let o = common::tinydem(&all, t.path());
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success() && err.contains(expected), "{err}");
+    }
+    // A frame cut short at the end of a line reads as a valid smaller frame: the run's log
+    // tells it apart.
+    let frame = t.path().join("out/particles000003.csv");
+    let text = std::fs::read_to_string(&frame).unwrap();
+    let cut: Vec<&str> = text.lines().take(20).collect();
+    std::fs::write(&frame, cut.join("\n") + "\n").unwrap();
+    let o = common::tinydem(&["analyze", "out"], t.path());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success()
+            && err.contains(
+                "particles000003.csv: 19 particles, but the run's log.csv says frame 3 had 60"
+            ),
+        "{err}"
+    );
+    std::fs::write(&frame, text).unwrap();
+    // An average over a frame deleted since.
+    std::fs::remove_file(t.path().join("out/particles000002.csv")).unwrap();
+    let o = common::tinydem(
+        &["analyze", "out", "--fields", "--frames", "1,3", "--average"],
+        t.path(),
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success()
+            && err.contains("frames it does not hold: 2 (it has frames 0 to 3, with gaps)"),
+        "{err}"
+    );
+}

@@ -27,6 +27,74 @@ pub fn frame_number(name: &str) -> Option<u64> {
     number.parse().ok()
 }
 
+/// A frame (or its pieces) with each clump's row made into its spheres and body, from the
+/// templates of `scenario` (the run's): what the analysis tools measure and draw.
+pub fn load_frame_as_grains(
+    path: &Path,
+    scenario: &crate::scenario::Scenario,
+) -> Result<Particles> {
+    let (p, clumps) = load_frame(path)?;
+    check_against_log(path, p.len())?;
+    match clumps {
+        Some(c) if c.templates.iter().any(Option::is_some) => {
+            if scenario.clumps.is_empty() {
+                bail!(
+                    "{}: the frame has clumps, but the scenario read has no [[clumps]]: give the \
+                     run's scenario (its run.toml)",
+                    path.display()
+                );
+            }
+            anyhow::Context::with_context(crate::io::inputs::with_clumps(scenario, p, &c), || {
+                format!("frame {}", path.display())
+            })
+        }
+        _ => Ok(p),
+    }
+}
+
+/// A frame of `rows` particles (plain spheres and clumps) read from `path` holds as many as
+/// its run's `log.csv` beside it says it had: a frame cut short at the end of a line reads
+/// as a valid smaller one, which this tells apart. (No log, or no row for the frame: no
+/// check.)
+fn check_against_log(path: &Path, rows: usize) -> Result<()> {
+    let (Some(dir), Some(k)) = (
+        path.parent(),
+        path.file_name().and_then(|n| frame_number(n.to_str()?)),
+    ) else {
+        return Ok(());
+    };
+    let Ok(log) = std::fs::read_to_string(dir.join(crate::io::output::LOG)) else {
+        return Ok(());
+    };
+    let mut lines = log.lines();
+    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+    let (Some(f), Some(n)) = (
+        header.iter().position(|&c| c == "frame"),
+        header.iter().position(|&c| c == "particles"),
+    ) else {
+        return Ok(());
+    };
+    // The last row of the frame (a resumed run may have logged it twice).
+    let logged = lines
+        .rev()
+        .filter_map(|l| {
+            let v: Vec<&str> = l.split(',').collect();
+            Some((
+                v.get(f)?.parse::<u64>().ok()?,
+                v.get(n)?.parse::<usize>().ok()?,
+            ))
+        })
+        .find(|&(frame, _)| frame == k);
+    match logged {
+        Some((_, n)) if n != rows => bail!(
+            "{}: {rows} particles, but the run's log.csv says frame {k} had {n}: the file is \
+             cut short or from another run",
+            path.display()
+        ),
+        _ => Ok(()),
+    }
+}
+
 /// The pieces `stem_0.ext`, `stem_1.ext`, ... of the file `path` (`stem.ext`), in order:
 /// `None` if there are none, an error if one is missing.
 fn pieces_of(path: &Path) -> Option<Result<Vec<PathBuf>>> {

@@ -7,59 +7,117 @@ use crate::model::integrate::Inertia;
 use crate::model::particles::Particles;
 use crate::neighbours::CellGrid;
 
+/// A grain of a frame: a plain sphere, or a clump (a rigid body of several spheres).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Grain {
+    /// Its centre (of mass) \[L\].
+    pub x: DVec3,
+    /// Its volume \[L³\] (of a clump: its mass over its material's density, so its spheres'
+    /// overlaps count once).
+    pub volume: f64,
+}
+
+/// The grains of a frame whose clumps are given as their spheres and bodies
+/// (`io::inputs::with_clumps`), with the density `rho[m]` of each material m; and for each
+/// particle (sphere), the index of its grain.
+pub fn grains(p: &Particles, rho: &[f64]) -> (Vec<Grain>, Vec<usize>) {
+    let density = |m: usize| rho.get(m).copied().unwrap_or(rho[0]);
+    let mut grains = Vec::with_capacity(p.len());
+    let mut of = vec![usize::MAX; p.len()];
+    for k in (0..p.len()).filter(|&k| p.body[k].is_none()) {
+        of[k] = grains.len();
+        let r = p.radius[k];
+        grains.push(Grain {
+            x: p.x[k],
+            volume: 4.0 / 3.0 * std::f64::consts::PI * r * r * r,
+        });
+    }
+    for (b, body) in p.bodies.list.iter().enumerate() {
+        let members = p.bodies.members(b);
+        let material = members
+            .first()
+            .map_or(0, |&k| p.material[k as usize] as usize);
+        for &k in members {
+            of[k as usize] = grains.len();
+        }
+        grains.push(Grain {
+            x: body.x,
+            volume: body.mass / density(material),
+        });
+    }
+    (grains, of)
+}
+
 /// Kinetic energy, translational and rotational \[J\], for the density `rho[m]` of each
-/// particle's material m.
+/// particle's material m: a plain sphere's of its own, a clump's (its spheres given with
+/// their body, `io::inputs::with_clumps`) that of its body.
 pub fn kinetic_energy(p: &Particles, rho: &[f64]) -> f64 {
-    (0..p.len())
+    let spheres: f64 = (0..p.len())
+        .filter(|&k| p.body[k].is_none())
         .map(|k| {
             let density = rho.get(p.material[k] as usize).copied().unwrap_or(rho[0]);
             let b = Inertia::new(p.radius[k], density, 0.0);
             0.5 * b.m * p.v[k].length_squared() + 0.5 * b.i * p.w[k].length_squared()
         })
-        .sum()
+        .sum();
+    let bodies: f64 = (p.bodies.list.iter())
+        .map(|b| {
+            let (t, r) = b.kinetic_energy();
+            t + r
+        })
+        .sum();
+    spheres + bodies
 }
 
-/// Mean number of particle-particle contacts per particle (each contact counts for both).
+/// Mean number of grains touching a grain (each contact counts for both): spheres of one
+/// clump do not touch each other, and two clumps touching at several spheres touch once.
 pub fn coordination_number(p: &Particles) -> f64 {
     if p.is_empty() {
         return 0.0;
     }
+    let (grains, of) = grains(p, &[1.0]);
     let grid = CellGrid::of_points(&p.x, 2.0 * p.max_radius());
-    let mut contacts = 0usize;
+    let mut touching: Vec<(usize, usize)> = Vec::new();
     for i in 0..p.len() {
         grid.for_each_near(p.x[i], |j| {
             let j = j as usize;
-            if j != i && p.x[i].distance(p.x[j]) < p.radius[i] + p.radius[j] {
-                contacts += 1;
+            let (a, b) = (of[i], of[j]);
+            if a < b && p.x[i].distance(p.x[j]) < p.radius[i] + p.radius[j] {
+                touching.push((a, b));
             }
         });
     }
-    contacts as f64 / p.len() as f64
+    touching.sort_unstable();
+    touching.dedup();
+    2.0 * touching.len() as f64 / grains.len() as f64
 }
 
 /// Solid fraction in the bulk of the packings of a frame, however many heaps it holds:
-/// around each particle, the volume of the particles whose centres lie within L = 4 mean
-/// radii, over the volume of that sphere; the median over the particles inside a packing,
-/// those whose neighbours within L surround them (their centroid lies within L/5 of the
-/// centre: a particle on a free surface or a wall has them on one side, a centroid about
-/// 3L/8 off). 0 if no particle is inside a packing (a gas, a monolayer, too few grains).
-/// Whole spheres are counted, so the error is of order R/L.
-pub fn packing_fraction(p: &Particles) -> f64 {
-    if p.len() < 20 {
+/// around each grain, the volume of the grains whose centres lie within L = 4 mean radii
+/// (of the spheres of equal volume), over the volume of that sphere; the median over the
+/// grains inside a packing, those whose neighbours within L surround them (their centroid
+/// lies within L/5 of the centre: a grain on a free surface or a wall has them on one side,
+/// a centroid about 3L/8 off). 0 if no grain is inside a packing (a gas, a monolayer, too
+/// few grains). Whole grains are counted, so the error is of order R/L. Clumps count as
+/// their bodies (`grains`).
+pub fn packing_fraction(p: &Particles, rho: &[f64]) -> f64 {
+    let (grains, _) = grains(p, rho);
+    if grains.len() < 20 {
         return 0.0;
     }
-    let r_mean = p.radius.iter().sum::<f64>() / p.len() as f64;
-    let l = 4.0 * r_mean;
     let ball = 4.0 / 3.0 * std::f64::consts::PI;
-    let grid = CellGrid::of_points(&p.x, l);
-    let mut fractions: Vec<f64> = (0..p.len())
+    let r_mean = grains.iter().map(|g| (g.volume / ball).cbrt()).sum::<f64>() / grains.len() as f64;
+    let l = 4.0 * r_mean;
+    let x: Vec<DVec3> = grains.iter().map(|g| g.x).collect();
+    let grid = CellGrid::of_points(&x, l);
+    let mut fractions: Vec<f64> = (0..grains.len())
         .filter_map(|i| {
             let (mut volume, mut centroid, mut n) = (0.0, DVec3::ZERO, 0usize);
-            grid.for_each_near(p.x[i], |j| {
+            grid.for_each_near(x[i], |j| {
                 let j = j as usize;
-                let d = p.x[j] - p.x[i];
+                let d = x[j] - x[i];
                 if d.length_squared() <= l * l {
-                    volume += ball * p.radius[j].powi(3);
+                    volume += grains[j].volume;
                     if j != i {
                         centroid += d;
                         n += 1;
@@ -399,14 +457,14 @@ mod tests {
                 }
             }
         }
-        let phi = packing_fraction(&p);
+        let phi = packing_fraction(&p, &[1000.0]);
         assert!((phi - std::f64::consts::PI / 6.0).abs() < 0.03, "{phi}");
         // A sparse gas has no bulk.
         let mut gas = Particles::default();
         for k in 0..50 {
             gas.push(at(0.1 * k as f64, 0.0, 0.01));
         }
-        assert_eq!(packing_fraction(&gas), 0.0);
+        assert_eq!(packing_fraction(&gas, &[1000.0]), 0.0);
     }
 
     #[test]

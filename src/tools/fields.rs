@@ -95,8 +95,9 @@ impl Kernel {
 }
 
 /// Where the fields are: points at the centres of the cells of a box, `counts` along x,
-/// y, z; or slices, cells that span the box but along one axis (`slices`). An axis that
-/// `wrap`s is periodic and spanned by the box.
+/// y, z; or slices, cells that span the box but along one axis (`slices`): within the box
+/// across that axis, averaged over its cross-section. An axis that `wrap`s is periodic and
+/// spanned by the box.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Grid {
     pub min: DVec3,
@@ -145,10 +146,21 @@ impl Grid {
         self.min + DVec3::from_array(idx.map(|i| i as f64 + 0.5)) * self.spacing
     }
 
-    /// Calls `add(point index, φ)` for each point within the kernel's reach of `at`.
+    /// Calls `add(point index, φ)` for each point within the kernel's reach of `at`. A slice
+    /// spans the box across its axis, and no further: what lies outside the box across it
+    /// (unless that axis wraps) adds nothing, so that a slice's density is that of its box.
     fn spread(&self, kernel: &Kernel, at: DVec3, mut add: impl FnMut(usize, f64)) {
         let reach = kernel.cutoff();
         let h = self.spacing;
+        if let Some(s) = self.slices {
+            let outside = |a: usize| {
+                let hi = self.min[a] + h[a] * self.counts[a] as f64;
+                a != s && !self.wrap[a] && !(self.min[a] <= at[a] && at[a] < hi)
+            };
+            if (0..3).any(outside) {
+                return;
+            }
+        }
         // The index range per axis (all of an axis a slice spans), and the offset along it.
         let range = |a: usize| -> (i64, i64) {
             if self.slices.is_some_and(|s| s != a) {
@@ -156,7 +168,11 @@ impl Grid {
             }
             let lo = ((at[a] - reach - self.min[a]) / h[a] - 0.5).floor() as i64;
             let hi = ((at[a] + reach - self.min[a]) / h[a] - 0.5).ceil() as i64;
-            (lo, hi)
+            match self.wrap[a] {
+                true => (lo, hi),
+                // (Points beyond the grid are skipped anyway.)
+                false => (lo.max(0), hi.min(self.counts[a] as i64 - 1)),
+            }
         };
         let index = |a: usize, i: i64| -> Option<usize> {
             let n = self.counts[a] as i64;

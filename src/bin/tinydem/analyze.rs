@@ -189,16 +189,9 @@ impl AnalyzeArgs {
         let mut no_pile = Vec::new();
         let count = frames.len();
         for (k, path) in frames {
-            let (p, clumps) = tinydem::io::pieces::load_frame(&path)?;
-            // A pile of clumps is fitted on the clumps' spheres (its surface, and diameters
-            // of the spheres for the window).
-            let spheres = match clumps {
-                Some(c) if !s.clumps.is_empty() => {
-                    Some(tinydem::io::inputs::with_clumps(&s, p.clone(), &c)?)
-                }
-                _ => None,
-            };
-            let row = table.row(k, (&p, spheres.as_ref().unwrap_or(&p)), &mut no_pile);
+            // Clumps as their spheres and bodies (a frame holds a row per body).
+            let p = tinydem::io::pieces::load_frame_as_grains(&path, &s)?;
+            let row = table.row(k, &p, &mut no_pile);
             println!("{}", aligned(&row));
             rows.push(row.join(","));
         }
@@ -249,10 +242,14 @@ fn frames_in(dir: &Path) -> Result<Vec<(u64, PathBuf)>> {
     Ok(frames)
 }
 
-/// The values of a row, right-aligned in columns 17 wide.
+/// The values of a row, right-aligned in columns 17 wide, or two more than the longest
+/// column name (so that names never run together).
 fn aligned<T: std::fmt::Display>(row: &[T]) -> String {
-    row.iter().map(|v| format!("{v:>17}")).collect()
+    row.iter().map(|v| format!("{v:>COLUMN$}")).collect()
 }
+
+/// The width of a column of the table.
+const COLUMN: usize = 22;
 
 /// What the table measures of each frame.
 struct Table {
@@ -293,25 +290,22 @@ impl Table {
         header
     }
 
-    /// The row of frame `k` with particles `p`; a frame with no pile to fit is added to
-    /// `no_pile` with the reason.
-    /// `spheres`: the particles with clumps as their spheres (the pile's surface).
-    fn row(
-        &self,
-        k: u64,
-        (p, spheres): (&Particles, &Particles),
-        no_pile: &mut Vec<(u64, NoPile)>,
-    ) -> Vec<String> {
+    /// The row of frame `k` with particles `p` (clumps as their spheres and bodies); a
+    /// frame with no pile to fit is added to `no_pile` with the reason. A pile of clumps is
+    /// fitted on its spheres (its surface, and their diameters for the window); the other
+    /// columns count grains (plain spheres and clumps).
+    fn row(&self, k: u64, p: &Particles, no_pile: &mut Vec<(u64, NoPile)>) -> Vec<String> {
+        let grains = p.len() - p.body.iter().filter(|b| b.is_some()).count() + p.bodies.len();
         let mut row = vec![
             k.to_string(),
             format!("{:.6e}", k as f64 * self.frame_time),
-            p.len().to_string(),
+            grains.to_string(),
             format!("{:.6e}", kinetic_energy(p, &self.densities)),
             format!("{:.4}", coordination_number(p)),
-            format!("{:.4}", packing_fraction(p)),
+            format!("{:.4}", packing_fraction(p, &self.densities)),
         ];
         if let Some(w) = self.repose {
-            match angle_of_repose(spheres, w) {
+            match angle_of_repose(p, w) {
                 Ok(a) => row.extend(
                     [a.left.angle, a.left.error, a.right.angle, a.right.error]
                         .map(|v| format!("{v:.2}")),

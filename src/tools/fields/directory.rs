@@ -8,7 +8,7 @@ use anyhow::{Context, Result, bail};
 use glam::DVec3;
 
 use super::{Fields, Grid, Kernel, Sums};
-use crate::io::pieces::{frame_number, load_frame, load_network};
+use crate::io::pieces::{frame_number, load_frame_as_grains, load_network};
 use crate::model::integrate::Inertia;
 use crate::model::particles::Particles;
 use crate::scenario::Scenario;
@@ -58,7 +58,7 @@ pub fn of_directory(
     };
     let frames = selected(dir, options.frames)?;
     let read = |k: u64| -> Result<(Particles, Vec<crate::engine::records::ContactRecord>)> {
-        let (p, _) = load_frame(&dir.join(crate::io::csv::frame_name(k)))?;
+        let p = load_frame_as_grains(&dir.join(crate::io::csv::frame_name(k)), &scenario)?;
         let name = format!("contacts{k:06}.csv");
         let contacts = load_network(&dir.join(&name)).with_context(|| {
             format!("the contact stress needs the contact network {name}: run with [output] contacts = true")
@@ -76,8 +76,8 @@ pub fn of_directory(
     let mut sums = Sums::new(grid.clone(), kernel);
     for (n, &k) in frames.iter().enumerate() {
         let (p, contacts) = read(k)?;
-        let mass = |i: usize| Inertia::mass(p.radius[i], densities[p.material[i] as usize]);
-        sums.add(&p, mass, Some(&contacts));
+        let mass = masses(&p, &densities);
+        sums.add(&p, |i| mass[i], Some(&contacts));
         if !options.average || n + 1 == frames.len() {
             let name = if options.average {
                 "fields_mean".to_string()
@@ -95,6 +95,23 @@ pub fn of_directory(
     Ok(out)
 }
 
+/// The mass of each particle: a plain sphere's of its radius and material, a clump's sphere
+/// its share of the clump's mass (by the cubes of the radii of its spheres), so that a
+/// clump counts once, with the mass of its body.
+fn masses(p: &Particles, densities: &[f64]) -> Vec<f64> {
+    let mut mass: Vec<f64> = (0..p.len())
+        .map(|i| Inertia::mass(p.radius[i], densities[p.material[i] as usize]))
+        .collect();
+    for (b, body) in p.bodies.list.iter().enumerate() {
+        let members = p.bodies.members(b);
+        let cubes: f64 = members.iter().map(|&k| p.radius[k as usize].powi(3)).sum();
+        for &k in members {
+            mass[k as usize] = body.mass * p.radius[k as usize].powi(3) / cubes;
+        }
+    }
+    mass
+}
+
 /// The numbers of the frames of `dir` from `range` (inclusive), or its last.
 fn selected(dir: &Path, range: Option<(u64, u64)>) -> Result<Vec<u64>> {
     let mut all: Vec<u64> = std::fs::read_dir(dir)
@@ -103,7 +120,43 @@ fn selected(dir: &Path, range: Option<(u64, u64)>) -> Result<Vec<u64>> {
         .collect();
     all.sort_unstable();
     let picked: Vec<u64> = match range {
-        Some((a, b)) => all.into_iter().filter(|k| (a..=b).contains(k)).collect(),
+        Some((a, b)) => {
+            if a > b {
+                bail!("--frames {a},{b}: FROM must not be after TO");
+            }
+            let picked: Vec<u64> = all
+                .iter()
+                .copied()
+                .filter(|k| (a..=b).contains(k))
+                .collect();
+            // Every frame asked for is there: an average over a frame deleted, or past the
+            // run's end, would quietly be over fewer.
+            let missing: Vec<u64> = (a..=b)
+                .filter(|k| picked.binary_search(k).is_err())
+                .collect();
+            if !missing.is_empty() && !all.is_empty() {
+                let shown: Vec<String> = missing.iter().take(5).map(u64::to_string).collect();
+                bail!(
+                    "{}: --frames {a},{b} asks for frames it does not hold: {}{} (it has frames \
+                     {} to {}{})",
+                    dir.display(),
+                    shown.join(", "),
+                    if missing.len() > 5 {
+                        format!(" and {} more", missing.len() - 5)
+                    } else {
+                        String::new()
+                    },
+                    all[0],
+                    all[all.len() - 1],
+                    if all.len() as u64 == all[all.len() - 1] - all[0] + 1 {
+                        ""
+                    } else {
+                        ", with gaps"
+                    }
+                );
+            }
+            picked
+        }
         None => all.last().copied().into_iter().collect(),
     };
     if picked.is_empty() {
@@ -143,12 +196,27 @@ fn grid_and_kernel(s: &Scenario, p: &Particles, options: &Options) -> Result<(Gr
             (lo, hi)
         }
     };
+    if !(min.is_finite() && max.is_finite()) {
+        bail!("the box {min} .. {max} is not finite");
+    }
     if !min.cmplt(max).all() {
         bail!("the box {min} .. {max} is empty");
     }
     let spacing = options.spacing.unwrap_or(2.0 * r);
-    if !(spacing > 0.0 && width > 0.0) {
-        bail!("the spacing and the kernel's width must be > 0");
+    if !(spacing > 0.0 && spacing.is_finite()) {
+        bail!("--spacing {spacing}: it must be a finite length > 0");
+    }
+    if !(width > 0.0 && width.is_finite()) {
+        bail!("--width {width}: it must be a finite length > 0");
+    }
+    let side = (max - min).max_element();
+    if kernel.cutoff() > side {
+        bail!(
+            "--width {width}: the kernel reaches {:.3e} m, beyond the box's largest side \
+             {side:.3e} m (a field that smooth is the box's mean): give a width below {:.3e} m",
+            kernel.cutoff(),
+            width * side / kernel.cutoff()
+        );
     }
     let wrap: [bool; 3] = std::array::from_fn(|a| {
         s.periodic[a]

@@ -416,13 +416,9 @@ impl Source {
     /// The particles of a frame: a clump's row (with the scenario's templates) as its
     /// spheres.
     fn particles_of(&self, frame: &Path) -> Result<Particles> {
-        let (p, clumps) = crate::io::pieces::load_frame(frame)?;
-        match (clumps, &self.sim) {
-            (Some(c), Some(sim)) if !sim.scenario.clumps.is_empty() => {
-                crate::io::inputs::with_clumps(&sim.scenario, p, &c)
-                    .with_context(|| format!("frame {}", frame.display()))
-            }
-            _ => Ok(p),
+        match &self.sim {
+            Some(sim) => crate::io::pieces::load_frame_as_grains(frame, &sim.scenario),
+            None => Ok(crate::io::pieces::load_frame(frame)?.0),
         }
     }
 
