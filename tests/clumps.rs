@@ -8,7 +8,7 @@ use glam::{DQuat, DVec3};
 use tinydem::particles::Particles;
 use tinydem::records::Partner;
 use tinydem::scenario::Scenario;
-use tinydem::simulation::Simulation;
+use tinydem::simulation::{Overlap, Simulation};
 
 const R: f64 = 0.005;
 const G: f64 = 9.81;
@@ -50,7 +50,7 @@ fn a_dumbbell_dropped_flat_rests_on_both_spheres_each_carrying_half_its_weight()
         DVec3::ZERO,
         DVec3::ZERO,
     );
-    let id = s.add_clump(0, 1.0, motion).unwrap();
+    let id = s.add_clump(0, 1.0, motion, Overlap::Refused).unwrap();
     assert_eq!(id, 0);
     assert_eq!(s.particles.len(), 2);
     run_for(&mut s, 0.5);
@@ -98,7 +98,7 @@ fn slide_on_incline(angle: f64) -> f64 {
         DVec3::ZERO,
         DVec3::ZERO,
     );
-    s.add_clump(0, 1.0, motion).unwrap();
+    s.add_clump(0, 1.0, motion, Overlap::Refused).unwrap();
     run_for(&mut s, 0.05); // settle
     let start = s.particles.bodies.list[0].x;
     run_for(&mut s, 0.3);
@@ -159,7 +159,7 @@ fn clump_collisions_conserve_momentum_and_angular_momentum() {
         ),
     ];
     for (t, x, q, v, w) in bodies {
-        s.add_clump(t, 1.0, (x, q, v, w)).unwrap();
+        s.add_clump(t, 1.0, (x, q, v, w), Overlap::Refused).unwrap();
     }
     let (m0, l0) = momenta(&s.particles);
     let mut touched = 0;
@@ -194,9 +194,11 @@ fn a_clump_of_one_sphere_moves_as_that_sphere_bit_for_bit() {
             DVec3::new(0.0, 30.0, 0.0),
         );
         if clump {
-            s.add_clump(1, 1.0, (x, DQuat::IDENTITY, v, w)).unwrap();
+            s.add_clump(1, 1.0, (x, DQuat::IDENTITY, v, w), Overlap::Refused)
+                .unwrap();
         } else {
-            s.add_particles(&[common::sphere(R, x, v, w)]).unwrap();
+            s.add_particles(&[common::sphere(R, x, v, w)], Overlap::Refused)
+                .unwrap();
         }
         run_for(&mut s, 0.2);
         s.particles
@@ -304,14 +306,18 @@ fn a_clump_whose_centre_enters_an_outlet_is_removed_whole() {
         0,
         1.0,
         (DVec3::ZERO, DQuat::from_rotation_y(1.2), down, DVec3::ZERO),
+        Overlap::Refused,
     )
     .unwrap();
-    s.add_particles(&[common::sphere(
-        R,
-        DVec3::new(0.1, 0.0, 0.0),
-        DVec3::ZERO,
-        DVec3::ZERO,
-    )])
+    s.add_particles(
+        &[common::sphere(
+            R,
+            DVec3::new(0.1, 0.0, 0.0),
+            DVec3::ZERO,
+            DVec3::ZERO,
+        )],
+        Overlap::Refused,
+    )
     .unwrap();
     let mass = s.particles.bodies.list[0].mass;
     run_for(&mut s, 0.05);
@@ -328,12 +334,18 @@ fn clumps_meeting_across_a_periodic_side_keep_their_shape_and_momenta() {
     let mut s = sim(&text(DVec3::ZERO, 0.5, domain));
     let tilt = DQuat::from_rotation_z(0.7);
     let (v, w) = (DVec3::new(0.8, 0.0, 0.0), DVec3::new(0.0, 5.0, -3.0));
-    s.add_clump(0, 1.0, (DVec3::new(0.03, 0.0, 0.0), tilt, v, w))
-        .unwrap();
+    s.add_clump(
+        0,
+        1.0,
+        (DVec3::new(0.03, 0.0, 0.0), tilt, v, w),
+        Overlap::Refused,
+    )
+    .unwrap();
     s.add_clump(
         0,
         1.0,
         (DVec3::new(-0.035, 0.002, 0.0), tilt.inverse(), -v, -w),
+        Overlap::Refused,
     )
     .unwrap();
     let (m0, l0) = momenta(&s.particles);
@@ -446,6 +458,7 @@ fn a_clump_crossing_the_sheared_side_of_a_lees_edwards_box_stays_whole() {
         0,
         1.0,
         (DVec3::new(0.0, 0.0, 0.04), q, v, DVec3::new(0.0, 3.0, 0.0)),
+        Overlap::Refused,
     )
     .unwrap();
     let mut straddled = false;
@@ -479,12 +492,20 @@ fn a_clump_crossing_the_sheared_side_of_a_lees_edwards_box_stays_whole() {
 fn a_clump_frozen_by_one_of_its_spheres_holds_still_under_a_falling_grain() {
     let mut s = sim(&text(DVec3::new(0.0, 0.0, -G), 0.5, ""));
     let q = DQuat::from_rotation_z(0.3);
-    s.add_clump(0, 1.0, (DVec3::ZERO, q, DVec3::ZERO, DVec3::ZERO))
-        .unwrap();
+    s.add_clump(
+        0,
+        1.0,
+        (DVec3::ZERO, q, DVec3::ZERO, DVec3::ZERO),
+        Overlap::Refused,
+    )
+    .unwrap();
     // A sphere dropped onto the clump's first sphere.
     let at = s.particles.x[0] + DVec3::new(0.0, 0.0, 3.0 * R);
-    s.add_particles(&[common::sphere(R, at, DVec3::ZERO, DVec3::ZERO)])
-        .unwrap();
+    s.add_particles(
+        &[common::sphere(R, at, DVec3::ZERO, DVec3::ZERO)],
+        Overlap::Refused,
+    )
+    .unwrap();
     // Fixing its second sphere fixes the clump whole.
     s.fix_particles(&[1], true).unwrap();
     assert_eq!(s.particles.fixed, [true, true, false]);

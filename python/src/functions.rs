@@ -22,7 +22,7 @@ pub(crate) fn run(
     from_checkpoint: Option<PathBuf>,
     quiet: bool,
 ) -> PyResult<PathBuf> {
-    let s = Scenario::load(&scenario).map_err(error)?;
+    let s = Scenario::load(&scenario).map_err(input_error)?;
     let out = output.unwrap_or_else(|| s.output_dir.clone());
     let pool = pool(threads)?;
     let requests = tinydem::run::Requests::default();
@@ -57,7 +57,23 @@ pub(crate) fn run(
         Err(panic) => return Err(panic_error(panic)),
     };
     match (result, interrupt) {
-        (Ok(_), _) => Ok(out),
+        (Ok(summary), _) => {
+            // What the command line warns of at the end of a run.
+            for short in &summary.spawn_shortfalls {
+                warn(py, short)?;
+            }
+            if summary.warnings > 0 {
+                warn(
+                    py,
+                    &format!(
+                        "{} pairs overlapped by more than the smaller radius at some step (the \
+                         run went on: it stops only past the smaller diameter). Likely cause: {}",
+                        summary.warnings, summary.advice
+                    ),
+                )?;
+            }
+            Ok(out)
+        }
         (Err(e), Some(signal)) => {
             // A stop with its checkpoint is said by the run itself.
             if e.downcast_ref::<tinydem::run::Interrupted>().is_none() {
@@ -259,7 +275,7 @@ pub(crate) fn read_csv<'py>(
     path: PathBuf,
 ) -> PyResult<(Vec<String>, Bound<'py, PyArray2<f64>>)> {
     let text = tinydem::files::read_to_string(&path)
-        .map_err(|e| PyRuntimeError::new_err(format!("cannot read {}: {e}", path.display())))?;
+        .map_err(|e| os_error(e.kind(), format!("cannot read {}: {e}", path.display())))?;
     let mut lines = text.lines();
     let header: Vec<String> = lines
         .next()

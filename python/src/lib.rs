@@ -8,16 +8,62 @@ use std::sync::Arc;
 use glam::{DQuat, DVec3};
 use numpy::ndarray::{Array1, Array2};
 use numpy::{AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArrayLike1, PyArrayLike2};
-use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::exceptions::{
+    PyFileExistsError, PyFileNotFoundError, PyOSError, PyPermissionError, PyRuntimeError,
+    PyRuntimeWarning, PyValueError,
+};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use tinydem::csv::Extra;
 use tinydem::scenario::Scenario;
 
-/// An error of the engine as a Python exception, with its whole chain of causes.
+/// An error of the engine as a Python exception, with its whole chain of causes: a file
+/// not found, there already or not permitted as the OSError of its kind, other failures to
+/// read or write as OSError, and the rest as RuntimeError.
 fn error(e: anyhow::Error) -> PyErr {
-    PyRuntimeError::new_err(pythonic(&format!("{e:#}")))
+    if e.downcast_ref::<tinydem::run::Refused>().is_some() {
+        return PyValueError::new_err(pythonic(&format!("{e:#}")));
+    }
+    match io_kind(&e) {
+        Some(kind) => os_error(kind, pythonic(&format!("{e:#}"))),
+        None => PyRuntimeError::new_err(pythonic(&format!("{e:#}"))),
+    }
+}
+
+/// An error in what the caller gave (a scenario, a file, an argument): the OSError of a
+/// file's trouble, else ValueError.
+fn input_error(e: anyhow::Error) -> PyErr {
+    match io_kind(&e) {
+        Some(kind) => os_error(kind, pythonic(&format!("{e:#}"))),
+        None => PyValueError::new_err(pythonic(&format!("{e:#}"))),
+    }
+}
+
+/// The kind of the first io error among the causes of `e`.
+fn io_kind(e: &anyhow::Error) -> Option<std::io::ErrorKind> {
+    e.chain()
+        .find_map(|c| c.downcast_ref::<std::io::Error>())
+        .map(std::io::Error::kind)
+}
+
+/// The OSError Python raises for an io error of `kind`.
+fn os_error(kind: std::io::ErrorKind, message: String) -> PyErr {
+    use std::io::ErrorKind::*;
+    match kind {
+        NotFound => PyFileNotFoundError::new_err(message),
+        AlreadyExists => PyFileExistsError::new_err(message),
+        PermissionDenied => PyPermissionError::new_err(message),
+        _ => PyOSError::new_err(message),
+    }
+}
+
+/// Says `message` as a Python warning (RuntimeWarning), as the command line says it with
+/// `warning:`; an error if the warnings filter turns warnings into errors.
+fn warn(py: Python<'_>, message: &str) -> PyResult<()> {
+    let text = std::ffi::CString::new(pythonic(message).replace('\0', " "))
+        .expect("no NUL left in the message");
+    PyErr::warn(py, &py.get_type::<PyRuntimeWarning>(), &text, 1)
 }
 
 /// A message of the engine with the command line's options named as Python's arguments.
@@ -167,6 +213,7 @@ impl Simulation {
     #[new]
     #[pyo3(signature = (scenario, threads=None, resume=None, from_checkpoint=None, force=false))]
     fn new(
+        py: Python<'_>,
         scenario: PathBuf,
         threads: Option<usize>,
         resume: Option<PathBuf>,
@@ -179,16 +226,28 @@ impl Simulation {
             ));
         }
         let pool = pool(threads)?;
-        let s = Scenario::load(&scenario).map_err(error)?;
-        if let Some(why) = tinydem::check::timestep_refusal(&s).filter(|_| !force) {
-            return Err(PyValueError::new_err(format!(
-                "{why} (pass force=True to run it anyway)"
-            )));
-        }
+        let s = Scenario::load(&scenario).map_err(input_error)?;
         let (sim, _) = guarded(|| {
             pool.install(|| tinydem::run::open(s, resume.as_deref(), from_checkpoint.as_deref()))
-                .map_err(error)
+                .map_err(input_error)
         })?;
+        // What the command line refuses (unless --force) and what it warns of.
+        let n = tinydem::check::most_particles(&sim.scenario, sim.particle_count())
+            + sim.removed.count() as usize;
+        let out = sim.scenario.output_dir.clone();
+        let refused = tinydem::check::refusals(&sim.scenario, n, &out);
+        if !refused.is_empty() && !force {
+            return Err(PyValueError::new_err(format!(
+                "{} (pass force=True to run it anyway)",
+                refused.join("\n")
+            )));
+        }
+        for why in refused {
+            warn(py, &format!("{why} (forced)"))?;
+        }
+        for caution in tinydem::check::cautions(&sim.scenario) {
+            warn(py, &caution)?;
+        }
         Ok(Simulation {
             sim,
             pool,
@@ -201,7 +260,12 @@ impl Simulation {
     /// becomes unstable, and so does every later call, with that diagnosis, unless
     /// `force=True` (the state is as the failing step left it).
     #[pyo3(signature = (n=1, force=false))]
-    fn step(&mut self, py: Python<'_>, n: u64, force: bool) -> PyResult<()> {
+    fn step(&mut self, py: Python<'_>, n: i64, force: bool) -> PyResult<()> {
+        let Ok(n) = u64::try_from(n) else {
+            return Err(PyValueError::new_err(format!(
+                "step({n}): the number of steps must be >= 0"
+            )));
+        };
         if let Some(why) = self.unstable.as_ref().filter(|_| !force) {
             return Err(PyRuntimeError::new_err(format!(
                 "{why}\n(this simulation became unstable then; its state is as that step left it: step(force=True) steps on anyway)"
@@ -234,6 +298,17 @@ impl Simulation {
                 Err(e) => return Err(e),
             };
             left -= done;
+            // What the command line warns of: overlaps past the smaller radius.
+            for said in self.sim.take_new_warnings() {
+                warn(
+                    py,
+                    &format!(
+                        "{said} (the run goes on: it stops only past the smaller diameter). \
+                         Likely cause: {}",
+                        self.sim.advice()
+                    ),
+                )?;
+            }
             py.check_signals()?;
         }
         Ok(())
@@ -283,8 +358,11 @@ impl Simulation {
     /// with its centre of mass at `position` [m], `orientation` (q0, q1, q2, q3) (default
     /// unrotated: the template's principal axes along x, y, z), `velocity`,
     /// `angular_velocity` and lengths scaled by `scale`; returns the body's id (that of its
-    /// first sphere; its spheres have the next ids). Overlaps are not checked.
-    #[pyo3(signature = (clump, position, orientation=None, velocity=None, angular_velocity=None, scale=1.0))]
+    /// first sphere; its spheres have the next ids). A clump that would overlap a particle
+    /// or a mesh face by more than a tenth of the smaller radius is refused (ValueError)
+    /// unless `allow_overlap=True`.
+    #[pyo3(signature = (clump, position, orientation=None, velocity=None, angular_velocity=None, scale=1.0, allow_overlap=false))]
+    #[allow(clippy::too_many_arguments)] // Python's keyword arguments
     fn add_clump(
         &mut self,
         clump: &Bound<'_, PyAny>,
@@ -293,6 +371,7 @@ impl Simulation {
         velocity: Option<[f64; 3]>,
         angular_velocity: Option<[f64; 3]>,
         scale: f64,
+        allow_overlap: bool,
     ) -> PyResult<i64> {
         let templates = &self.sim.scenario.clumps;
         let template = match clump.extract::<usize>() {
@@ -313,8 +392,10 @@ impl Simulation {
             DVec3::from_array(velocity.unwrap_or_default()),
             DVec3::from_array(angular_velocity.unwrap_or_default()),
         );
-        let id = (self.sim.add_clump(template, scale, motion))
-            .map_err(|e| PyValueError::new_err(format!("{e:#}")))?;
+        let id = (self
+            .sim
+            .add_clump(template, scale, motion, overlap(allow_overlap)))
+        .map_err(|e| PyValueError::new_err(format!("{e:#}")))?;
         Ok(id as i64)
     }
 
@@ -330,7 +411,10 @@ impl Simulation {
     /// Adds particles at `positions` (N, 3) with `radii` (N,) [m], `velocities` and
     /// `angular_velocities` (default zero), `material` (an index of the scenario's
     /// materials) and `tag`; returns their ids (the next ones). Array-likes of numbers.
-    #[pyo3(signature = (positions, radii, velocities=None, angular_velocities=None, material=0, tag=0))]
+    /// Radii must lie within the scenario's [geometry] radius_min..radius_max, and a
+    /// particle that would overlap another (new or present) or a mesh face by more than a
+    /// tenth of the smaller radius is refused (ValueError) unless `allow_overlap=True`.
+    #[pyo3(signature = (positions, radii, velocities=None, angular_velocities=None, material=0, tag=0, allow_overlap=false))]
     #[allow(clippy::too_many_arguments)] // Python's keyword arguments
     fn add<'py>(
         &mut self,
@@ -341,6 +425,7 @@ impl Simulation {
         angular_velocities: Option<Vectors>,
         material: u16,
         tag: u32,
+        allow_overlap: bool,
     ) -> PyResult<Bound<'py, PyArray1<i64>>> {
         let r = radii.as_array().to_vec();
         let n = r.len();
@@ -369,8 +454,8 @@ impl Simulation {
             .collect();
         let ids = self
             .sim
-            .add_particles(&new)
-            .map_err(|e| PyValueError::new_err(format!("material: {e:#}")))?;
+            .add_particles(&new, overlap(allow_overlap))
+            .map_err(|e| PyValueError::new_err(format!("{e:#}")))?;
         Ok(Array1::from_iter(ids.into_iter().map(|id| id as i64)).into_pyarray(py))
     }
 
@@ -556,6 +641,14 @@ fn _tinydem(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(_internal_panic, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
+}
+
+/// The engine's overlap rule for an `allow_overlap` argument.
+fn overlap(allow: bool) -> tinydem::simulation::Overlap {
+    match allow {
+        true => tinydem::simulation::Overlap::Allowed,
+        false => tinydem::simulation::Overlap::Refused,
+    }
 }
 
 /// Particle ids from Python: whole numbers from 0 (64-bit, as numpy's int64 holds them).

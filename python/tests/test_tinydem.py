@@ -7,6 +7,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -176,12 +178,22 @@ def test_read_frame_reads_tags_and_ids(tmp_path):
 
 
 def test_errors_are_python_exceptions(tmp_path):
-    with pytest.raises(RuntimeError, match="cannot read scenario"):
+    with pytest.raises(FileNotFoundError, match="cannot read scenario"):
         tinydem.Simulation(tmp_path / "missing.toml")
     bad = tmp_path / "bad.toml"
     bad.write_text("[simulation]\nframes = -1\n")
-    with pytest.raises(RuntimeError):
+    with pytest.raises(ValueError, match=r"bad.toml:2: \[simulation\] frames"):
         tinydem.Simulation(bad)
+    unknown = tmp_path / "unknown.toml"
+    unknown.write_text("[simulation]\nframez = 3\n")
+    with pytest.raises(ValueError, match="unknown field `framez`"):
+        tinydem.run(unknown)
+    no_mesh = tmp_path / "no_mesh.toml"
+    no_mesh.write_text('[geometry]\nmesh = "box.stl"\n')
+    with pytest.raises(FileNotFoundError, match=r"\[geometry\] mesh: cannot read .*box.stl"):
+        tinydem.Simulation(no_mesh)
+    with pytest.raises(FileNotFoundError):
+        tinydem.run(no_mesh)
 
 
 def test_an_unstable_run_raises(tmp_path):
@@ -199,7 +211,7 @@ def test_an_unstable_run_raises(tmp_path):
     # As run() does, the constructor refuses that time step unless forced.
     with pytest.raises(ValueError, match="pass force=True"):
         tinydem.Simulation(s)
-    with pytest.raises(RuntimeError, match=r"pass force=True to run it anyway\)"):
+    with pytest.raises(ValueError, match=r"pass force=True to run it anyway\)"):
         tinydem.run(s, output=tmp_path / "out")
     sim = tinydem.Simulation(s, force=True)
     with pytest.raises(RuntimeError, match="unstable") as first:
@@ -351,7 +363,7 @@ def test_clumps_added_from_python_move_as_rigid_bodies(tmp_path):
 def test_errors_name_python_arguments(study, tmp_path):
     s, _ = study
     tinydem.run(s, output=tmp_path / "out")
-    with pytest.raises(RuntimeError) as e:
+    with pytest.raises(FileExistsError) as e:
         tinydem.run(s, output=tmp_path / "out")
     assert "overwrite=True" in str(e.value) and "--overwrite" not in str(e.value)
 
@@ -406,7 +418,7 @@ def test_fields_of_a_bed_hold_its_mass_and_press_down(tmp_path):
     with pytest.raises(ValueError, match="kernel"):
         tinydem.fields(out, kernel="box")
     (out / "contacts000003.csv").unlink()
-    with pytest.raises(RuntimeError, match="contacts = true"):
+    with pytest.raises(FileNotFoundError, match="contacts = true"):
         tinydem.fields(out)
 
 
@@ -479,3 +491,48 @@ def test_a_frame_in_pieces_reads_as_one(tmp_path):
     (tmp_path / "particles000007_1.csv").unlink()
     with pytest.raises(FileNotFoundError, match="particles000007_1.csv is missing"):
         tinydem.read_frame(tmp_path / "particles000007.csv")
+
+
+def test_a_forced_blow_up_warns_as_the_command_line_does(tmp_path):
+    """Two grains at 20 x Eq. 50's time step, forced: they pass halfway through each other in
+    a step. The command line warns of the overlap past the smaller radius; Python says it as
+    a RuntimeWarning (and the forced refusal itself)."""
+    (tmp_path / "p.csv").write_text(
+        "x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz\n"
+        "-0.0052,0,0,0.005,2,0,0,1,0,0,0,0,0,0\n0.0052,0,0,0.005,-2,0,0,1,0,0,0,0,0,0\n"
+    )
+    s = tmp_path / "s.toml"
+    s.write_text(
+        "[geometry]\nradius_min = 0.005\nradius_max = 0.01\n"
+        "[kinetics]\ngravity = [0.0, 0.0, 0.0]\n"
+        "[simulation]\ntimestep = 3e-3\nmax_particles = 0\n"
+        '[input]\nparticles = "p.csv"\n'
+    )
+    with pytest.raises(ValueError, match="Eq. 50"):
+        tinydem.Simulation(s)
+    with pytest.warns(RuntimeWarning, match=r"x Eq. 50.*\(forced\)"):
+        sim = tinydem.Simulation(s, force=True)
+    with pytest.warns(RuntimeWarning, match="overlap .* more than the smaller radius") as said:
+        sim.step(100)
+    assert any("Likely cause: timestep" in str(w.message) for w in said)
+    # Once per pair, as on the command line.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sim.step(100)
+
+
+def test_add_refuses_deep_overlaps_and_radii_the_lists_are_not_made_for(study):
+    s, _ = study
+    sim = tinydem.Simulation(s)
+    r = 0.005
+    with pytest.raises(ValueError, match="new particle 0 would overlap new particle 1 by 196 % of the smaller radius"):
+        sim.add([[0.0, 0.0, 0.3], [0.0002, 0.0, 0.3]], [r, r])
+    with pytest.raises(ValueError, match=r"radius 0.07 .* outside \[geometry\] radius_min"):
+        sim.add([[0.0, 0.0, 0.3]], [0.07])
+    n = len(sim)
+    assert sim.add([[0.0, 0.0, 0.3], [0.0002, 0.0, 0.3]], [r, r], allow_overlap=True).shape == (2,)
+    assert len(sim) == n + 2
+    with pytest.raises(ValueError, match="would overlap particle"):
+        sim.add([[0.0, 0.0, 0.3]], [r])
+    with pytest.raises(ValueError, match=r"step\(-5\): the number of steps must be >= 0"):
+        sim.step(-5)

@@ -2,7 +2,7 @@
 
 import os
 from pathlib import Path
-from typing import Dict, List, Optional, Tuple, Union
+from typing import Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -25,8 +25,9 @@ class Simulation:
         force: bool = False,
     ) -> None: ...
     def step(self, n: int = 1, force: bool = False) -> None:
-        """Advances by n time steps; RuntimeError when the run becomes unstable, and at every
-        later call (with that diagnosis, doing nothing) unless force=True."""
+        """Advances by n >= 0 time steps; RuntimeError when the run becomes unstable, and at
+        every later call (with that diagnosis, doing nothing) unless force=True. Overlaps past
+        the smaller radius are said as RuntimeWarnings, as the command line says them."""
     @property
     def time(self) -> float:
         """Simulated time [s]."""
@@ -50,8 +51,27 @@ class Simulation:
         angular_velocities: Optional[npt.ArrayLike] = None,
         material: int = 0,
         tag: int = 0,
+        allow_overlap: bool = False,
     ) -> npt.NDArray[np.int64]:
-        """Adds particles with the next ids, which it returns."""
+        """Adds particles with the next ids, which it returns. ValueError for radii outside
+        [geometry] radius_min..radius_max, and for overlaps with other particles or mesh
+        faces deeper than a tenth of the smaller radius unless allow_overlap=True."""
+    def add_clump(
+        self,
+        clump: Union[str, int],
+        position: Sequence[float],
+        orientation: Optional[Sequence[float]] = None,
+        velocity: Optional[Sequence[float]] = None,
+        angular_velocity: Optional[Sequence[float]] = None,
+        scale: float = 1.0,
+        allow_overlap: bool = False,
+    ) -> int:
+        """Adds a clump of a [[clumps]] template (its name or index) with its centre of mass at
+        position; returns the body's id (that of its first sphere). ValueError for overlaps
+        deeper than a tenth of the smaller radius unless allow_overlap=True."""
+    @property
+    def bodies(self) -> npt.NDArray[np.int64]:
+        """(N,) the body each particle is a sphere of (its id), -1 for a plain sphere."""
     def remove(self, ids: npt.ArrayLike) -> None:
         """Removes the particles of these ids."""
     def freeze(self, ids: npt.ArrayLike) -> None:

@@ -408,12 +408,26 @@ fn refuse(sim: &Simulation, output_dir: &Path) -> Result<()> {
     sim.agree(if why.is_empty() {
         Ok(())
     } else {
-        Err(anyhow::anyhow!(
-            "{}\n(run with --force to run it anyway)",
-            why.join("\n")
-        ))
+        Err(Refused(why).into())
     })
 }
+
+/// What `tinydem check` refuses a run for, said with the way past it (`--force`): an
+/// error of its own type, so that Python raises it as a ValueError.
+#[derive(Clone, Debug)]
+pub struct Refused(pub Vec<String>);
+
+impl std::fmt::Display for Refused {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{}\n(run with --force to run it anyway)",
+            self.0.join("\n")
+        )
+    }
+}
+
+impl std::error::Error for Refused {}
 
 /// The error of a run that became unstable, with the state at the failure written to
 /// `unstable.csv` (collective).

@@ -3,6 +3,19 @@
 
 use super::*;
 
+/// Whether particles added from outside the step may overlap others deeply.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Overlap {
+    /// More than [`DEEPEST_ADDED`] of the smaller radius is refused.
+    Refused,
+    Allowed,
+}
+
+/// The deepest overlap of an added particle with another or a face that is taken without
+/// being asked for (`Overlap::Allowed`), as a fraction of the smaller radius: a packing made
+/// elsewhere may overlap a little; deeper, the contact law throws the grains apart.
+pub const DEEPEST_ADDED: f64 = 0.1;
+
 impl Simulation {
     /// After particles were moved from outside the step: the lists are made anew at the
     /// next step (with the springs of the contacts they keep).
@@ -12,7 +25,11 @@ impl Simulation {
 
     /// Adds `new` particles with the next ids (returned); the lists take them in at the
     /// next step. Their materials must be the scenario's.
-    pub fn add_particles(&mut self, new: &[crate::model::particles::Particle]) -> Result<Vec<Id>> {
+    pub fn add_particles(
+        &mut self,
+        new: &[crate::model::particles::Particle],
+        overlap: Overlap,
+    ) -> Result<Vec<Id>> {
         self.refuse_split("add particles")?;
         let n = self.scenario.materials.len();
         if let Some(p) = new.iter().find(|p| p.material as usize >= n) {
@@ -21,6 +38,19 @@ impl Simulation {
                 p.material,
                 n - 1
             );
+        }
+        let g = &self.scenario.geometry;
+        let (lo, hi) = (g.radius_min, g.radius_max);
+        if let Some(k) = new.iter().position(|p| !(lo..=hi).contains(&p.radius)) {
+            bail!(
+                "radius {} of particle {k} is outside [geometry] radius_min..radius_max = \
+                 {lo}..{hi} (the neighbour lists are made for those)",
+                new[k].radius
+            );
+        }
+        if overlap == Overlap::Refused {
+            let spheres: Vec<(DVec3, f64)> = new.iter().map(|p| (p.x, p.radius)).collect();
+            self.refuse_deep_overlaps(&spheres, false)?;
         }
         let first = self.particles.next_id;
         for p in new {
@@ -39,6 +69,7 @@ impl Simulation {
         template: usize,
         scale: f64,
         (x, q, v, w): (DVec3, glam::DQuat, DVec3, DVec3),
+        overlap: Overlap,
     ) -> Result<Id> {
         self.refuse_split("add clumps")?;
         let Some(t) = self.scenario.clumps.get(template) else {
@@ -55,11 +86,71 @@ impl Simulation {
                 "a clump's position, orientation and velocities must be finite, the orientation not zero"
             );
         }
+        let q = q.normalize();
+        if overlap == Overlap::Refused {
+            let spheres: Vec<(DVec3, f64)> = (t.spheres.iter())
+                .map(|s| (x + q * (scale * s.centre), scale * s.radius))
+                .collect();
+            self.refuse_deep_overlaps(&spheres, true)?;
+        }
         let first = self.particles.next_id;
-        let motion = (x, q.normalize(), v, w);
+        let motion = (x, q, v, w);
         spawn::place_clump(&mut self.particles, (t, template as u16), scale, motion);
         self.particles_moved();
         Ok(first)
+    }
+
+    /// Refuses new spheres `(centre, radius)` that would overlap a particle present, a mesh
+    /// face or (unless they are the spheres of one clump, `one_body`) one another by more
+    /// than [`DEEPEST_ADDED`] of the smaller radius: the contact law would throw them apart.
+    fn refuse_deep_overlaps(&self, new: &[(DVec3, f64)], one_body: bool) -> Result<()> {
+        let p = &self.particles;
+        let reach = 2.0
+            * p.max_radius()
+                .max(new.iter().map(|s| s.1).fold(0.0, f64::max));
+        let mut x: Vec<DVec3> = p.x.clone();
+        let mut radius: Vec<f64> = p.radius.clone();
+        if !one_body {
+            x.extend(new.iter().map(|s| s.0));
+            radius.extend(new.iter().map(|s| s.1));
+        }
+        let grid = crate::neighbours::CellGrid::of_points(&x, reach.max(f64::MIN_POSITIVE));
+        let name = |j: usize| match j.checked_sub(p.len()) {
+            None => format!("particle {}", p.id[j]),
+            Some(k) => format!("new particle {k}"),
+        };
+        for (k, &(at, r)) in new.iter().enumerate() {
+            if !(at.is_finite() && r.is_finite()) {
+                bail!("particle {k}: its place and radius must be finite");
+            }
+            let mut found = None;
+            grid.for_each_near(at, |j| {
+                let j = j as usize;
+                let gap = at.distance(x[j]) - r - radius[j];
+                let other = j != p.len() + k;
+                if found.is_none() && other && gap < -DEEPEST_ADDED * r.min(radius[j]) {
+                    found = Some((j, -gap / r.min(radius[j])));
+                }
+            });
+            if let Some((j, depth)) = found {
+                bail!(
+                    "new particle {k} would overlap {} by {:.0} % of the smaller radius",
+                    name(j),
+                    100.0 * depth
+                );
+            }
+            for &f in self.face_grid.at(at).iter() {
+                let face = &self.walls.mesh.faces[f as usize];
+                let gap = face.separation(at).length() - r - face.radius;
+                if gap < -DEEPEST_ADDED * r {
+                    bail!(
+                        "new particle {k} would overlap mesh face {f} by {:.0} % of its radius",
+                        -100.0 * gap / r
+                    );
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Removes the particles of `ids` (each must be present) and the springs of their

@@ -32,6 +32,7 @@ mod advance;
 mod bodies;
 mod checks;
 mod edit;
+pub use edit::{DEEPEST_ADDED, Overlap};
 mod faces;
 mod loads;
 mod pairs;

@@ -60,13 +60,15 @@ impl Scenario {
                 let absolute = |p: &Path| std::path::absolute(p).unwrap_or(p.to_path_buf());
                 let dir = path.parent().filter(|d| !d.as_os_str().is_empty());
                 let dir = dir.unwrap_or(Path::new("."));
-                bail!(
+                // (The io error kept as the cause, so that Python raises FileNotFoundError.)
+                let said = format!(
                     "{}: {key}: cannot read {}: {e} (a relative path is taken from the \
                      scenario's directory, {})",
                     path.display(),
                     absolute(file).display(),
                     absolute(dir).display()
                 );
+                return Err(std::io::Error::new(e.kind(), said).into());
             }
         }
         Ok(())

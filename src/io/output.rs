@@ -114,12 +114,17 @@ pub fn claim_output(dir: &Path, overwrite: bool) -> Result<()> {
         return Ok(());
     }
     if !overwrite {
-        anyhow::bail!(
-            "{} holds the output of an earlier run ({} files, e.g. {}): pass --overwrite to replace it, --resume to continue it, or --output another directory",
-            dir.display(),
-            old.len(),
-            old[0].file_name().unwrap_or_default().to_string_lossy()
-        );
+        // (An io error of its kind, so that Python raises FileExistsError.)
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::AlreadyExists,
+            format!(
+                "{} holds the output of an earlier run ({} files, e.g. {}): pass --overwrite to replace it, --resume to continue it, or --output another directory",
+                dir.display(),
+                old.len(),
+                old[0].file_name().unwrap_or_default().to_string_lossy()
+            ),
+        )
+        .into());
     }
     for p in old {
         std::fs::remove_file(&p).with_context(|| format!("cannot remove {}", p.display()))?;
