@@ -278,7 +278,7 @@ fn analyze_fields_averages_slices_and_needs_the_contact_networks() {
         BOX,
     ]);
     assert!(
-        said.contains("fields_mean.vti") && said.contains("1 x 1 x 11 points, 3 frame(s)"),
+        said.contains("slices_z_mean.vti") && said.contains("1 x 1 x 11 points, 3 frame(s)"),
         "{said}"
     );
     // Without contact networks, the contact stress cannot be had: a clear error.
@@ -353,7 +353,19 @@ fn slices_hold_the_mass_of_the_grains_within_their_box_and_no_more() {
         t.path(),
     );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let density = csv_column(&t.path().join("out/fields000001.csv"), "density");
+    let density = csv_column(&t.path().join("out/slices_z000001.csv"), "density");
+    // A grid of the same frame goes to a file of its own (it replaced the slices' before).
+    let o = common::tinydem(
+        &["analyze", "out", "--fields", "--spacing", "0.01"],
+        t.path(),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let grid = csv_column(&t.path().join("out/fields000001.csv"), "density");
+    assert!(grid.len() > density.len());
+    assert_eq!(
+        csv_column(&t.path().join("out/slices_z000001.csv"), "density"),
+        density
+    );
     let dz = (top + 0.02) / density.len() as f64;
     let field_mass: f64 = density.iter().map(|rho| rho * dz * 0.05 * 0.05).sum();
     assert!(

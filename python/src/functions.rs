@@ -175,7 +175,8 @@ pub(crate) fn render<'py>(
 /// Coarse-grained fields of a run's output directory (as `tinydem analyze --fields`):
 /// density, velocity and stress (compression positive) with its contact and kinetic parts,
 /// on a grid or in slices, each set also written as fieldsNNNNNN.vti and .csv beside the
-/// frames (fields_mean.* averaged). Returns a list of dicts of numpy arrays: points (N, 3),
+/// frames (slices_zNNNNNN.* in slices along z, so that they never replace a grid's;
+/// fields_mean.* and slices_z_mean.* averaged). Returns a list of dicts of numpy arrays: points (N, 3),
 /// counts (3,), density (N,), velocity (N, 3), stress, contact_stress, kinetic_stress
 /// (N, 3, 3), frames (how many it averages) and files.
 ///

@@ -155,4 +155,5 @@ def fields(
     bounds: Optional[Tuple[Tuple[float, float, float], Tuple[float, float, float]]] = None,
 ) -> List[Dict[str, object]]:
     """Coarse-grained density, velocity and stress of a run's frames (as `tinydem analyze
-    --fields`): a dict of numpy arrays per set, also written as fieldsNNNNNN.vti and .csv."""
+    --fields`): a dict of numpy arrays per set, also written as fieldsNNNNNN.vti and .csv
+    (slices_zNNNNNN.* in slices along z)."""

@@ -78,6 +78,9 @@ pub fn is_run_output(name: &str) -> bool {
         || frame("contacts")
         || frame("mesh")
         || frame("fields")
+        || ["x", "y", "z"].iter().any(|a| {
+            frame(&format!("slices_{a}")) || name.starts_with(&format!("slices_{a}_mean."))
+        })
         || [
             RUN_TOML,
             FRAMES,

@@ -63,7 +63,8 @@ pub struct AnalyzeArgs {
 struct FieldArgs {
     /// Instead of the table: coarse-grained density, velocity and stress (contact and
     /// kinetic parts, compression positive) on a grid or in slices, as fieldsNNNNNN.vti and
-    /// .csv beside the frames (fields_mean.* with --average). Needs the contact networks
+    /// .csv beside the frames (slices_zNNNNNN.* in slices along z; fields_mean.* and
+    /// slices_z_mean.* with --average). Needs the contact networks
     /// ([output] contacts = true).
     #[arg(long)]
     fields: bool,

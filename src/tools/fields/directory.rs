@@ -79,11 +79,7 @@ pub fn of_directory(
         let mass = masses(&p, &densities);
         sums.add(&p, |i| mass[i], Some(&contacts));
         if !options.average || n + 1 == frames.len() {
-            let name = if options.average {
-                "fields_mean".to_string()
-            } else {
-                format!("fields{k:06}")
-            };
+            let name = file_name(options, k);
             let fields = sums.fields();
             let files = write(dir, &name, &fields)?;
             out.push((fields, files));
@@ -93,6 +89,20 @@ pub fn of_directory(
         }
     }
     Ok(out)
+}
+
+/// The name (without extension) of the fields of frame `k`: `fieldsNNNNNN` on a grid,
+/// `slices_zNNNNNN` in slices along z (so that the slices of a frame do not replace its
+/// grid), `fields_mean` and `slices_z_mean` averaged.
+pub fn file_name(options: &Options, k: u64) -> String {
+    let kind = match options.slices {
+        Some(a) => format!("slices_{}", ["x", "y", "z"][a]),
+        None => "fields".to_string(),
+    };
+    match options.average {
+        true => format!("{kind}_mean"),
+        false => format!("{kind}{k:06}"),
+    }
 }
 
 /// The mass of each particle: a plain sphere's of its radius and material, a clump's sphere
