@@ -25,6 +25,8 @@ pub enum ColorBy {
     Radius,
     Tag,
     Material,
+    /// Each clump in a colour of its own (drawn from ten by its id), plain spheres grey.
+    Clump,
 }
 
 /// Where the camera looks from.
@@ -67,12 +69,36 @@ impl ColorBy {
             ColorBy::Radius => "radius [m]",
             ColorBy::Tag => "tag",
             ColorBy::Material => "material",
+            ColorBy::Clump => "grain",
         }
     }
 
     /// Whether the values are categories (a legend) rather than a scale (a colour bar).
     fn categorical(self) -> bool {
-        matches!(self, ColorBy::Tag | ColorBy::Material)
+        matches!(self, ColorBy::Tag | ColorBy::Material | ColorBy::Clump)
+    }
+
+    /// The colour of value `v` of a categorical colouring.
+    fn category(self, v: f64) -> DVec3 {
+        match self {
+            ColorBy::Clump if v < 0.0 => PLAIN,
+            // A clump's colour from its id, mixed, so that neighbours (of nearby ids) differ.
+            ColorBy::Clump => {
+                let mut h = (v as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+                h ^= h >> 31;
+                category_colour((h % CATEGORIES.len() as u64) as u32)
+            }
+            _ => category_colour(v as u32),
+        }
+    }
+
+    /// The entries of the legend for the categories seen: each with its colour.
+    fn legend_colour(self, k: u32) -> DVec3 {
+        match (self, k) {
+            (ColorBy::Clump, CLUMPS) => category_colour(0),
+            (ColorBy::Clump, _) => PLAIN,
+            _ => category_colour(k),
+        }
     }
 
     fn values(self, p: &Particles) -> Vec<f64> {
@@ -82,6 +108,9 @@ impl ColorBy {
             ColorBy::Radius => p.radius.clone(),
             ColorBy::Tag => p.tag.iter().map(|&t| t as f64).collect(),
             ColorBy::Material => p.material.iter().map(|&m| m as f64).collect(),
+            ColorBy::Clump => (p.body.iter())
+                .map(|b| b.map_or(-1.0, |b| b.first() as f64))
+                .collect(),
         }
     }
 }
@@ -125,6 +154,13 @@ const CATEGORIES: [[f64; 3]; 10] = [
     [0.737, 0.741, 0.133],
     [0.090, 0.745, 0.812],
 ];
+
+/// Plain spheres among clumps (`--color clump`).
+const PLAIN: DVec3 = DVec3::new(0.78, 0.78, 0.78);
+
+/// The legend's entries of `--color clump`: clumps (each its colour), plain spheres.
+const CLUMPS: u32 = 0;
+const SPHERES: u32 = 1;
 
 fn category_colour(k: u32) -> DVec3 {
     DVec3::from_array(CATEGORIES[k as usize % CATEGORIES.len()])
@@ -203,12 +239,13 @@ impl Layout {
 
     /// Grows the layout to show the frame `p` with `mesh`: the particles without the
     /// farthest half per cent on each side (a few escaped grains should not shrink the
-    /// picture; the mesh where there are none), and the colour values from the 1 % to the 99 % quantile (radii: all, as a
-    /// few special particles are the point of such a picture).
+    /// picture), and the mesh along the axes where it is at most twice as wide as they (a
+    /// drum around its charge shows whole; a settled bed fills the picture rather than lie as a
+    /// strip at the bottom of a tall container); the mesh alone where there are no particles;
+    /// and the colour values from the 1 % to the 99 % quantile (radii: all, as a few special
+    /// particles are the point of such a picture).
     pub fn include(&mut self, p: &Particles, mesh: &Mesh, style: &Style) {
         let cam = camera(style.view);
-        // The view is the particles' (a settled bed fills it, not a strip at the bottom of
-        // its container); the mesh's only where there are none.
         if p.is_empty() {
             for face in &mesh.faces {
                 for c in face.corners() {
@@ -221,15 +258,50 @@ impl Layout {
         }
         let r_max = p.max_radius();
         let cut = p.len() / 200;
-        for axis in 0..3 {
-            let mut v: Vec<f64> = p.x.iter().map(|x| (cam * *x)[axis]).collect();
+        let range = |of: &dyn Fn(DVec3) -> f64| {
+            let mut v: Vec<f64> = p.x.iter().map(|x| of(*x)).collect();
             v.sort_by(f64::total_cmp);
-            self.lo[axis] = self.lo[axis].min(v[cut] - r_max);
-            self.hi[axis] = self.hi[axis].max(v[v.len() - 1 - cut] + r_max);
+            (v[cut] - r_max, v[v.len() - 1 - cut] + r_max)
+        };
+        for axis in 0..3 {
+            let (lo, hi) = range(&|x| (cam * x)[axis]);
+            self.lo[axis] = self.lo[axis].min(lo);
+            self.hi[axis] = self.hi[axis].max(hi);
+        }
+        // The mesh's vertices within the box of the particles, grown along the world axes
+        // where the mesh is at most twice as wide.
+        let (mut lo, mut hi) = (DVec3::ZERO, DVec3::ZERO);
+        for a in 0..3 {
+            (lo[a], hi[a]) = range(&|x| x[a]);
+        }
+        let (mesh_lo, mesh_hi) =
+            (mesh.faces.iter()).fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(l, h), f| {
+                let (a, b) = f.bounding_box();
+                (l.min(a), h.max(b))
+            });
+        for a in 0..3 {
+            if mesh_hi[a] - mesh_lo[a] <= 2.0 * (hi[a] - lo[a]) {
+                (lo[a], hi[a]) = (lo[a].min(mesh_lo[a]), hi[a].max(mesh_hi[a]));
+            }
+        }
+        for face in &mesh.faces {
+            for c in face.corners() {
+                let c = cam * c.clamp(lo, hi);
+                self.lo = self.lo.min(c);
+                self.hi = self.hi.max(c);
+            }
         }
         let mut values = style.color.values(p);
-        if style.color.categorical() {
-            self.categories.extend(values.iter().map(|&v| v as u32));
+        match style.color {
+            ColorBy::Clump => (self.categories).extend(
+                values
+                    .iter()
+                    .map(|&v| if v < 0.0 { SPHERES } else { CLUMPS }),
+            ),
+            _ if style.color.categorical() => {
+                self.categories.extend(values.iter().map(|&v| v as u32))
+            }
+            _ => {}
         }
         values.sort_by(f64::total_cmp);
         let cut = if style.color == ColorBy::Radius {
@@ -284,6 +356,8 @@ impl Layout {
 
     fn label(&self, color: ColorBy, k: u32) -> String {
         match color {
+            ColorBy::Clump if k == CLUMPS => "clumps (a colour each)".to_string(),
+            ColorBy::Clump => "plain spheres".to_string(),
             ColorBy::Material => match self.material_names.get(k as usize) {
                 Some(name) => format!("{k} {name}"),
                 None => format!("material {k}"),

@@ -103,7 +103,7 @@ pub fn render_in(
     let values = style.color.values(p);
     let colour = |v: f64| {
         if style.color.categorical() {
-            category_colour(v as u32)
+            style.color.category(v)
         } else if vmax > vmin {
             colormap((v - vmin) / (vmax - vmin))
         } else {
@@ -201,15 +201,12 @@ impl Canvas {
         }
     }
 
-    /// The mesh's edges, hidden behind particles that are in front of them.
+    /// The mesh's outline ([`outline`]), hidden behind particles that are in front of it.
     fn edges(&mut self, scene: &Scene, mesh: &Mesh) {
         let (right, h) = (scene.right(), scene.h);
-        for face in &mesh.faces {
-            let corners = face.corners();
-            let n = corners.len();
-            let edges = if n <= 2 { n - 1 } else { n };
-            for e in 0..edges.max(1) {
-                let (a, b) = (scene.cam * corners[e % n], scene.cam * corners[(e + 1) % n]);
+        for (a, b) in outline(mesh, scene.cam.row(2)) {
+            {
+                let (a, b) = (scene.cam * a, scene.cam * b);
                 let ((ax, ay), (bx, by)) = (scene.to_px(a), scene.to_px(b));
                 let steps = ((bx - ax).abs().max((by - ay).abs()).ceil() as usize).max(1);
                 for st in 0..=steps {
@@ -228,6 +225,69 @@ impl Canvas {
     }
 }
 
+/// The edges of a mesh that show its shape, as a draughtsman draws it: the edges of a
+/// surface's border, the creases where its faces meet at more than 30 degrees, and the
+/// silhouette, where a face turned toward the viewer (`toward`) meets one turned away;
+/// not the edges that only cut a flat or gently curved surface into faces (the spokes of a
+/// drum's end cap, the seams along its side). Points and segments are drawn whole.
+pub(super) fn outline(mesh: &Mesh, toward: DVec3) -> Vec<(DVec3, DVec3)> {
+    let mut lo = DVec3::INFINITY;
+    let mut hi = DVec3::NEG_INFINITY;
+    for f in &mesh.faces {
+        let (a, b) = f.bounding_box();
+        (lo, hi) = (lo.min(a), hi.max(b));
+    }
+    // Corners of neighbouring faces, computed apart, meet within a rounding error.
+    let tol = 1e-9 * (hi - lo).max_element().max(f64::MIN_POSITIVE);
+    let key = |p: DVec3| (p / tol).round().as_i64vec3().to_array();
+    // Each edge by its ends' keys: its ends, and the normals of the faces it borders.
+    type Edge = (DVec3, DVec3, Vec<DVec3>);
+    let mut edges: std::collections::HashMap<([i64; 3], [i64; 3]), Edge> = Default::default();
+    let mut whole = Vec::new();
+    for face in &mesh.faces {
+        let corners = face.corners();
+        let Some(n) = face.normal() else {
+            match corners[..] {
+                [a] => whole.push((a, a)),
+                [a, b] => whole.push((a, b)),
+                _ => {}
+            }
+            continue;
+        };
+        for e in 0..corners.len() {
+            let (a, b) = (corners[e], corners[(e + 1) % corners.len()]);
+            let (ka, kb) = (key(a), key(b));
+            let k = if ka <= kb { (ka, kb) } else { (kb, ka) };
+            edges.entry(k).or_insert((a, b, Vec::new())).2.push(n);
+        }
+    }
+    let crease = 30f64.to_radians().cos();
+    let mut lines: Vec<(DVec3, DVec3)> = edges
+        .into_values()
+        .filter(|(_, _, normals)| {
+            if normals.len() == 1 {
+                return true; // a border
+            }
+            // (A file's faces may wind either way: a normal opposed to the first is turned.)
+            let m = normals[0];
+            let aligned = normals.iter().map(|&n| if m.dot(n) < 0.0 { -n } else { n });
+            let sharp = aligned.clone().any(|n| m.dot(n) < crease);
+            let facing = |n: DVec3| n.dot(toward) > 0.0;
+            let silhouette = aligned.clone().any(facing) && !aligned.clone().all(facing);
+            sharp || silhouette
+        })
+        .map(|(a, b, _)| (a, b))
+        .collect();
+    // (In a fixed order: the hash map's is not.)
+    lines.sort_by(|x, y| {
+        (x.0.to_array(), x.1.to_array())
+            .partial_cmp(&(y.0.to_array(), y.1.to_array()))
+            .unwrap_or(std::cmp::Ordering::Equal)
+    });
+    lines.extend(whole);
+    lines
+}
+
 /// The legend of a categorical colouring, right of the scene.
 fn legend(img: &mut RgbImage, scene: &Scene, style: &Style, layout: &Layout) {
     let (s, k, top) = (scene.s, scene.k, scene.top);
@@ -236,7 +296,7 @@ fn legend(img: &mut RgbImage, scene: &Scene, style: &Style, layout: &Layout) {
     let title = style.color.title();
     text::draw(img, x0, top as i64 - 8 * s, title, k, INK);
     for &c in &layout.categories {
-        let col = rgb(category_colour(c));
+        let col = rgb(style.color.legend_colour(c));
         for dy in 0..8 * s {
             for dx in 0..8 * s {
                 put(img, x0 + dx, y + dy, col);

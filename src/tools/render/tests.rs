@@ -141,8 +141,10 @@ fn spheres_and_an_edge(y: f64) -> (RgbImage, RgbImage) {
     p.push(one(DVec3::new(3.0, 0.0, 0.0), DVec3::ZERO).get(0));
     let off = format!("OFF\n3 1 0\n-3 {y} 0\n6 {y} 0\n1.5 {y} -5\n3 0 1 2\n");
     let mesh = Mesh::parse_off(&off, "t.off", &[0.0]).unwrap();
-    let plain = render(&p, &Mesh::default(), &style).unwrap();
-    (plain, render(&p, &mesh, &style).unwrap())
+    // (One view for both: the mesh widens it.)
+    let layout = Layout::of(&p, &mesh, &style);
+    let plain = render_in(&p, &Mesh::default(), &style, &layout, None).unwrap();
+    (plain, render_in(&p, &mesh, &style, &layout, None).unwrap())
 }
 
 /// The pixels where the second picture differs from the first, and of those the ones where
@@ -217,4 +219,101 @@ fn gif_frames_are_dithered_without_bands() {
         [q[0], q[1], q[2]]
     });
     assert!(smooth < 1.2 && banded > 1.5 * smooth, "{smooth} {banded}");
+}
+
+/// A drum of radius 1 along y about the origin, its 48 sides and two end caps of triangles.
+fn drum() -> Mesh {
+    crate::geometry::shapes::Shape::Drum {
+        center: DVec3::ZERO,
+        axis: DVec3::Y,
+        radius: 1.0,
+        length: 0.6,
+        resolution: 48,
+    }
+    .mesh(0.0)
+}
+
+#[test]
+fn a_drum_is_drawn_by_its_rims_and_silhouette_not_the_spokes_of_its_caps() {
+    let mesh = drum();
+    for view in [View::Iso, View::Front, View::Side] {
+        let toward = camera(view).row(2);
+        let lines = picture::outline(&mesh, toward);
+        // No line reaches the centre of a cap (where the triangles' spokes meet).
+        let spoke = |p: DVec3| p.x.abs() < 1e-9 && p.z.abs() < 1e-9;
+        assert!(
+            lines.iter().all(|(a, b)| !spoke(*a) && !spoke(*b)),
+            "{view:?}"
+        );
+        // The rims, 48 edges each, are all there.
+        let on_rim =
+            |p: DVec3, y: f64| (p.y - y).abs() < 1e-9 && (p.x.hypot(p.z) - 1.0).abs() < 1e-9;
+        for y in [-0.3, 0.3] {
+            let rim = lines
+                .iter()
+                .filter(|(a, b)| on_rim(*a, y) && on_rim(*b, y))
+                .count();
+            assert_eq!(rim, 48, "{view:?}");
+        }
+    }
+    // Seen from the side (along -x), the silhouette: two seams along the drum, at the top
+    // and the bottom; seen along its axis, none (every side is edge-on or hidden).
+    let seams = |view| {
+        let lines = picture::outline(&mesh, camera(view).row(2));
+        lines
+            .iter()
+            .filter(|(a, b)| (a.y - b.y).abs() > 0.5)
+            .count()
+    };
+    assert_eq!(seams(View::Side), 2);
+    // A box's twelve edges, all creases.
+    let b = crate::geometry::shapes::Shape::Box {
+        min: DVec3::ZERO,
+        max: DVec3::ONE,
+        open: [false; 6],
+    }
+    .mesh(0.0);
+    assert_eq!(picture::outline(&b, camera(View::Iso).row(2)).len(), 12);
+}
+
+#[test]
+fn a_drum_about_its_charge_shows_whole_and_a_tall_box_does_not_shrink_its_bed() {
+    // Grains in the bottom of the drum: the drum (at most twice as wide) shows whole.
+    let mut p = Particles::default();
+    for k in 0..40 {
+        let a = k as f64 * 0.1;
+        let x = DVec3::new(0.6 * a.cos() - 0.3, 0.0, -0.1 - 0.4 * (k % 3) as f64);
+        let mut g = one(x, DVec3::ZERO);
+        g.radius[0] = 0.1;
+        p.push(g.get(0));
+    }
+    let style = Style {
+        view: View::Front,
+        ..front(ColorBy::Speed)
+    };
+    let (lo, hi) = Layout::of(&p, &drum(), &style).bounds();
+    assert!(
+        lo.x <= -1.0 + 1e-9 && hi.x >= 1.0 - 1e-9 && lo.y <= -1.0 + 1e-9 && hi.y >= 1.0 - 1e-9,
+        "{lo} {hi}"
+    );
+    // A bed 0.2 deep in a box 10 tall: the picture keeps to the bed's height.
+    let tall = crate::geometry::shapes::Shape::Box {
+        min: DVec3::new(-1.0, -1.0, -1.1),
+        max: DVec3::new(1.0, 1.0, 9.0),
+        open: [false, false, false, false, false, true],
+    }
+    .mesh(0.0);
+    let (lo, hi) = Layout::of(&p, &tall, &style).bounds();
+    assert!(hi.y <= 1e-9 && lo.y >= -1.0 - 1e-9, "{lo} {hi}");
+}
+
+#[test]
+fn clumps_get_a_colour_each_and_plain_spheres_grey() {
+    let c = ColorBy::Clump;
+    assert_eq!(c.category(-1.0), PLAIN);
+    let colours: std::collections::BTreeSet<[u8; 3]> = (0..20)
+        .map(|id| rgb(c.category(id as f64 * 2.0)).0)
+        .collect();
+    assert!(colours.len() >= 6, "{colours:?}");
+    assert!(!colours.contains(&rgb(PLAIN).0));
 }
