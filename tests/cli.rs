@@ -1,9 +1,9 @@
 //! The command line: error paths exit non-zero with a clear message and never panic;
 //! results do not depend on the number of threads.
 
-mod common;
+use crate::common;
 
-use common::tinydem;
+use crate::common::tinydem;
 use std::path::{Path, PathBuf};
 use std::process::Output;
 

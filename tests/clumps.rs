@@ -2,7 +2,7 @@
 //! and on an incline, collisions that conserve momentum and angular momentum, a clump of
 //! one sphere as that sphere, bodies removed whole, checkpoints and thread counts.
 
-mod common;
+use crate::common;
 
 use glam::{DQuat, DVec3};
 use tinydem::particles::Particles;

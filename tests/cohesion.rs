@@ -2,7 +2,7 @@
 //! the overlap where the Hertz force balances the pull; a grain hangs under a ceiling while
 //! its weight is below the analytic pull-off force, and falls when it is above.
 
-mod common;
+use crate::common;
 
 use std::f64::consts::PI;
 

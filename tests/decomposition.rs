@@ -4,7 +4,7 @@
 //! It is what a run split over processes rests on: each process holds its own particles in
 //! its own order.
 
-mod common;
+use crate::common;
 
 use tinydem::comm::{Comm, Threads};
 use tinydem::particles::Particles;

@@ -2,7 +2,7 @@
 //! count, leaves the others' motion untouched; the load on the walls of a settled bed is its
 //! weight; torques follow Newton's third law about the stated point.
 
-mod common;
+use crate::common;
 
 use std::collections::{BTreeMap, BTreeSet};
 

@@ -3,7 +3,7 @@
 //! files the command writes.
 //! (Kernels, and integrals of single particles and contacts: `src/tools/fields/tests.rs`.)
 
-mod common;
+use crate::common;
 
 use glam::{DQuat, DVec3};
 use tinydem::fields::{Grid, Kernel, Sums};

@@ -2,7 +2,7 @@
 //! `fixed` column of a particle file, `Simulation::fix_particles` as Python's `freeze`),
 //! while they push on the others with their material.
 
-mod common;
+use crate::common;
 
 use glam::DVec3;
 use tinydem::csv::{Extra, read_particles, write_particles};

@@ -3,7 +3,7 @@
 //! printed, the original program's) they do. Elastic impacts, the tangential restitution's
 //! independence of Δt, a bed that comes to rest and a column whose wall carries load.
 
-mod common;
+use crate::common;
 
 use glam::DVec3;
 use tinydem::integrate::Inertia;

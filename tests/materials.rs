@@ -2,7 +2,7 @@
 //! time with E* of two materials, momentum with two densities, walls of a material, and the
 //! lanes of a mixed group giving each pair the bits it has alone.
 
-mod common;
+use crate::common;
 
 use glam::{DQuat, DVec3};
 use tinydem::integrate::Inertia;

@@ -2,7 +2,7 @@
 //! original program's contact per face ("per_face") on request; grooves and corners keep
 //! all their contacts.
 
-mod common;
+use crate::common;
 
 use glam::DVec3;
 use tinydem::integrate::Inertia;

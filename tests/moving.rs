@@ -1,7 +1,5 @@
 //! Moving meshes: friction with a moving wall uses the wall's velocity at the contact point.
 
-mod common;
-
 use std::path::Path;
 
 use tinydem::scenario::Scenario;

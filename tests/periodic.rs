@@ -2,7 +2,7 @@
 //! inside the box; a periodic gas keeps its particles and its momentum; a periodic run
 //! resumes bit for bit.
 
-mod common;
+use crate::common;
 
 use glam::{DQuat, DVec3};
 use tinydem::integrate::Inertia;

@@ -1,7 +1,7 @@
 //! Physics against theory: Hertz collisions, energy conservation, friction regimes,
 //! drag, planar runs and orientation.
 
-mod common;
+use crate::common;
 
 use std::f64::consts::PI;
 

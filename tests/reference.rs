@@ -3,7 +3,7 @@
 //! of their README: |actual - expected| <= tol[f] * (1 + |expected|) for every compared
 //! frame f, particle i and column c.
 
-mod common;
+use crate::common;
 
 use tinydem::csv::{frame_name, load_particles};
 use tinydem::particles::Particle;

@@ -1,9 +1,9 @@
 //! Faults: unstable runs stop loudly, interrupted runs resume bit for bit, killed runs
 //! leave only complete files.
 
-mod common;
+use crate::common;
 
-use common::tinydem;
+use crate::common::tinydem;
 use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};

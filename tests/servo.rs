@@ -3,7 +3,7 @@
 //! a user runs it (fill, then press, then shear), each stage from the last's snapshot.
 //! (Split runs and checkpoints with servos: `tests/decomposition.rs`.)
 
-mod common;
+use crate::common;
 
 use tinydem::integrate::Inertia;
 use tinydem::simulation::Simulation;

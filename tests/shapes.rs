@@ -2,7 +2,7 @@
 //! rest where the shape's geometry puts it, and the shape carries its weight.
 //! (Areas and volumes against the analytic ones: `src/geometry/shapes/tests.rs`.)
 
-mod common;
+use crate::common;
 
 use std::f64::consts::PI;
 

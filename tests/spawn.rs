@@ -1,7 +1,7 @@
 //! `[[spawn]]` regions: a rate within one particle of rate x time when there is room, a
 //! count, a time window, materials and velocities, and the distributions of radii.
 
-mod common;
+use crate::common;
 
 use tinydem::simulation::Simulation;
 

@@ -2,7 +2,7 @@
 //! the bits of one uninterrupted run; removing the plug of a filled silo starts its discharge;
 //! `check --from` says what a stage changes.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

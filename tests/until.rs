@@ -2,11 +2,11 @@
 //! that frame, its log row (naming the condition) and a checkpoint; resumed runs keep the
 //! conditions, and a stage checks its own.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 
-use common::tinydem;
+use crate::common::tinydem;
 
 /// A closed box 6 cm wide, 20 cm tall.
 const BOX: &str = "OFF\n8 5 0\n-0.03 -0.03 0\n0.03 -0.03 0\n0.03 0.03 0\n-0.03 0.03 0\n\

@@ -2,7 +2,7 @@
 //! test's own reader of VTK's raw appended XML (always) and by a real VTK reader (meshio, from
 //! PyPI) where python3 has it; `.ci/run` installs meshio, and under CI its check must run.
 
-mod common;
+use crate::common;
 
 use std::collections::BTreeMap;
 use std::path::Path;

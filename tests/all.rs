@@ -1,0 +1,32 @@
+//! The integration tests, in one binary (one link, and all their tests run side by side):
+//! each file of `tests/` is a module here. `fuzz`, `mpi` (its own feature) and `memory`
+//! (which reads the process's peak memory) are binaries of their own.
+
+mod common;
+
+mod bad_inputs;
+mod book;
+mod cli;
+mod clumps;
+mod cohesion;
+mod decomposition;
+mod domain;
+mod examples;
+mod fields;
+mod fixed;
+mod friction_springs;
+mod materials;
+mod mesh_contacts;
+mod moving;
+mod periodic;
+mod physics;
+mod reference;
+mod robustness;
+mod scenarios;
+mod servo;
+mod shapes;
+mod spawn;
+mod stages;
+mod stl;
+mod until;
+mod vtk;
