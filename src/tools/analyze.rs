@@ -318,6 +318,97 @@ fn fit_slope(points: &[(f64, f64)]) -> Option<(f64, f64)> {
     Some((slope, (residuals / (n - 2.0) / sxx).sqrt()))
 }
 
+/// The free surface of the bed in a rotating drum: its inclination in the plane normal to the
+/// drum's axis \[degrees\], with the standard error of the fit, over `columns` surface
+/// columns one grain diameter wide.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfaceAngle {
+    pub angle: f64,
+    pub error: f64,
+    pub columns: usize,
+}
+
+/// Why a frame holds no drum bed to measure.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum NoSurface {
+    TooFewGrains(usize),
+    TooFewColumns(usize),
+}
+
+impl std::fmt::Display for NoSurface {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        match self {
+            NoSurface::TooFewGrains(n) => write!(f, "{n} grains, fewer than 20"),
+            NoSurface::TooFewColumns(n) => {
+                write!(
+                    f,
+                    "{n} surface columns in the middle of the bed, fewer than 3"
+                )
+            }
+        }
+    }
+}
+
+/// The dynamic angle of repose of the bed in a drum turning about the axis `axis` through
+/// `centre`, gravity along `down`: the inclination of its free surface against the
+/// horizontal, in the plane normal to the axis (what a user of a drum fits by hand).
+///
+/// The bed's centroid lies on the normal to the surface's chord through the drum's centre
+/// (exactly so for the circular segment a flat surface cuts): that normal gives a first
+/// estimate of the surface's direction. Along that direction, in columns one mean diameter d
+/// wide, the highest top of a grain is the surface; the columns of the middle 60 % of the
+/// chord (away from the wall, where the surface curves into it) are fitted by least squares,
+/// and the fit's slope corrects the estimate. An S-shaped surface (a fast drum) is fitted in
+/// its middle, as a straight line.
+pub fn drum_angle(
+    p: &Particles,
+    centre: DVec3,
+    axis: DVec3,
+    down: DVec3,
+) -> Result<SurfaceAngle, NoSurface> {
+    if p.len() < 20 {
+        return Err(NoSurface::TooFewGrains(p.len()));
+    }
+    let a = axis.normalize();
+    let up = -(down - a * down.dot(a)).normalize();
+    let across = up.cross(a);
+    let plane = |x: DVec3| glam::DVec2::new((x - centre).dot(across), (x - centre).dot(up));
+    let n = p.len() as f64;
+    let centroid = (0..p.len()).map(|k| plane(p.x[k])).sum::<glam::DVec2>() / n;
+    let inward = -centroid.normalize();
+    let along = glam::DVec2::new(inward.y, -inward.x);
+    let d = 2.0 * p.radius.iter().sum::<f64>() / n;
+    let (sigma, eta): (Vec<f64>, Vec<f64>) = (0..p.len())
+        .map(|k| {
+            let q = plane(p.x[k]);
+            (q.dot(along), q.dot(inward) + p.radius[k])
+        })
+        .unzip();
+    let lo = sigma.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = sigma.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let columns = (((hi - lo) / d).floor() as usize) + 1;
+    let mut top = vec![f64::NEG_INFINITY; columns];
+    for (s, e) in sigma.iter().zip(&eta) {
+        let c = (((s - lo) / d) as usize).min(columns - 1);
+        top[c] = top[c].max(*e);
+    }
+    let middle = (lo + 0.2 * (hi - lo))..(hi - 0.2 * (hi - lo));
+    let points: Vec<(f64, f64)> = (0..columns)
+        .map(|c| (lo + (c as f64 + 0.5) * d, top[c]))
+        .filter(|&(s, t)| middle.contains(&s) && t.is_finite())
+        .collect();
+    let (slope, error) = fit_slope(&points).ok_or(NoSurface::TooFewColumns(points.len()))?;
+    let first = along.y.atan2(along.x);
+    let angle = (first + slope.atan()).to_degrees();
+    // An inclination against the horizontal, whichever way the surface rises.
+    let angle = angle.rem_euclid(180.0);
+    Ok(SurfaceAngle {
+        angle: if angle > 90.0 { 180.0 - angle } else { angle },
+        error: (error / (1.0 + slope * slope)).to_degrees(),
+        columns: points.len(),
+    })
+}
+
 /// Mean height of the particles with radius at least `r` (None if there are none).
 pub fn mean_height_of_large(p: &Particles, r: f64) -> Option<f64> {
     let z: Vec<f64> = (0..p.len())
@@ -465,6 +556,36 @@ mod tests {
             gas.push(at(0.1 * k as f64, 0.0, 0.01));
         }
         assert_eq!(packing_fraction(&gas, &[1000.0]), 0.0);
+    }
+
+    #[test]
+    fn the_surface_of_a_bed_in_a_drum_has_its_angle() {
+        // A drum of radius 0.1 along y, half filled below a surface through its axis tilted
+        // by 35 degrees (and by 20, falling the other way), grains on a square lattice.
+        let r = 0.002;
+        for tilt in [35.0f64, -20.0] {
+            let t = tilt.to_radians();
+            let (normal, mut p) = (glam::DVec2::new(-t.sin(), t.cos()), Particles::default());
+            let step = 2.0 * r;
+            let n = (0.1 / step) as i32;
+            for i in -n..=n {
+                for k in -n..=n {
+                    let q = glam::DVec2::new(i as f64 * step, k as f64 * step);
+                    if q.length() < 0.1 - r && q.dot(normal) < -0.01 {
+                        for j in 0..3 {
+                            p.push(at(q.x, q.y, r));
+                            let last = p.len() - 1;
+                            p.x[last].y = j as f64 * step;
+                        }
+                    }
+                }
+            }
+            let a = drum_angle(&p, DVec3::ZERO, DVec3::Y, DVec3::NEG_Z).unwrap();
+            assert!((a.angle - tilt.abs()).abs() < 0.5, "{tilt}: {a:?}");
+            assert!(a.columns > 10 && a.error < 1.0, "{a:?}");
+        }
+        let few = heap(0.001, -0.01..0.01, |_| 0.003);
+        assert!(drum_angle(&few, DVec3::ZERO, DVec3::Y, DVec3::NEG_Z).is_err());
     }
 
     #[test]

@@ -7,7 +7,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 
 use tinydem::analyze::{
-    NoPile, ReposeWindow, angle_of_repose, coordination_number, kinetic_energy,
+    NoPile, ReposeWindow, angle_of_repose, coordination_number, drum_angle, kinetic_energy,
     mean_height_of_large, packing_fraction,
 };
 use tinydem::particles::Particles;
@@ -36,6 +36,11 @@ pub struct AnalyzeArgs {
         requires = "repose"
     )]
     window: Option<Vec<f64>>,
+    /// Fit the dynamic angle of repose of the bed in a rotating drum: the inclination of its
+    /// free surface in the plane normal to the drum's axis (the drum: the scenario's first
+    /// built-in drum, or mesh turning about an axis).
+    #[arg(long)]
+    drum: bool,
     /// Report the mean height of the particles with at least this radius.
     #[arg(long)]
     large: Option<f64>,
@@ -177,10 +182,12 @@ impl AnalyzeArgs {
             None => Scenario::parse("", Path::new("defaults"))?,
         };
         let frames = frames_in(&self.dir)?;
+        let drum = self.drum.then(|| drum_of(&s)).transpose()?;
         let table = Table {
             frame_time: s.simulation.steps_per_frame as f64 * s.simulation.timestep,
             densities: s.materials.iter().map(|m| m.properties.density).collect(),
             repose,
+            drum,
             large: self.large,
             tag: self.tag,
         };
@@ -252,6 +259,30 @@ fn aligned<T: std::fmt::Display>(row: &[T]) -> String {
 /// The width of a column of the table.
 const COLUMN: usize = 22;
 
+/// The drum of a scenario, for `--drum`: its centre, axis and the direction of gravity.
+fn drum_of(s: &Scenario) -> Result<(glam::DVec3, glam::DVec3, glam::DVec3)> {
+    use tinydem::motion::Motion;
+    use tinydem::scenario::{MeshInput, Shape};
+    let found = s.meshes.iter().find_map(|m| match (&m.input, m.motion) {
+        (MeshInput::Shape(Shape::Drum { center, axis, .. }), _) => Some((*center, *axis)),
+        (_, Some(Motion::Rotation { center, axis, .. })) => Some((center, axis)),
+        _ => None,
+    });
+    let Some((centre, axis)) = found else {
+        anyhow::bail!(
+            "--drum: the scenario has no drum (a [[meshes]] shape of type \"drum\", or a mesh \
+             with motion = {{ type = \"rotation\", ... }})"
+        );
+    };
+    let g = s.kinetics.gravity;
+    let down = if g.length_squared() > 0.0 && g.cross(axis).length_squared() > 0.0 {
+        g.normalize()
+    } else {
+        glam::DVec3::NEG_Z
+    };
+    Ok((centre, axis, down))
+}
+
 /// What the table measures of each frame.
 struct Table {
     /// Simulated time between frames.
@@ -259,6 +290,8 @@ struct Table {
     /// The density of each material.
     densities: Vec<f64>,
     repose: Option<ReposeWindow>,
+    /// A drum's centre, axis and gravity's direction.
+    drum: Option<(glam::DVec3, glam::DVec3, glam::DVec3)>,
     large: Option<f64>,
     tag: Option<u32>,
 }
@@ -281,6 +314,9 @@ impl Table {
                 "repose_right_deg",
                 "repose_right_err_deg",
             ]);
+        }
+        if self.drum.is_some() {
+            header.extend(["drum_angle_deg", "drum_angle_err_deg"]);
         }
         if self.large.is_some() {
             header.push("large_mean_height");
@@ -315,6 +351,12 @@ impl Table {
                     no_pile.push((k, why));
                     row.extend(["nan"; 4].map(String::from))
                 }
+            }
+        }
+        if let Some((centre, axis, down)) = self.drum {
+            match drum_angle(p, centre, axis, down) {
+                Ok(a) => row.extend([a.angle, a.error].map(|v| format!("{v:.2}"))),
+                Err(_) => row.extend(["nan"; 2].map(String::from)),
             }
         }
         if let Some(r) = self.large {
