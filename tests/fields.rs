@@ -228,7 +228,7 @@ fn analyze_fields_writes_image_data_and_csv_of_the_same_numbers() {
     let csv = std::fs::read_to_string(t.path().join("out/fields000003.csv")).unwrap();
     let mut lines = csv.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    assert_eq!(header.len(), 34);
+    assert_eq!(header.len(), 35);
     let rows: Vec<Vec<f64>> = lines
         .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
         .collect();
@@ -239,6 +239,7 @@ fn analyze_fields_writes_image_data_and_csv_of_the_same_numbers() {
         names,
         [
             "density",
+            "volume_fraction",
             "velocity",
             "stress",
             "contact_stress",
@@ -248,7 +249,7 @@ fn analyze_fields_writes_image_data_and_csv_of_the_same_numbers() {
     let column = |name: &str| header.iter().position(|h| *h == name).unwrap();
     for (k, row) in rows.iter().enumerate() {
         assert_eq!(arrays[0].1[k], row[column("density")]);
-        assert_eq!(arrays[2].1[9 * k + 5], row[column("stress_yz")]);
+        assert_eq!(arrays[3].1[9 * k + 5], row[column("stress_yz")]);
     }
     // The grains rest on the floor: the floor's cells hold them, under compression.
     assert!(
@@ -372,6 +373,44 @@ fn slices_hold_the_mass_of_the_grains_within_their_box_and_no_more() {
         (field_mass / counted - 1.0).abs() < 1e-3,
         "the slices hold {field_mass} kg, the grains in the box {counted} kg"
     );
+    // Bins (LIGGGHTS's ave/euler) hold it to the last digits, and their solid fraction is
+    // the grains' volume (the same count) over theirs.
+    let o = common::tinydem(
+        &[
+            "analyze",
+            "out",
+            "--fields",
+            "--kernel",
+            "cell",
+            "--slices",
+            "z",
+            "--spacing",
+            "0.004",
+            "--bounds",
+            &format!("-0.025,-0.025,-0.02,0.025,0.025,{top}"),
+        ],
+        t.path(),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let slices = t.path().join("out/slices_z000001.csv");
+    let (density, fraction) = (
+        csv_column(&slices, "density"),
+        csv_column(&slices, "volume_fraction"),
+    );
+    let dz = (top + 0.02) / density.len() as f64;
+    let binned: f64 = density.iter().map(|rho| rho * dz * 0.05 * 0.05).sum();
+    assert!(
+        (binned / counted - 1.0).abs() < 1e-9,
+        "{binned} against {counted}"
+    );
+    let solid: f64 = fraction.iter().map(|f| f * dz * 0.05 * 0.05).sum();
+    assert!((solid * 2500.0 / counted - 1.0).abs() < 1e-9, "{solid}");
+    // In the bulk of the bed (its bins but the two at the floor and the two at the surface,
+    // where a bin of centres layered by the floor holds whole grains), a random packing's.
+    let filled: Vec<f64> = fraction.iter().copied().filter(|&f| f > 0.0).collect();
+    let inner = &filled[2..filled.len() - 2];
+    let bulk = inner.iter().sum::<f64>() / inner.len() as f64;
+    assert!((0.5..0.7).contains(&bulk), "{fraction:?}");
 }
 
 #[test]

@@ -203,9 +203,10 @@ pub(crate) fn fields<'py>(
     let shape = match kernel {
         "gaussian" => Shape::Gaussian,
         "lucy" => Shape::Lucy,
+        "cell" => Shape::Cell,
         other => {
             return Err(PyValueError::new_err(format!(
-                "kernel {other:?}: \"gaussian\" or \"lucy\""
+                "kernel {other:?}: \"gaussian\", \"lucy\" or \"cell\""
             )));
         }
     };
@@ -257,6 +258,10 @@ pub(crate) fn fields<'py>(
         d.set_item(
             "density",
             Array1::from_vec(f.density.clone()).into_pyarray(py),
+        )?;
+        d.set_item(
+            "volume_fraction",
+            Array1::from_vec(f.volume_fraction.clone()).into_pyarray(py),
         )?;
         d.set_item("velocity", shaped(velocity).into_pyarray(py))?;
         d.set_item("stress", tensors(&stress)?.into_pyarray(py))?;

@@ -34,6 +34,9 @@ pub enum Kernel {
     Gaussian { width: f64 },
     /// Lucy's polynomial (1 + 3q)(1 − q)³ with q = r / width (zero beyond `width`).
     Lucy { width: f64 },
+    /// The grid's cells as bins (LIGGGHTS's `ave/euler`): 1/V of the cell that holds the
+    /// point, 0 elsewhere; a slice's cell spans the box across its axis.
+    Cell,
 }
 
 /// Of a Gaussian cut at 3 standard deviations, the part of its integral inside the cut:
@@ -41,11 +44,12 @@ pub enum Kernel {
 const GAUSSIAN_INSIDE: f64 = 0.970_709_140_760_959_2;
 
 impl Kernel {
-    /// Where it ends.
+    /// Where it ends (0 for cells: at the cell's faces).
     pub fn cutoff(&self) -> f64 {
         match *self {
             Kernel::Gaussian { width } => 3.0 * width,
             Kernel::Lucy { width } => width,
+            Kernel::Cell => 0.0,
         }
     }
 
@@ -67,6 +71,7 @@ impl Kernel {
                 let norm = 16.0 * std::f64::consts::PI * width.powi(3) / 105.0;
                 (1.0 + 3.0 * q) * (1.0 - q).powi(3) / norm
             }
+            Kernel::Cell => unreachable!("cells are spread by the grid"),
         }
     }
 
@@ -90,6 +95,7 @@ impl Kernel {
                 let c = 105.0 / (16.0 * std::f64::consts::PI * width.powi(3));
                 std::f64::consts::TAU * width * width * c * (0.1 - f(q))
             }
+            Kernel::Cell => unreachable!("cells are spread by the grid"),
         }
     }
 }
@@ -135,6 +141,26 @@ impl Grid {
         self.counts.iter().product()
     }
 
+    /// Calls `add(cell index, 1/V)` for the cell of the box that holds `at`, if one does
+    /// (across a wrapping axis, the cell of its image).
+    fn bin(&self, at: DVec3, mut add: impl FnMut(usize, f64)) {
+        let mut index = [0usize; 3];
+        for a in 0..3 {
+            let n = self.counts[a] as i64;
+            let i = ((at[a] - self.min[a]) / self.spacing[a]).floor() as i64;
+            index[a] = match self.wrap[a] {
+                true => i.rem_euclid(n) as usize,
+                false if (0..n).contains(&i) => i as usize,
+                false => return,
+            };
+        }
+        let [nx, ny, _] = self.counts;
+        add(
+            index[0] + nx * (index[1] + ny * index[2]),
+            1.0 / self.spacing.element_product(),
+        );
+    }
+
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }
@@ -160,6 +186,9 @@ impl Grid {
             if (0..3).any(outside) {
                 return;
             }
+        }
+        if *kernel == Kernel::Cell {
+            return self.bin(at, add);
         }
         // The index range per axis (all of an axis a slice spans), and the offset along it.
         let range = |a: usize| -> (i64, i64) {
@@ -217,6 +246,8 @@ pub struct Sums {
     kernel: Kernel,
     frames: usize,
     density: Vec<f64>,
+    /// Σ V φ: the solid fraction.
+    volume: Vec<f64>,
     momentum: Vec<DVec3>,
     /// Σ m v ⊗ v φ.
     flux: Vec<DMat3>,
@@ -239,6 +270,7 @@ impl Sums {
             kernel,
             frames: 0,
             density: vec![0.0; n],
+            volume: vec![0.0; n],
             momentum: vec![DVec3::ZERO; n],
             flux: vec![DMat3::ZERO; n],
             contact: vec![DMat3::ZERO; n],
@@ -246,27 +278,41 @@ impl Sums {
     }
 
     /// Adds a frame: its particles `p`, the mass of each (`mass(k)`), and its contact
-    /// network (`None`: no contact stress).
+    /// network (`None`: no contact stress); each particle's volume that of its sphere.
     pub fn add(
         &mut self,
         p: &Particles,
         mass: impl Fn(usize) -> f64,
         contacts: Option<&[ContactRecord]>,
     ) {
+        let ball = |k: usize| 4.0 / 3.0 * std::f64::consts::PI * p.radius[k].powi(3);
+        self.add_grains(p, |k| (mass(k), ball(k)), contacts);
+    }
+
+    /// [`Sums::add`] with the mass and volume of each particle (`of(k)`: the spheres of a
+    /// clump share its mass and its volume, their overlaps counted once).
+    pub fn add_grains(
+        &mut self,
+        p: &Particles,
+        of: impl Fn(usize) -> (f64, f64),
+        contacts: Option<&[ContactRecord]>,
+    ) {
         self.frames += 1;
         for k in 0..p.len() {
-            let (m, v) = (mass(k), p.v[k]);
+            let ((m, vol), v) = (of(k), p.v[k]);
             let mvv = DMat3::from_cols(v * (m * v.x), v * (m * v.y), v * (m * v.z));
             let Sums {
                 grid,
                 kernel,
                 density,
+                volume,
                 momentum,
                 flux,
                 ..
             } = self;
             grid.spread(kernel, p.x[k], |g, phi| {
                 density[g] += m * phi;
+                volume[g] += vol * phi;
                 momentum[g] += m * phi * v;
                 flux[g] += mvv * phi;
             });
@@ -299,10 +345,13 @@ impl Sums {
         };
         let f = c.f_n + c.f_t;
         let fb = DMat3::from_cols(f * branch.x, f * branch.y, f * branch.z);
-        // Segments no longer than a third of the kernel's reach, four nodes each.
-        let segments = (3.0 * branch.length() / self.kernel.cutoff())
-            .ceil()
-            .max(1.0) as usize;
+        // Segments no longer than a third of the kernel's reach (of cells: a third of the
+        // narrowest), four nodes each.
+        let reach = match self.kernel {
+            Kernel::Cell => self.grid.spacing.min_element(),
+            k => k.cutoff(),
+        };
+        let segments = (3.0 * branch.length() / reach).ceil().max(1.0) as usize;
         let Sums {
             grid,
             kernel,
@@ -337,6 +386,7 @@ impl Sums {
             grid: self.grid.clone(),
             frames: self.frames,
             density,
+            volume_fraction: self.volume.iter().map(|v| v / n).collect(),
             velocity,
             contact: self.contact.iter().map(|c| *c * (1.0 / n)).collect(),
             kinetic,
@@ -352,6 +402,8 @@ pub struct Fields {
     pub frames: usize,
     /// \[M/L³\]
     pub density: Vec<f64>,
+    /// The solid fraction: the grains' volume per volume \[-\].
+    pub volume_fraction: Vec<f64>,
     /// \[L/T\]
     pub velocity: Vec<DVec3>,
     /// The contact and kinetic stress \[M/(L T²)\], compression positive; element (r, c)
@@ -374,7 +426,7 @@ impl Fields {
                 .join(",")
         };
         format!(
-            "x,y,z,density,vx,vy,vz,{},{},{}",
+            "x,y,z,density,volume_fraction,vx,vy,vz,{},{},{}",
             tensor("stress"),
             tensor("contact"),
             tensor("kinetic")
@@ -391,7 +443,16 @@ impl Fields {
         };
         let x = self.grid.point(k);
         let v = self.velocity[k];
-        let mut row = vec![x.x, x.y, x.z, self.density[k], v.x, v.y, v.z];
+        let mut row = vec![
+            x.x,
+            x.y,
+            x.z,
+            self.density[k],
+            self.volume_fraction[k],
+            v.x,
+            v.y,
+            v.z,
+        ];
         row.extend(rows(self.stress(k)));
         row.extend(rows(self.contact[k]));
         row.extend(rows(self.kinetic[k]));

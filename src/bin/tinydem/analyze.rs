@@ -112,6 +112,8 @@ struct FieldArgs {
 enum KernelArg {
     Gaussian,
     Lucy,
+    /// The grid's cells as bins, as LIGGGHTS's ave/euler (no width).
+    Cell,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -136,6 +138,7 @@ impl FieldArgs {
             shape: Some(match self.kernel {
                 KernelArg::Gaussian => Shape::Gaussian,
                 KernelArg::Lucy => Shape::Lucy,
+                KernelArg::Cell => Shape::Cell,
             }),
             width: self.width,
             slices: self.slices.map(|a| a as usize),

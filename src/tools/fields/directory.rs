@@ -18,6 +18,8 @@ use crate::scenario::Scenario;
 pub enum Shape {
     Gaussian,
     Lucy,
+    /// The grid's cells as bins (`Kernel::Cell`).
+    Cell,
 }
 
 /// What `tinydem analyze --fields` is asked for; `None`s take the defaults.
@@ -77,7 +79,8 @@ pub fn of_directory(
     for (n, &k) in frames.iter().enumerate() {
         let (p, contacts) = read(k)?;
         let mass = masses(&p, &densities);
-        sums.add(&p, |i| mass[i], Some(&contacts));
+        let volume = |i: usize| mass[i] / densities[p.material[i] as usize];
+        sums.add_grains(&p, |i| (mass[i], volume(i)), Some(&contacts));
         if !options.average || n + 1 == frames.len() {
             let name = file_name(options, k);
             let fields = sums.fields();
@@ -189,6 +192,9 @@ fn grid_and_kernel(s: &Scenario, p: &Particles, options: &Options) -> Result<(Gr
         bail!("the first frame has no particles");
     }
     let r = p.radius.iter().sum::<f64>() / p.len() as f64;
+    if options.shape == Some(Shape::Cell) && options.width.is_some() {
+        bail!("--width: cells have no kernel width; --spacing sets their size");
+    }
     let width = options.width.unwrap_or(match options.shape {
         Some(Shape::Lucy) => 3.0 * r,
         _ => r,
@@ -196,6 +202,7 @@ fn grid_and_kernel(s: &Scenario, p: &Particles, options: &Options) -> Result<(Gr
     let kernel = match options.shape.unwrap_or(Shape::Gaussian) {
         Shape::Gaussian => Kernel::Gaussian { width },
         Shape::Lucy => Kernel::Lucy { width },
+        Shape::Cell => Kernel::Cell,
     };
     let (min, max) = match (options.bounds, s.domain) {
         (Some(b), _) => b,
@@ -260,6 +267,7 @@ fn write(dir: &Path, name: &str, fields: &Fields) -> Result<[PathBuf; 2]> {
         &vti,
         &[
             ("density", 1, &fields.density),
+            ("volume_fraction", 1, &fields.volume_fraction),
             ("velocity", 3, &velocity),
             ("stress", 9, &tensor(&stress)),
             ("contact_stress", 9, &tensor(&fields.contact)),
