@@ -304,13 +304,12 @@ fn csv_column(path: &std::path::Path, name: &str) -> Vec<f64> {
         .collect()
 }
 
-#[test]
-fn slices_hold_the_mass_of_the_grains_within_their_box_and_no_more() {
-    // A bed in a ring of radius 35 mm; slices over a 5 x 5 cm box inside it. Before, a
-    // slice summed its whole plane and divided by the box's area: 0.88 packing fraction.
-    let t = tempfile::tempdir().unwrap();
+/// A bed in a ring of radius 35 mm, run into `t/out`; the top of the box to measure (5 x 5
+/// cm across, inside the ring, from below the floor to above the bed) and the mass of the
+/// grains whose centres lie in it.
+fn ring_bed(t: &std::path::Path) -> (f64, f64) {
     std::fs::write(
-        t.path().join("s.toml"),
+        t.join("s.toml"),
         "[geometry]\nradius_min = 0.003\nradius_max = 0.004\n\
          spawn_min = [-0.03, -0.03, 0.01]\nspawn_max = [0.03, 0.03, 0.08]\n\
          [material]\ndensity = 2500.0\nyoungs_modulus = 1e7\n\
@@ -319,9 +318,9 @@ fn slices_hold_the_mass_of_the_grains_within_their_box_and_no_more() {
          [[meshes]]\nshape = { type = \"cylinder\", center = [0.0, 0.0, 0.0], axis = [0.0, 0.0, 1.0], radius = 0.035, height = 0.1, open = [\"top\"] }\n",
     )
     .unwrap();
-    let o = common::tinydem(&["run", "s.toml", "-o", "out", "-q"], t.path());
+    let o = common::tinydem(&["run", "s.toml", "-o", "out", "-q"], t);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let frame = t.path().join("out/particles000001.csv");
+    let frame = t.join("out/particles000001.csv");
     let (x, y, z, r) = (
         csv_column(&frame, "x"),
         csv_column(&frame, "y"),
@@ -338,23 +337,35 @@ fn slices_hold_the_mass_of_the_grains_within_their_box_and_no_more() {
         outside > 50,
         "the ring holds grains outside the box: {outside}"
     );
-    let top = z.iter().fold(0.0f64, |m, &z| m.max(z)) + 0.02;
-    let o = common::tinydem(
-        &[
-            "analyze",
-            "out",
-            "--fields",
-            "--slices",
-            "z",
-            "--spacing",
-            "0.002",
-            "--bounds",
-            &format!("-0.025,-0.025,-0.02,0.025,0.025,{top}"),
-        ],
-        t.path(),
-    );
+    (z.iter().fold(0.0f64, |m, &z| m.max(z)) + 0.02, counted)
+}
+
+/// `tinydem analyze out --fields` in slices along z over the box up to `top`, with `extra`
+/// arguments; the slices' density and volume fraction, and their thickness.
+fn slices(t: &std::path::Path, top: f64, extra: &[&str]) -> (Vec<f64>, Vec<f64>, f64) {
+    let bounds = format!("-0.025,-0.025,-0.02,0.025,0.025,{top}");
+    let mut args = vec![
+        "analyze", "out", "--fields", "--slices", "z", "--bounds", &bounds,
+    ];
+    args.extend(extra);
+    let o = common::tinydem(&args, t);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let density = csv_column(&t.path().join("out/slices_z000001.csv"), "density");
+    let file = t.join("out/slices_z000001.csv");
+    let (density, fraction) = (
+        csv_column(&file, "density"),
+        csv_column(&file, "volume_fraction"),
+    );
+    let dz = (top + 0.02) / density.len() as f64;
+    (density, fraction, dz)
+}
+
+#[test]
+fn slices_hold_the_mass_of_the_grains_within_their_box_and_no_more() {
+    // Before, a slice summed its whole plane and divided by the box's area: a bed in a ring
+    // gave 0.88 packing fraction.
+    let t = tempfile::tempdir().unwrap();
+    let (top, counted) = ring_bed(t.path());
+    let (density, _, dz) = slices(t.path(), top, &["--spacing", "0.002"]);
     // A grid of the same frame goes to a file of its own (it replaced the slices' before).
     let o = common::tinydem(
         &["analyze", "out", "--fields", "--spacing", "0.01"],
@@ -367,7 +378,6 @@ fn slices_hold_the_mass_of_the_grains_within_their_box_and_no_more() {
         csv_column(&t.path().join("out/slices_z000001.csv"), "density"),
         density
     );
-    let dz = (top + 0.02) / density.len() as f64;
     let field_mass: f64 = density.iter().map(|rho| rho * dz * 0.05 * 0.05).sum();
     assert!(
         (field_mass / counted - 1.0).abs() < 1e-3,
@@ -375,29 +385,8 @@ fn slices_hold_the_mass_of_the_grains_within_their_box_and_no_more() {
     );
     // Bins (LIGGGHTS's ave/euler) hold it to the last digits, and their solid fraction is
     // the grains' volume (the same count) over theirs.
-    let o = common::tinydem(
-        &[
-            "analyze",
-            "out",
-            "--fields",
-            "--kernel",
-            "cell",
-            "--slices",
-            "z",
-            "--spacing",
-            "0.004",
-            "--bounds",
-            &format!("-0.025,-0.025,-0.02,0.025,0.025,{top}"),
-        ],
-        t.path(),
-    );
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let slices = t.path().join("out/slices_z000001.csv");
-    let (density, fraction) = (
-        csv_column(&slices, "density"),
-        csv_column(&slices, "volume_fraction"),
-    );
-    let dz = (top + 0.02) / density.len() as f64;
+    let (density, fraction, dz) =
+        slices(t.path(), top, &["--kernel", "cell", "--spacing", "0.004"]);
     let binned: f64 = density.iter().map(|rho| rho * dz * 0.05 * 0.05).sum();
     assert!(
         (binned / counted - 1.0).abs() < 1e-9,
