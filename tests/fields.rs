@@ -452,3 +452,55 @@ fn fields_refuse_kernels_wider_than_the_box_and_frames_the_run_lacks() {
         "{err}"
     );
 }
+
+#[test]
+fn wall_stresses_carry_a_resting_bed_on_its_floor() {
+    // Grains at rest in a box: the faces' forces add up to the bed's weight, pressing down
+    // on the floor (its pressure over its area the same), and the side walls carry little.
+    let t = tempfile::tempdir().unwrap();
+    std::fs::write(
+        t.path().join("s.toml"),
+        "[geometry]\nradius_min = 0.004\nradius_max = 0.005\n\
+         spawn_min = [-0.02, -0.02, 0.01]\nspawn_max = [0.02, 0.02, 0.06]\n\
+         [material]\nrestitution = 0.3\nfriction_sliding = 0.5\n\
+         [simulation]\nmax_particles = 60\nframes = 2\nsteps_per_frame = 6000\n\
+         [output]\ncontacts = true\n\
+         [[meshes]]\nshape = { type = \"box\", min = [-0.03, -0.03, 0.0], max = [0.03, 0.03, 0.1], open = [\"+z\"] }\n",
+    )
+    .unwrap();
+    let o = common::tinydem(&["run", "s.toml", "-o", "out", "-q"], t.path());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = common::tinydem(&["analyze", "out", "--wall-stress"], t.path());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let said = String::from_utf8_lossy(&o.stdout);
+    assert!(said.contains("wall_stress000002.vtu"), "{said}");
+    let frame = t.path().join("out/particles000002.csv");
+    let weight: f64 = (csv_column(&frame, "R").iter())
+        .map(|&r| Inertia::mass(r, 1000.0) * G)
+        .sum();
+    let table = t.path().join("out/wall_stress000002.csv");
+    let (fz, pressure, area, mesh) = (
+        csv_column(&table, "fz"),
+        csv_column(&table, "pressure"),
+        csv_column(&table, "area"),
+        csv_column(&table, "mesh"),
+    );
+    assert!(mesh.iter().all(|&m| m == 1.0), "the box is [[meshes]] #1");
+    let down: f64 = -fz.iter().sum::<f64>();
+    assert!(
+        (down / weight - 1.0).abs() < 0.01,
+        "{down} N on the walls, {weight} N of grains"
+    );
+    // The box's faces: -x, +x, -y, +y, -z (the floor); +z open.
+    let floor = 4;
+    assert!(
+        (pressure[floor] * area[floor] / weight - 1.0).abs() < 0.02,
+        "{pressure:?}"
+    );
+    assert!(
+        pressure[..4].iter().all(|&p| p * 0.06 * 0.1 < 0.2 * weight),
+        "{pressure:?}"
+    );
+    let vtu = std::fs::read(t.path().join("out/wall_stress000002.vtu")).unwrap();
+    assert!(String::from_utf8_lossy(&vtu).contains("Name=\"pressure\""));
+}

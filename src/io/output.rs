@@ -78,6 +78,7 @@ pub fn is_run_output(name: &str) -> bool {
         || frame("contacts")
         || frame("mesh")
         || frame("fields")
+        || frame("wall_stress")
         || ["x", "y", "z"].iter().any(|a| {
             frame(&format!("slices_{a}")) || name.starts_with(&format!("slices_{a}_mean."))
         })

@@ -315,6 +315,12 @@ fn particles_vtu(p: &Particles, bodies: bool) -> Vtu {
 
 /// Writes the mesh faces as a `.vtu` file: one cell per face, with its radius.
 pub fn write_mesh(path: &Path, mesh: &Mesh) -> Result<()> {
+    write_mesh_with(path, mesh, &[])
+}
+
+/// Writes the mesh faces as [`write_mesh`] does, with further cell arrays: each its name, its
+/// number of components and a value per face and component.
+pub fn write_mesh_with(path: &Path, mesh: &Mesh, cells: &[(&str, usize, &[f64])]) -> Result<()> {
     use Section::*;
     let mut points = Vec::new();
     let mut connectivity = Vec::new();
@@ -343,6 +349,9 @@ pub fn write_mesh(path: &Path, mesh: &Mesh) -> Result<()> {
         nc,
         mesh.faces.iter().map(|f| f.radius),
     );
+    for (name, components, values) in cells {
+        v.array(CellData, name, *components, nc, values.iter().copied());
+    }
     v.vectors(Points, "points", points.len(), points.iter().copied());
     v.array(
         Cells,

@@ -3,6 +3,8 @@
 pub mod analyze;
 pub mod bench;
 pub mod fields;
+pub mod frames;
 pub mod plot;
 pub mod render;
 pub mod text;
+pub mod walls;

@@ -41,6 +41,11 @@ pub struct AnalyzeArgs {
     /// built-in drum, or mesh turning about an axis).
     #[arg(long)]
     drum: bool,
+    /// Instead of the table: the load of the grains on each mesh face of every frame with
+    /// a contact network (force, pressure, shear stress), as wall_stressNNNNNN.vtu (the mesh
+    /// with cell arrays) and .csv beside the frames. Needs [output] contacts = true.
+    #[arg(long, conflicts_with = "fields")]
+    wall_stress: bool,
     /// Report the mean height of the particles with at least this radius.
     #[arg(long)]
     large: Option<f64>,
@@ -172,6 +177,13 @@ impl AnalyzeArgs {
     pub fn execute(self) -> Result<()> {
         if self.fields.fields {
             return self.fields.execute(&self.dir, self.scenario.as_deref());
+        }
+        if self.wall_stress {
+            let written = tinydem::tools::walls::of_directory(&self.dir, self.scenario.as_deref())?;
+            for pair in written.chunks(2) {
+                println!("{} and {}", pair[0].display(), pair[1].display());
+            }
+            return Ok(());
         }
         let repose = self
             .repose

@@ -8,10 +8,9 @@ use anyhow::{Context, Result, bail};
 use glam::{DMat3, DVec3};
 use image::{Rgb, RgbImage};
 
-use crate::engine::Simulation;
 use crate::geometry::mesh::{Mesh, Primitive};
 use crate::model::particles::Particles;
-use crate::scenario::Scenario;
+use crate::tools::frames::{RunFrames, frames_of};
 use crate::tools::text::{self, put};
 
 mod picture;
@@ -403,143 +402,6 @@ pub struct Rendered {
     pub notes: Vec<String>,
 }
 
-/// The number of a frame file `particlesNNNNNN.csv` (or `particlesNNNNNN_0.csv`, the
-/// first piece of one a split run wrote in pieces).
-fn frame_number(p: &Path) -> Option<u64> {
-    crate::io::pieces::frame_number(p.file_name()?.to_str()?)
-}
-
-/// The times of the frames listed in a directory's `frames.csv`, by frame number.
-fn frame_times(dir: &Path) -> std::collections::HashMap<u64, f64> {
-    let Ok(text) = std::fs::read_to_string(dir.join(crate::io::output::FRAMES)) else {
-        return Default::default();
-    };
-    text.lines()
-        .skip(1)
-        .filter_map(|l| {
-            let v: Vec<&str> = l.split(',').collect();
-            Some((v.first()?.parse().ok()?, v.get(2)?.parse().ok()?))
-        })
-        .collect()
-}
-
-/// Each servo's displacement at each frame, from the run's `log.csv` (`meshK_position`).
-fn servo_positions(dir: &Path) -> std::collections::HashMap<u64, Vec<(u32, f64)>> {
-    let Ok(text) = std::fs::read_to_string(dir.join(crate::io::output::LOG)) else {
-        return Default::default();
-    };
-    let mut lines = text.lines();
-    let header = lines.next().unwrap_or_default();
-    let columns: Vec<(usize, u32)> = (header.split(',').enumerate())
-        .filter_map(|(c, name)| {
-            let k = name.strip_prefix("mesh")?.strip_suffix("_position")?;
-            Some((c, k.parse().ok()?))
-        })
-        .collect();
-    if columns.is_empty() {
-        return Default::default();
-    }
-    lines
-        .filter_map(|l| {
-            let v: Vec<&str> = l.split(',').collect();
-            let at = |&(c, k): &(usize, u32)| Some((k, v.get(c)?.parse().ok()?));
-            let positions = columns.iter().map(at).collect::<Option<Vec<_>>>()?;
-            Some((v.first()?.parse().ok()?, positions))
-        })
-        .collect()
-}
-
-/// What the pictures of a run's frames are drawn with: the run's simulation (for its
-/// meshes at each frame's time and its materials), further mesh files, the frames' times
-/// and where its servos were.
-struct Source {
-    sim: Option<Simulation>,
-    extra: Mesh,
-    times: std::collections::HashMap<u64, f64>,
-    servos: std::collections::HashMap<u64, Vec<(u32, f64)>>,
-}
-
-impl Source {
-    /// The source of the frames in `dir`: `scenario` (default: the run's `run.toml`) and
-    /// the mesh files `meshes`.
-    fn open(dir: &Path, scenario: Option<&Path>, meshes: &[PathBuf]) -> Result<Source> {
-        let scenario = scenario
-            .map(Path::to_path_buf)
-            .or_else(|| crate::io::output::run_toml(dir));
-        let sim = match &scenario {
-            Some(s) => Some(Simulation::new(Scenario {
-                particles: None,
-                ..Scenario::load(s)?
-            })?),
-            None => None,
-        };
-        let mut extra = Mesh::default();
-        for m in meshes {
-            // Radii do not show in pictures; accept any radius index of an OFF file.
-            let part = Mesh::load(m, &[0.0; 1024])?;
-            extra.faces.extend(part.faces);
-        }
-        Ok(Source {
-            sim,
-            extra,
-            times: frame_times(dir),
-            servos: servo_positions(dir),
-        })
-    }
-
-    /// The particles of a frame: a clump's row (with the scenario's templates) as its
-    /// spheres.
-    fn particles_of(&self, frame: &Path) -> Result<Particles> {
-        match &self.sim {
-            Some(sim) => crate::io::pieces::load_frame_as_grains(frame, &sim.scenario),
-            None => Ok(crate::io::pieces::load_frame(frame)?.0),
-        }
-    }
-
-    /// The time of a frame: from `frames.csv`, else from its number and the scenario.
-    fn time_of(&self, frame: &Path) -> Option<f64> {
-        let k = frame_number(frame)?;
-        self.times.get(&k).copied().or_else(|| {
-            self.sim.as_ref().map(|sim| {
-                let s = &sim.scenario.simulation;
-                k as f64 * s.steps_per_frame as f64 * s.timestep
-            })
-        })
-    }
-
-    /// The meshes of `frame`, at its time `t` (servos where the run's log has them).
-    fn mesh_of(&mut self, frame: &Path, t: Option<f64>) -> Mesh {
-        let mut mesh = self.extra.clone();
-        if let Some(sim) = self.sim.as_mut() {
-            if let Some(at) = frame_number(frame).and_then(|k| self.servos.get(&k)) {
-                sim.walls.place_servos(at);
-            }
-            mesh.faces
-                .extend(sim.walls.at(t.unwrap_or(0.0)).faces.iter().copied());
-        }
-        mesh
-    }
-}
-
-/// The frames of `path`: itself, or every `particlesNNNNNN.csv` of a directory, in order.
-fn frames_of(path: &Path) -> Result<Vec<PathBuf>> {
-    if !path.is_dir() {
-        return Ok(vec![path.to_path_buf()]);
-    }
-    let mut f: Vec<PathBuf> = std::fs::read_dir(path)
-        .with_context(|| format!("cannot read directory {}", path.display()))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter_map(|p| Some(path.join(crate::io::csv::frame_name(frame_number(&p)?))))
-        .collect();
-    f.sort();
-    anyhow::ensure!(
-        !f.is_empty(),
-        "{}: no frames particlesNNNNNN.csv",
-        path.display()
-    );
-    Ok(f)
-}
-
 /// Renders a frame `particlesNNNNNN.csv` to `output` (default: beside it, as .png), or every
 /// frame of an output directory into `output` (default: the directory), all in one layout
 /// (view and colour range fitted to all frames, or as `fixed`), with an animation if asked.
@@ -559,7 +421,7 @@ pub fn render_path(
     } else {
         path.parent().unwrap_or(Path::new(".")).to_path_buf()
     };
-    let mut source = Source::open(&dir, scenario, meshes)?;
+    let mut source = RunFrames::open(&dir, scenario, meshes)?;
     let frames = frames_of(path)?;
     // The layout of all frames, then the pictures in it.
     let mut layout = Layout::empty();

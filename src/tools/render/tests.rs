@@ -5,30 +5,6 @@ use crate::model::particles::Particle;
 use glam::DQuat;
 
 #[test]
-fn servos_are_placed_where_the_log_has_them() {
-    let dir = tempfile::tempdir().unwrap();
-    let header = crate::io::output::LOG_HEADER;
-    let zeros = "0,".repeat(8);
-    let log = format!(
-        "{header},mesh2_position,mesh2_load,mesh4_position,mesh4_load\n\
-         0,0,0.0,{zeros}0.0,0.0,0.0,0.0\n\
-         3,300,0.1,{zeros}0.0125,2.5,-0.5,0.0\n"
-    );
-    std::fs::write(dir.path().join(crate::io::output::LOG), log).unwrap();
-    let at = servo_positions(dir.path());
-    assert_eq!(at[&3], vec![(2, 0.0125), (4, -0.5)]);
-    assert_eq!(at[&0], vec![(2, 0.0), (4, 0.0)]);
-    // A run without servos, or without a log: none.
-    std::fs::write(
-        dir.path().join(crate::io::output::LOG),
-        format!("{header}\n"),
-    )
-    .unwrap();
-    assert!(servo_positions(dir.path()).is_empty());
-    assert!(servo_positions(&dir.path().join("none")).is_empty());
-}
-
-#[test]
 fn a_sphere_is_drawn_in_the_middle() {
     let style = Style {
         width: 320,
