@@ -210,3 +210,35 @@ fn a_region_that_cannot_place_its_grains_is_reported() {
         vec!["[[spawn]] #1 made 20 of 50 particles: [simulation] max_particles = 20 was reached"]
     );
 }
+
+#[test]
+fn a_volume_fraction_fills_its_box_with_that_share_of_grains() {
+    // As LIGGGHTS's insert/pack with volumefraction_region: uniform radii in [2, 3] mm,
+    // E[R^3] = (3^4 - 2^4) / 4 mm^3, in a 5 cm box to 0.2 of its volume: 367 grains.
+    let text = "[geometry]\nradius_min = 0.002\nradius_max = 0.003\n\
+                [kinetics]\ngravity = [0.0, 0.0, 0.0]\n\
+                [simulation]\nmax_particles = 100000\nspawn_attempts = 1000\n\
+                [[spawn]]\nmin = [0.0, 0.0, 0.0]\nmax = [0.05, 0.05, 0.05]\nvolume_fraction = 0.2\n";
+    let mut s = common::simulate(text, 0);
+    assert_eq!(s.scenario.spawn[0].count, Some(367));
+    for _ in 0..20 {
+        s.step().unwrap();
+    }
+    let p = &s.particles;
+    assert_eq!(p.len(), 367);
+    let solid: f64 = p
+        .radius
+        .iter()
+        .map(|r| 4.0 / 3.0 * std::f64::consts::PI * r.powi(3))
+        .sum();
+    let fraction = solid / 0.05f64.powi(3);
+    assert!((fraction - 0.2).abs() < 0.01, "{fraction}");
+    // Of clumps: the template's volume (mass over density) times the mean cube of the scale.
+    let dimers = "[geometry]\nradius_min = 0.002\nradius_max = 0.003\n\
+                  [[clumps]]\nname = \"dimer\"\nspheres = [[-0.002, 0.0, 0.0, 0.002], [0.002, 0.0, 0.0, 0.002]]\n\
+                  [[spawn]]\nmin = [0.0, 0.0, 0.0]\nmax = [0.05, 0.05, 0.05]\nclump = \"dimer\"\nvolume_fraction = 0.1\n";
+    let s = common::simulate(dimers, 0);
+    let t = &s.scenario.clumps[0];
+    let expected = 0.1 * 0.05f64.powi(3) / (t.mass / 1000.0);
+    assert_eq!(s.scenario.spawn[0].count, Some(expected.round() as u64));
+}

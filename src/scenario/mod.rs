@@ -378,6 +378,57 @@ pub enum RadiusDistribution {
 }
 
 impl RadiusDistribution {
+    /// The mean of the cube of the radii it draws, E[R³] \[L³\] (by the midpoint rule for
+    /// the truncated normal and log-normal: 4,000 intervals of [min, max]).
+    pub fn mean_cube(&self) -> f64 {
+        let truncated = |min: f64, max: f64, density: &dyn Fn(f64) -> f64| {
+            if max <= min {
+                return min.powi(3);
+            }
+            let n = 4000;
+            let h = (max - min) / n as f64;
+            let (mut weight, mut cubes) = (0.0, 0.0);
+            for k in 0..n {
+                let r = min + (k as f64 + 0.5) * h;
+                let w = density(r);
+                (weight, cubes) = (weight + w, cubes + w * r.powi(3));
+            }
+            cubes / weight
+        };
+        match self {
+            RadiusDistribution::Uniform { min, max } if max > min => {
+                (max.powi(4) - min.powi(4)) / (4.0 * (max - min))
+            }
+            RadiusDistribution::Uniform { min, .. } => min.powi(3),
+            RadiusDistribution::Normal {
+                mean,
+                std,
+                min,
+                max,
+            } => truncated(*min, *max, &|r| (-0.5 * ((r - mean) / std).powi(2)).exp()),
+            RadiusDistribution::LogNormal {
+                mean,
+                std,
+                min,
+                max,
+            } => {
+                let sigma2 = (1.0 + (std / mean).powi(2)).ln();
+                let mu = mean.ln() - 0.5 * sigma2;
+                let density = |r: f64| (-(r.ln() - mu).powi(2) / (2.0 * sigma2)).exp() / r;
+                truncated(*min, *max, &density)
+            }
+            RadiusDistribution::Table { radii, weights } => {
+                let total: f64 = weights.iter().sum();
+                radii
+                    .iter()
+                    .zip(weights)
+                    .map(|(r, w)| w * r.powi(3))
+                    .sum::<f64>()
+                    / total
+            }
+        }
+    }
+
     /// The largest radius it draws.
     pub fn largest(&self) -> f64 {
         match self {

@@ -98,6 +98,7 @@ pub(super) struct RawSpawn {
     pub(super) material: Option<String>,
     pub(super) velocity: Option<[f64; 3]>,
     pub(super) count: Option<u64>,
+    pub(super) volume_fraction: Option<f64>,
     pub(super) rate: Option<f64>,
     pub(super) start: Option<f64>,
     pub(super) stop: Option<f64>,

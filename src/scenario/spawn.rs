@@ -13,7 +13,7 @@ use super::*;
 pub(super) fn spawn(
     raw: Vec<RawSpawn>,
     index: &dyn Fn(&str, &str) -> Result<u16>,
-    clumps: &[ClumpTemplate],
+    (clumps, materials): (&[ClumpTemplate], &[MaterialSpec]),
     kinetics: &Kinetics,
     geometry: &Geometry,
     simulation: &SimulationTable,
@@ -28,7 +28,7 @@ pub(super) fn spawn(
                 &format!("[[spawn]] #{}", k + 1),
                 r,
                 &index,
-                clumps,
+                (clumps, materials),
                 kinetics.initial_velocity,
                 (radius_min, radius_max),
             )
@@ -88,7 +88,7 @@ fn spawn_region(
     key: &str,
     r: RawSpawn,
     index: &dyn Fn(&str, &str) -> Result<u16>,
-    clumps: &[ClumpTemplate],
+    (clumps, materials): (&[ClumpTemplate], &[MaterialSpec]),
     velocity: DVec3,
     radii: (f64, f64),
 ) -> Result<SpawnRegion> {
@@ -128,8 +128,31 @@ fn spawn_region(
         .rate
         .map(|x| check(&k("rate"), x, Range::Positive))
         .transpose()?;
-    if r.count.is_none() && rate.is_none() {
-        bail!("{key} needs a count (particles in all) or a rate (particles per second), or both");
+    let radius = Radii {
+        key,
+        lo: radii.0,
+        hi: radii.1,
+    }
+    .distribution(r.radius)?;
+    let count = match (r.count, r.volume_fraction) {
+        (Some(_), Some(_)) => {
+            bail!("{key} has a count and a volume_fraction: give one of them")
+        }
+        (Some(n), None) => Some(n),
+        (None, Some(phi)) => {
+            let grain = match clump {
+                Some(c) => clump_volume(c, clumps, materials),
+                None => 4.0 / 3.0 * std::f64::consts::PI * radius.mean_cube(),
+            };
+            Some(count_of(key, phi, region, grain)?)
+        }
+        (None, None) => None,
+    };
+    if count.is_none() && rate.is_none() {
+        bail!(
+            "{key} needs a count (particles in all), a volume_fraction (of its box, as many \
+             particles as make it) or a rate (particles per second)"
+        );
     }
     let start = check(&k("start"), r.start.unwrap_or(0.0), Range::NonNegative)?;
     let stop = match r.stop {
@@ -139,23 +162,48 @@ fn spawn_region(
     if stop <= start {
         bail!("{} = {stop} must be after start = {start}", k("stop"));
     }
-    let radius = Radii {
-        key,
-        lo: radii.0,
-        hi: radii.1,
-    }
-    .distribution(r.radius)?;
     Ok(SpawnRegion {
         region,
         material,
         velocity,
-        count: r.count,
+        count,
         rate,
         start,
         stop,
         radius,
         clump,
     })
+}
+
+/// The mean volume of a clump of `c`: its template's mass over its material's density, times
+/// the mean cube of a scale uniform in its range.
+fn clump_volume(c: SpawnClump, clumps: &[ClumpTemplate], materials: &[MaterialSpec]) -> f64 {
+    let t = &clumps[c.template as usize];
+    let volume = t.mass / materials[t.material as usize].properties.density;
+    let (a, b) = c.scale;
+    let scale_cubed = if b > a {
+        (b.powi(4) - a.powi(4)) / (4.0 * (b - a))
+    } else {
+        a.powi(3)
+    };
+    volume * scale_cubed
+}
+
+/// The count of grains of mean volume `grain` that fill the fraction `phi` of `region` (as
+/// LIGGGHTS's `insert/pack` with `volumefraction_region`).
+fn count_of(key: &str, phi: f64, region: Region, grain: f64) -> Result<u64> {
+    if !(phi > 0.0 && phi < 1.0) {
+        bail!("{key} volume_fraction = {phi} is not allowed: it must be in (0, 1)");
+    }
+    let volume = (region.max - region.min).element_product();
+    if volume <= 0.0 {
+        bail!(
+            "{key} volume_fraction = {phi}: its box {} .. {} has no volume to fill (give a count)",
+            region.min,
+            region.max
+        );
+    }
+    Ok(((phi * volume / grain).round() as u64).max(1))
 }
 
 /// The radius distribution of a `[[spawn]]` region (`key`), its radii within

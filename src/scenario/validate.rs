@@ -197,7 +197,7 @@ impl Scenario {
         let spawn = spawn(
             raw.spawn,
             &index,
-            &clumps,
+            (&clumps, &materials),
             &kinetics,
             &geometry,
             &simulation,
