@@ -116,14 +116,15 @@ fn spawn_region(
         }
         None => None,
     };
-    let material = match &r.material {
-        Some(name) => index(&k("material"), name)?,
-        None => 0,
-    };
-    let velocity = match r.velocity {
-        Some(v) => check_vec(&k("velocity"), v)?,
-        None => velocity,
-    };
+    let material = (r.material.as_ref())
+        .map(|name| index(&k("material"), name))
+        .transpose()?
+        .unwrap_or(0);
+    let velocity = (r
+        .velocity
+        .map(|v| check_vec(&k("velocity"), v))
+        .transpose()?)
+    .unwrap_or(velocity);
     let rate = r
         .rate
         .map(|x| check(&k("rate"), x, Range::Positive))
@@ -138,7 +139,6 @@ fn spawn_region(
         (Some(_), Some(_)) => {
             bail!("{key} has a count and a volume_fraction: give one of them")
         }
-        (Some(n), None) => Some(n),
         (None, Some(phi)) => {
             let grain = match clump {
                 Some(c) => clump_volume(c, clumps, materials),
@@ -146,7 +146,7 @@ fn spawn_region(
             };
             Some(count_of(key, phi, region, grain)?)
         }
-        (None, None) => None,
+        (n, None) => n,
     };
     if count.is_none() && rate.is_none() {
         bail!(
@@ -154,14 +154,7 @@ fn spawn_region(
              particles as make it) or a rate (particles per second)"
         );
     }
-    let start = check(&k("start"), r.start.unwrap_or(0.0), Range::NonNegative)?;
-    let stop = match r.stop {
-        Some(t) => check(&k("stop"), t, Range::NonNegative)?,
-        None => f64::INFINITY,
-    };
-    if stop <= start {
-        bail!("{} = {stop} must be after start = {start}", k("stop"));
-    }
+    let (start, stop) = window(&k, r.start, r.stop)?;
     Ok(SpawnRegion {
         region,
         material,
@@ -173,6 +166,19 @@ fn spawn_region(
         radius,
         clump,
     })
+}
+
+/// A region's window `start`..`stop` [s] (default: always), `stop` after `start`.
+fn window(k: &dyn Fn(&str) -> String, start: Option<f64>, stop: Option<f64>) -> Result<(f64, f64)> {
+    let start = check(&k("start"), start.unwrap_or(0.0), Range::NonNegative)?;
+    let stop = match stop {
+        Some(t) => check(&k("stop"), t, Range::NonNegative)?,
+        None => f64::INFINITY,
+    };
+    if stop <= start {
+        bail!("{} = {stop} must be after start = {start}", k("stop"));
+    }
+    Ok((start, stop))
 }
 
 /// The mean volume of a clump of `c`: its template's mass over its material's density, times
