@@ -504,3 +504,66 @@ fn wall_stresses_carry_a_resting_bed_on_its_floor() {
     let vtu = std::fs::read(t.path().join("out/wall_stress000002.vtu")).unwrap();
     assert!(String::from_utf8_lossy(&vtu).contains("Name=\"pressure\""));
 }
+
+#[test]
+fn frames_carry_each_grains_contact_force_and_torque() {
+    // `[output] forces = true`: a bed at rest in a box; each grain's contact force and torque
+    // in the frame (its fx, ..., tz) is that of its contacts in the network, the forces add
+    // up to the bed's weight (the contacts between grains cancel), the frame reads back, and
+    // the VTK file holds them too.
+    let t = tempfile::tempdir().unwrap();
+    std::fs::write(
+        t.path().join("s.toml"),
+        "[geometry]\nradius_min = 0.004\nradius_max = 0.005\n\
+         spawn_min = [-0.02, -0.02, 0.01]\nspawn_max = [0.02, 0.02, 0.06]\n\
+         [material]\nrestitution = 0.3\nfriction_sliding = 0.5\nfriction_rolling = 0.2\n\
+         [simulation]\nmax_particles = 60\nframes = 2\nsteps_per_frame = 6000\n\
+         [output]\ncontacts = true\nforces = true\nformats = [\"csv\", \"vtk\"]\n\
+         [[meshes]]\nshape = { type = \"box\", min = [-0.03, -0.03, 0.0], max = [0.03, 0.03, 0.1], open = [\"+z\"] }\n",
+    )
+    .unwrap();
+    let o = common::tinydem(&["run", "s.toml", "-o", "out", "-q"], t.path());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let frame = t.path().join("out/particles000002.csv");
+    let (fz, r) = (csv_column(&frame, "fz"), csv_column(&frame, "R"));
+    let weight: f64 = r.iter().map(|&r| Inertia::mass(r, 1000.0) * G).sum();
+    let up: f64 = fz.iter().sum();
+    assert!(
+        (up / weight - 1.0).abs() < 0.01,
+        "{up} N up, {weight} N of grains"
+    );
+    // Each grain's: from its contacts in the network (the force on id_i, minus it on id_j).
+    let network = t.path().join("out/contacts000002.csv");
+    let (i, j) = (csv_column(&network, "id_i"), csv_column(&network, "id_j"));
+    let (fn_z, ft_z) = (csv_column(&network, "fn_z"), csv_column(&network, "ft_z"));
+    let mut by_id = vec![0.0; fz.len()];
+    for c in 0..i.len() {
+        by_id[i[c] as usize] += fn_z[c] + ft_z[c];
+        if j[c] >= 0.0 {
+            by_id[j[c] as usize] -= fn_z[c] + ft_z[c];
+        }
+    }
+    for (k, (a, b)) in fz.iter().zip(&by_id).enumerate() {
+        assert!(
+            (a - b).abs() <= 1e-12 * weight,
+            "grain {k}: {a} against {b}"
+        );
+    }
+    // At rest, each grain's contact force holds its weight, and its torques balance.
+    let tx = csv_column(&frame, "tx");
+    for k in 0..fz.len() {
+        let w = Inertia::mass(r[k], 1000.0) * G;
+        assert!(
+            (fz[k] / w - 1.0).abs() < 0.05,
+            "grain {k}: {} of its weight",
+            fz[k] / w
+        );
+        assert!(tx[k].abs() < 1e-3 * w * r[k], "grain {k}: torque {}", tx[k]);
+    }
+    // Read back by the tools, and in the VTK frame.
+    let o = common::tinydem(&["analyze", "out"], t.path());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let vtu = std::fs::read(t.path().join("out/particles000002.vtu")).unwrap();
+    let text = String::from_utf8_lossy(&vtu);
+    assert!(text.contains("Name=\"force\"") && text.contains("Name=\"torque\""));
+}

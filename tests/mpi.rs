@@ -109,7 +109,7 @@ fn reference_cases_on_1_to_4_processes_write_the_same_bytes() {
 }
 
 /// The filling, discharging silo: spawning, an outlet, wall loads, contact networks in CSV
-/// and VTK.
+/// and VTK, each grain's contact force and torque in the frames.
 fn silo(dir: &Path, frames: u64) -> PathBuf {
     let path = dir.join("silo.toml");
     std::fs::write(
@@ -121,7 +121,7 @@ fn silo(dir: &Path, frames: u64) -> PathBuf {
              [simulation]\nmax_particles = 300\nframes = {frames}\nsteps_per_frame = 250\n\
              [domain]\nmin = [-0.1, -0.1, -0.2]\nmax = [0.1, 0.1, 0.2]\n\
              [[outlets]]\nmin = [-0.1, -0.1, -0.2]\nmax = [0.1, 0.1, -0.05]\n\
-             [output]\nwall_forces = true\ncontacts = true\nformats = [\"csv\", \"vtk\"]\n",
+             [output]\nwall_forces = true\ncontacts = true\nforces = true\nformats = [\"csv\", \"vtk\"]\n",
             common::data("stages/silo.off").display()
         ),
     )
@@ -248,7 +248,7 @@ fn a_servo_lid_on_1_to_3_processes_writes_the_same_bytes() {
          spawn_min = [-0.03, -0.03, 0.005]\nspawn_max = [0.03, 0.03, 0.05]\n\
          [simulation]\nmax_particles = 250\nframes = 6\nsteps_per_frame = 300\n\
          [domain]\nmin = [-0.03, -0.03, -0.01]\nmax = [0.03, 0.03, 0.1]\nperiodic = [true, true, false]\n\
-         [output]\nwall_forces = true\n\
+         [output]\nwall_forces = true\nforces = true\n\
          [[meshes]]\nshape = { type = \"plane\", point = [0.0, 0.0, 0.0], normal = [0.0, 0.0, 1.0], size = 0.4 }\n\
          [[meshes]]\nshape = { type = \"plane\", point = [0.0, 0.0, 0.06], normal = [0.0, 0.0, 1.0], size = 0.4 }\n\
          motion = { type = \"servo\", direction = [0.0, 0.0, -1.0], stress = 150.0, max_speed = 0.5 }\n",

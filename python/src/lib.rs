@@ -588,6 +588,7 @@ impl Simulation {
             ids: self.sim.frames_carry_ids(),
             fixed: self.sim.has_fixed(),
             clump: !self.sim.scenario.clumps.is_empty(),
+            loads: None,
         };
         let dir = path.parent().filter(|d| !d.as_os_str().is_empty());
         let name = path

@@ -16,8 +16,9 @@ use crate::scenario::{Formats, Gather, Met, Scenario};
 pub(super) struct Frames<'a> {
     dir: &'a Path,
     formats: Formats,
-    /// The CSV frames' columns beyond the fourteen.
-    pub(super) extra: Extra,
+    /// The CSV frames' columns beyond the fourteen (the loads, with `[output] forces`,
+    /// frame by frame).
+    pub(super) extra: Extra<'static>,
     /// Simulated time between frames.
     frame_time: f64,
     /// Whether each process of a split run writes its own piece of each frame
@@ -39,6 +40,7 @@ impl<'a> Frames<'a> {
                 ids: sim.frames_carry_ids(),
                 fixed: sim.has_fixed(),
                 clump: !sim.scenario.clumps.is_empty(),
+                loads: None,
             },
             frame_time: sim.scenario.simulation.steps_per_frame as f64
                 * sim.scenario.simulation.timestep,
@@ -61,15 +63,27 @@ impl<'a> Frames<'a> {
             return self.write_pieces(k, sim);
         }
         let particles = sim.particles_in_domain();
-        let contacts = sim
-            .scenario
-            .contact_network
-            .then(|| sim.contact_network_to(Reach::Writer));
+        let s = &sim.scenario;
+        let contacts =
+            (s.contact_network || s.forces).then(|| sim.contact_network_to(Reach::Writer));
         if !sim.is_writer() {
             return Ok(());
         }
+        // The contact force and torque of each row (clumps whole) and of each sphere.
+        let loads = |whole: bool| {
+            let network = contacts.as_deref().filter(|_| s.forces)?;
+            Some(crate::engine::records::contact_loads(
+                &particles, network, whole,
+            ))
+        };
+        let (rows, spheres) = (loads(true), loads(false));
+        let contacts = contacts.filter(|_| s.contact_network);
         if self.formats.csv {
-            write_frame(self.dir, k, &particles, self.extra)?;
+            let extra = Extra {
+                loads: rows.as_ref(),
+                ..self.extra
+            };
+            write_frame(self.dir, k, &particles, extra)?;
         }
         if let Some(contacts) = contacts {
             crate::io::csv::write_contacts(self.dir, &format!("contacts{k:06}.csv"), &contacts)?;
@@ -81,7 +95,7 @@ impl<'a> Frames<'a> {
         }
         if self.formats.vtk {
             let name = format!("particles{k:06}.vtu");
-            vtk::write_particles(&self.dir.join(&name), &particles)?;
+            vtk::write_particles(&self.dir.join(&name), &particles, spheres.as_ref())?;
             self.collection("particles", k, "vtu")?;
             self.moving_mesh(k, sim)?;
         }
@@ -99,11 +113,21 @@ impl<'a> Frames<'a> {
             .scenario
             .contact_network
             .then(|| sim.own_contact_network());
+        // Every contact of an own particle is among those this process holds (its ghosts are
+        // within reach): the loads of its own rows from them.
+        let loads = |whole: bool| {
+            let network = sim.scenario.forces.then(|| sim.held_contacts())?;
+            Some(crate::engine::records::contact_loads(
+                &held, &network, whole,
+            ))
+        };
+        let (rows, spheres) = (loads(true), loads(false));
         let bodies = self.extra.clump;
         let written = (|| -> Result<()> {
             if self.formats.csv {
                 let extra = Extra {
                     ids: true,
+                    loads: rows.as_ref(),
                     ..self.extra
                 };
                 write_frame_as(self.dir, &piece("particles", "csv"), &own, extra)?;
@@ -117,7 +141,7 @@ impl<'a> Frames<'a> {
             }
             if self.formats.vtk {
                 let path = self.dir.join(piece("particles", "vtu"));
-                vtk::write_particle_piece(&path, &own, bodies)?;
+                vtk::write_particle_piece(&path, &own, bodies, spheres.as_ref())?;
             }
             Ok(())
         })();
@@ -132,7 +156,8 @@ impl<'a> Frames<'a> {
                 .collect()
         };
         let list = self.dir.join(format!("particles{k:06}.pvtu"));
-        vtk::write_particle_list(&list, &pieces("particles", "vtu"), bodies)?;
+        let forces = sim.scenario.forces;
+        vtk::write_particle_list(&list, &pieces("particles", "vtu"), bodies, forces)?;
         self.collection("particles", k, "pvtu")?;
         if contacts.is_some() {
             let list = self.dir.join(format!("contacts{k:06}.pvtp"));

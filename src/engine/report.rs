@@ -35,6 +35,12 @@ impl Simulation {
         network
     }
 
+    /// The contacts of the particles this process holds (own and ghosts): in a split run,
+    /// every contact of an own particle is among them.
+    pub fn held_contacts(&self) -> Vec<ContactRecord> {
+        self.held_contact_network()
+    }
+
     /// The contact network of the particles this process holds (own and ghosts).
     pub(super) fn held_contact_network(&self) -> Vec<ContactRecord> {
         let mut out = self.held_pair_records();
@@ -137,6 +143,11 @@ impl Simulation {
             f_n,
             f_t: force.f - f_n,
             overlap: kin.delta,
+            tau_i: force.tau_i,
+            tau_j: match with {
+                Partner::Particle(_) => force.tau_j,
+                Partner::Face(_) => DVec3::ZERO,
+            },
         }
     }
 

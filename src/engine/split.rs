@@ -48,6 +48,8 @@ pub(crate) fn gather_contacts(
         w.vec3(c.f_n);
         w.vec3(c.f_t);
         w.f64(c.overlap);
+        w.vec3(c.tau_i);
+        w.vec3(c.tau_j);
     }
     let mut all = Vec::new();
     for m in comm.gather_to(reach, w.0) {
@@ -65,6 +67,8 @@ pub(crate) fn gather_contacts(
                 f_n: r.vec3(),
                 f_t: r.vec3(),
                 overlap: r.f64(),
+                tau_i: r.vec3(),
+                tau_j: r.vec3(),
             });
         }
     }

@@ -27,9 +27,13 @@ pub fn frame_name(k: u64) -> String {
     format!("particles{k:06}.csv")
 }
 
+/// The columns of the contact force and torque on each row (`[output] forces`): written by
+/// a run, and passed over when a frame is read.
+pub const FORCE_COLUMNS: [&str; 6] = ["fx", "fy", "fz", "tx", "ty", "tz"];
+
 /// The columns of a frame beyond the original fourteen.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Extra {
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Extra<'a> {
     /// `tag`
     pub tag: bool,
     /// `id` and `material`
@@ -38,6 +42,9 @@ pub struct Extra {
     pub fixed: bool,
     /// `clump` (the scenario has clumps): a row per rigid body, `R` its bounding radius
     pub clump: bool,
+    /// [`FORCE_COLUMNS`]: each row's contact force and torque, by its id (a row without
+    /// one has none)
+    pub loads: Option<&'a crate::engine::records::Loads>,
 }
 
 /// Writes all particles as CSV text in id order, with the `extra` columns.
@@ -57,6 +64,9 @@ pub fn write_particles(out: &mut impl Write, p: &Particles, extra: Extra) -> std
     let clump = extra.clump || !p.bodies.is_empty();
     if clump {
         out.write_all(b",clump")?;
+    }
+    if extra.loads.is_some() {
+        out.write_all(format!(",{}", FORCE_COLUMNS.join(",")).as_bytes())?;
     }
     out.write_all(b"\n")?;
     let mut buf = ryu::Buffer::new();
@@ -99,6 +109,13 @@ pub fn write_particles(out: &mut impl Write, p: &Particles, extra: Extra) -> std
             line.push(',');
             line.push_str(itoa::Buffer::new().format(template));
         }
+        if let Some(loads) = extra.loads {
+            let (f, t) = loads.get(&id).copied().unwrap_or_default();
+            for value in [f.x, f.y, f.z, t.x, t.y, t.z] {
+                line.push(',');
+                line.push_str(buf.format(value));
+            }
+        }
         line.push('\n');
         out.write_all(line.as_bytes())?;
     }
@@ -120,7 +137,11 @@ pub fn write_frame_as(dir: &Path, name: &str, p: &Particles, extra: Extra) -> Re
 }
 
 /// The header of a contact network file.
-pub const CONTACT_COLUMNS: &str = "id_i,id_j,face,x,y,z,fn_x,fn_y,fn_z,ft_x,ft_y,ft_z,overlap";
+pub const CONTACT_COLUMNS: &str = "id_i,id_j,face,x,y,z,fn_x,fn_y,fn_z,ft_x,ft_y,ft_z,overlap,\
+ti_x,ti_y,ti_z,tj_x,tj_y,tj_z";
+
+/// The header of the contact networks of earlier versions, without the torques.
+const CONTACT_COLUMNS_V1: &str = "id_i,id_j,face,x,y,z,fn_x,fn_y,fn_z,ft_x,ft_y,ft_z,overlap";
 
 /// Writes the contact network atomically to `dir/name`: a line per contact, `id_j` or
 /// `face` -1 where it does not apply.
@@ -143,7 +164,8 @@ pub fn write_contacts(dir: &Path, name: &str, contacts: &[ContactRecord]) -> Res
             }
             for x in [
                 c.point.x, c.point.y, c.point.z, c.f_n.x, c.f_n.y, c.f_n.z, c.f_t.x, c.f_t.y,
-                c.f_t.z, c.overlap,
+                c.f_t.z, c.overlap, c.tau_i.x, c.tau_i.y, c.tau_i.z, c.tau_j.x, c.tau_j.y,
+                c.tau_j.z,
             ] {
                 line.push(',');
                 line.push_str(buf.format(x));
@@ -166,27 +188,29 @@ pub fn load_contacts(path: &Path) -> Result<Vec<ContactRecord>> {
     )
     .with_context(|| format!("cannot read contact file {file}"))?;
     let mut lines = text.lines();
-    if lines.next().map(str::trim) != Some(CONTACT_COLUMNS) {
-        bail!("{file}:1: expected the header '{CONTACT_COLUMNS}'");
-    }
+    let values = match lines.next().map(str::trim) {
+        Some(CONTACT_COLUMNS) => 19,
+        Some(CONTACT_COLUMNS_V1) => 13,
+        _ => bail!("{file}:1: expected the header '{CONTACT_COLUMNS}'"),
+    };
     lines
         .enumerate()
         .filter(|(_, l)| !l.trim().is_empty())
-        .map(|(k, line)| contact(line, &file, k + 2))
+        .map(|(k, line)| contact(line, &file, k + 2, values))
         .collect()
 }
 
-/// One line `n` of a contact network.
-fn contact(line: &str, file: &str, n: usize) -> Result<ContactRecord> {
+/// One line `n` of a contact network of `values` columns (19, or 13 without the torques).
+fn contact(line: &str, file: &str, n: usize, values: usize) -> Result<ContactRecord> {
     let fields: Vec<&str> = line.split(',').map(str::trim).collect();
-    if fields.len() != 13 {
-        bail!("{file}:{n}: {} values, expected 13", fields.len());
+    if fields.len() != values {
+        bail!("{file}:{n}: {} values, expected {values}", fields.len());
     }
     let int = |k: usize| -> Result<i64> {
         (fields[k].parse())
             .map_err(|_| anyhow::anyhow!("{file}:{n}: '{}' is not a whole number", fields[k]))
     };
-    let mut x = [0.0; 10];
+    let mut x = [0.0; 16];
     for (v, text) in x.iter_mut().zip(&fields[3..]) {
         *v = text
             .parse()
@@ -211,12 +235,16 @@ fn contact(line: &str, file: &str, n: usize) -> Result<ContactRecord> {
         f_n: v(3),
         f_t: v(6),
         overlap: x[9],
+        tau_i: v(10),
+        tau_j: v(13),
     })
 }
 
 /// The columns of a particle CSV file, from its header.
 struct Header {
     columns: usize,
+    /// The columns a run writes that a frame read passes over ([`FORCE_COLUMNS`]).
+    passed: Vec<usize>,
     /// The column of each optional whole-number quantity: tag, id, material, fixed.
     int_column: [Option<usize>; 5],
     /// The quantity (of the 14) each column holds.
@@ -231,7 +259,12 @@ impl Header {
         let mut slot = [usize::MAX; 14];
         // The optional whole-number columns: tag, id, material, fixed.
         let mut int_column = [None; 5];
+        let mut passed = Vec::new();
         for (col, name) in names.iter().enumerate() {
+            if FORCE_COLUMNS.contains(name) {
+                passed.push(col);
+                continue;
+            }
             if let Some(k) = INT_COLUMNS.iter().position(|c| c == name) {
                 if int_column[k].is_some() {
                     bail!("{file}:1: column '{name}' appears twice");
@@ -266,6 +299,7 @@ impl Header {
         }
         Ok(Header {
             columns: names.len(),
+            passed,
             int_column,
             quantity_of_column,
         })
@@ -281,7 +315,7 @@ impl Header {
         let mut ints = [0u64; 5];
         for (col, text) in line.split(',').enumerate() {
             count += 1;
-            if col >= names {
+            if col >= names || self.passed.contains(&col) {
                 continue;
             }
             let text = text.trim();
@@ -614,6 +648,8 @@ mod tests {
                 f_n: DVec3::new(0.0, 0.0, 1.5e-3),
                 f_t: DVec3::new(-2e-5, 1e-300, 0.0),
                 overlap: 1e-6,
+                tau_i: DVec3::new(1e-9, -2e-8, 0.1),
+                tau_j: DVec3::new(0.0, 3e-9, -1.0 / 7.0),
             },
             ContactRecord {
                 id: 4,
@@ -622,6 +658,8 @@ mod tests {
                 f_n: DVec3::X,
                 f_t: DVec3::ZERO,
                 overlap: 0.0,
+                tau_i: DVec3::ZERO,
+                tau_j: DVec3::ZERO,
             },
         ];
         let path = write_contacts(dir.path(), "contacts000001.csv", &contacts).unwrap();
@@ -631,8 +669,21 @@ mod tests {
             format!("{:#}", load_contacts(&path).unwrap_err())
         };
         assert!(bad("1,2,3").contains(":2: 3 values"));
-        assert!(bad("1,2,3,0,0,0,0,0,0,0,0,0,0").contains("a particle (id_j, face = -1)"));
-        assert!(bad("1,2,-1,0,0,nan,0,0,0,0,0,0,0").contains("'nan' is not a finite"));
+        let zeros = ",0".repeat(6);
+        assert!(
+            bad(&format!("1,2,3,0,0,0,0,0,0,0,0,0,0{zeros}"))
+                .contains("a particle (id_j, face = -1)")
+        );
+        assert!(
+            bad(&format!("1,2,-1,0,0,nan,0,0,0,0,0,0,0{zeros}")).contains("'nan' is not a finite")
+        );
+        // A network of an earlier version, without the torques: read with none.
+        std::fs::write(
+            &path,
+            format!("{CONTACT_COLUMNS_V1}\n4,-1,12,0,0,0,1,0,0,0,0,0,0\n"),
+        )
+        .unwrap();
+        assert_eq!(load_contacts(&path).unwrap(), contacts[1..]);
     }
 
     #[test]

@@ -12,7 +12,7 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 
-use crate::engine::records::{ContactRecord, Partner};
+use crate::engine::records::{ContactRecord, Loads, Partner};
 use crate::geometry::mesh::{Mesh, Primitive};
 use crate::model::particles::{Id, Particles};
 
@@ -255,25 +255,43 @@ fn atomic_write(path: &Path, parts: &[&[u8]]) -> Result<()> {
         .with_context(|| format!("cannot write {}", path.display()))
 }
 
-/// Writes the particles as a `.vtu` file, in id order.
-pub fn write_particles(path: &Path, p: &Particles) -> Result<()> {
-    particles_vtu(p, !p.bodies.is_empty()).write(path, p.len(), p.len())
+/// Writes the particles as a `.vtu` file, in id order; with the arrays `force` and `torque`
+/// of each particle's contacts if `loads` are given (by id).
+pub fn write_particles(path: &Path, p: &Particles, loads: Option<&Loads>) -> Result<()> {
+    particles_vtu(p, !p.bodies.is_empty(), loads).write(path, p.len(), p.len())
 }
 
 /// Writes one process's piece of the particles of a frame (as [`write_particles`]; with
 /// the `body` array if `bodies`, so that all pieces have the same arrays).
-pub fn write_particle_piece(path: &Path, p: &Particles, bodies: bool) -> Result<()> {
-    particles_vtu(p, bodies).write(path, p.len(), p.len())
+pub fn write_particle_piece(
+    path: &Path,
+    p: &Particles,
+    bodies: bool,
+    loads: Option<&Loads>,
+) -> Result<()> {
+    particles_vtu(p, bodies, loads).write(path, p.len(), p.len())
 }
 
 /// Writes the `.pvtu` file that makes the pieces `sources` (of [`write_particle_piece`])
-/// one data set for ParaView.
-pub fn write_particle_list(path: &Path, sources: &[String], bodies: bool) -> Result<()> {
-    particles_vtu(&Particles::default(), bodies).write_list(path, "PUnstructuredGrid", sources)
+/// one data set for ParaView; `forces`: they hold `force` and `torque`.
+pub fn write_particle_list(
+    path: &Path,
+    sources: &[String],
+    bodies: bool,
+    forces: bool,
+) -> Result<()> {
+    let none = Loads::default();
+    let loads = forces.then_some(&none);
+    particles_vtu(&Particles::default(), bodies, loads).write_list(
+        path,
+        "PUnstructuredGrid",
+        sources,
+    )
 }
 
-/// The particles' file, in id order; with the `body` array if `bodies`.
-fn particles_vtu(p: &Particles, bodies: bool) -> Vtu {
+/// The particles' file, in id order; with the `body` array if `bodies`, and `force` and
+/// `torque` from `loads`.
+fn particles_vtu(p: &Particles, bodies: bool, loads: Option<&Loads>) -> Vtu {
     use Section::*;
     let n = p.len();
     let order = p.id_order();
@@ -305,6 +323,11 @@ fn particles_vtu(p: &Particles, bodies: bool) -> Vtu {
         // for a plain sphere.
         let body = |i: usize| p.body[i].map_or(-1, |b| b.first() as i64);
         v.array(PointData, "body", 1, n, by_id().map(body));
+    }
+    if let Some(loads) = loads {
+        let load = |i: usize| loads.get(&p.id[i]).copied().unwrap_or_default();
+        v.vectors(PointData, "force", n, by_id().map(|i| load(i).0));
+        v.vectors(PointData, "torque", n, by_id().map(|i| load(i).1));
     }
     v.vectors(Points, "points", n, by_id().map(|i| p.x[i]));
     v.array(Cells, "connectivity", 1, n, 0..n as i64);

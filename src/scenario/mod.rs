@@ -31,7 +31,7 @@
 //! [[materials]] name, density, youngs_modulus, poisson_ratio, restitution, friction_*
 //! [[interactions]] materials = [a, b], restitution, friction_*
 //! [input]      particles
-//! [output]     dir, checkpoint_every, checkpoint_minutes, formats, wall_forces, contacts,
+//! [output]     dir, checkpoint_every, checkpoint_minutes, formats, wall_forces, contacts, forces,
 //!              gather = "auto" | "always" | "never"
 //! ```
 //! Paths are relative to the scenario file. Unknown keys and values outside Table 2's
@@ -542,6 +542,9 @@ pub struct Scenario {
     pub wall_forces: bool,
     /// Write the contact network with every frame (`contactsNNNNNN.csv`, and `.vtp` with VTK).
     pub contact_network: bool,
+    /// Write each row's contact force and torque in the frames (`fx,fy,fz,tx,ty,tz`; VTK's
+    /// `force` and `torque` of each sphere).
+    pub forces: bool,
     /// Whether a split run gathers each frame into one file or writes a piece per process.
     pub gather: Gather,
 }

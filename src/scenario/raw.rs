@@ -339,5 +339,6 @@ pub(super) struct RawOutput {
     pub(super) formats: Option<Vec<String>>,
     pub(super) wall_forces: Option<bool>,
     pub(super) contacts: Option<bool>,
+    pub(super) forces: Option<bool>,
     pub(super) gather: Option<String>,
 }

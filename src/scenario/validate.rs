@@ -235,6 +235,7 @@ impl Scenario {
             formats: Formats::parse(raw.output.formats)?,
             wall_forces: raw.output.wall_forces.unwrap_or(false),
             contact_network: raw.output.contacts.unwrap_or(false),
+            forces: raw.output.forces.unwrap_or(false),
             gather: Gather::parse(raw.output.gather)?,
         };
         scenario.consistent()?;

@@ -102,7 +102,56 @@ pub struct ContactRecord {
     pub f_t: DVec3,
     /// δ \[L\]
     pub overlap: f64,
+    /// The torque on particle `id` and on the other particle (0 for a face), about their
+    /// centres: sliding, rolling and twisting (Eqs. 58-60) \[N m\].
+    pub tau_i: DVec3,
+    pub tau_j: DVec3,
 }
+
+/// The contact force and torque on each particle (torque about its centre) by its id, or,
+/// with `whole`, on each row of a frame: a clump's (by its first sphere's id) summed over its
+/// spheres, the torque about its centre of mass; from the contacts of `contacts` of the
+/// particles `p` (partners not among them left out). Gravity and drag are not counted.
+pub fn contact_loads(p: &Particles, contacts: &[ContactRecord], whole: bool) -> Loads {
+    let at: rustc_hash::FxHashMap<Id, usize> =
+        p.id.iter().enumerate().map(|(k, &id)| (id, k)).collect();
+    let mut loads = Loads::default();
+    // The row of the particle stored at `k`, and the lever of a force on it about the row's
+    // centre (a clump's centre of mass: from the body's frame, which holds whatever images
+    // of a periodic domain its centre and spheres were put at).
+    let row = |k: usize| match p.body[k].filter(|_| whole) {
+        Some(b) => {
+            let index = p.bodies.index_of(b).expect("a listed body");
+            let body = &p.bodies.list[index];
+            let m = (p.bodies.members(index).iter())
+                .position(|&s| s as usize == k)
+                .expect("a sphere of its body");
+            (b.first(), body.q * body.offsets[m])
+        }
+        None => (p.id[k], DVec3::ZERO),
+    };
+    let mut add = |k: usize, f: DVec3, tau: DVec3| {
+        let (id, lever) = row(k);
+        let load = loads.entry(id).or_default();
+        load.0 += f;
+        load.1 += tau + lever.cross(f);
+    };
+    for c in contacts {
+        let f = c.f_n + c.f_t;
+        if let Some(&i) = at.get(&c.id) {
+            add(i, f, c.tau_i);
+        }
+        if let Partner::Particle(j) = c.with
+            && let Some(&j) = at.get(&j)
+        {
+            add(j, -f, c.tau_j);
+        }
+    }
+    loads
+}
+
+/// Force and torque by id (of a particle, or a clump's row).
+pub type Loads = rustc_hash::FxHashMap<Id, (DVec3, DVec3)>;
 
 impl ContactRecord {
     /// Where it stands in a network: pairs by (lower id, higher id), then contacts with

@@ -112,6 +112,8 @@ fn a_contacts_stress_integrates_to_its_force_times_its_branch() {
             f_n: n * 2.0,
             f_t: DVec3::new(0.2, -0.1, 0.0),
             overlap: delta,
+            tau_i: DVec3::ZERO,
+            tau_j: DVec3::ZERO,
         },
         ContactRecord {
             id: 9,
@@ -120,6 +122,8 @@ fn a_contacts_stress_integrates_to_its_force_times_its_branch() {
             f_n: DVec3::Z,
             f_t: DVec3::ZERO,
             overlap: 0.0,
+            tau_i: DVec3::ZERO,
+            tau_j: DVec3::ZERO,
         },
     ];
     let grid = Grid::over(DVec3::ZERO, DVec3::splat(0.1), 0.0025, None, [false; 3]);
