@@ -108,6 +108,14 @@ fn reference_cases_on_1_to_4_processes_write_the_same_bytes() {
     }
 }
 
+/// The values of the column `name` of a CSV frame's text, row by row.
+fn column<'a>(text: &'a str, name: &str) -> Vec<&'a str> {
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let at = header.iter().position(|&h| h == name).expect("the column");
+    lines.map(|l| l.split(',').nth(at).unwrap()).collect()
+}
+
 /// The filling, discharging silo: spawning, an outlet, wall loads, contact networks in CSV
 /// and VTK, each grain's contact force and torque in the frames.
 fn silo(dir: &Path, frames: u64) -> PathBuf {
@@ -367,11 +375,7 @@ fn clumps_in_a_filling_silo_on_1_to_3_processes_write_the_same_bytes() {
         .rfind(|f| f.0.starts_with("particles") && f.0.ends_with(".csv"))
         .unwrap();
     let last = String::from_utf8_lossy(&last.1);
-    let clumps: Vec<&str> = last
-        .lines()
-        .skip(1)
-        .map(|r| r.rsplit(',').next().unwrap())
-        .collect();
+    let clumps = column(&last, "clump");
     let count = |c: &str| clumps.iter().filter(|&&k| k == c).count();
     assert!(
         count("0") > 30 && count("1") > 20 && count("-1") > 30,
@@ -633,9 +637,7 @@ fn a_particle_file_of_clumps_without_ids_read_in_shares_writes_the_same_bytes() 
         .1;
     // Rows: dimer (ids 0, 1), sphere (2), triangle (3, 4, 5), dimer (6, 7), ...
     let text = String::from_utf8_lossy(first);
-    let ids: Vec<&str> = (text.lines().skip(1).take(4))
-        .map(|l| l.rsplit(',').nth(2).unwrap())
-        .collect();
+    let ids = &column(&text, "id")[..4];
     assert_eq!(
         ids,
         ["0", "2", "3", "6"],
