@@ -800,6 +800,8 @@ mod tests {
         assert_eq!(s.simulation.frames * s.simulation.steps_per_frame, 50_000);
         // Eq. (50): 0.002 * sqrt(1000 * 0.91 / 1e6)
         assert!((s.simulation.timestep - 6.0332412e-5).abs() < 1e-12);
+        // A run killed without warning loses at most ten minutes unless the user says.
+        assert_eq!(s.checkpoint_minutes, 10.0);
     }
 
     #[test]
