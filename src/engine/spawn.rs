@@ -82,9 +82,7 @@ fn draw(rng: &mut ChaCha8Rng, d: &RadiusDistribution) -> f64 {
             min,
             max,
         } => {
-            // ln R ~ N(mu, sigma²) with the mean and deviation of R itself.
-            let sigma2 = (1.0 + (std / mean).powi(2)).ln();
-            let mu = mean.ln() - 0.5 * sigma2;
+            let (mu, sigma2) = crate::scenario::log_normal(mean, std);
             truncated(rng, min, max, &|z| (mu + sigma2.sqrt() * z).exp())
         }
         RadiusDistribution::Table {

@@ -377,6 +377,13 @@ pub enum RadiusDistribution {
     Table { radii: Vec<f64>, weights: Vec<f64> },
 }
 
+/// The parameters mu and sigma² of ln R ~ N(mu, sigma²) for the mean and standard deviation
+/// of R itself.
+pub fn log_normal(mean: f64, std: f64) -> (f64, f64) {
+    let sigma2 = (1.0 + (std / mean).powi(2)).ln();
+    (mean.ln() - 0.5 * sigma2, sigma2)
+}
+
 impl RadiusDistribution {
     /// The mean of the cube of the radii it draws, E[R³] \[L³\] (by the midpoint rule for
     /// the truncated normal and log-normal: 4,000 intervals of [min, max]).
@@ -412,8 +419,7 @@ impl RadiusDistribution {
                 min,
                 max,
             } => {
-                let sigma2 = (1.0 + (std / mean).powi(2)).ln();
-                let mu = mean.ln() - 0.5 * sigma2;
+                let (mu, sigma2) = log_normal(*mean, *std);
                 let density = |r: f64| (-(r.ln() - mu).powi(2) / (2.0 * sigma2)).exp() / r;
                 truncated(*min, *max, &density)
             }
