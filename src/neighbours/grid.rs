@@ -175,7 +175,7 @@ const MAX_CELLS_PER_FACE: f64 = 4096.0;
 /// The grid of mesh faces: each face binned into every cell its bounding box, grown by the
 /// reach of a particle, overlaps, so the cell of a particle's centre lists every face it can
 /// reach before the next rebuild. Cells are 2 R_max + skin wide; a face that would span more
-/// than [`MAX_CELLS_PER_FACE`] of them (a floor of a kilometre under millimetre grains would
+/// than `MAX_CELLS_PER_FACE` (4,096) of them (a floor of a kilometre under millimetre grains would
 /// span 10^9) is binned in a level of cells 4, 16, ... times as wide, so that no face costs
 /// more than that many entries. Usually every face is in the first level.
 #[derive(Clone, Debug, Default)]

@@ -385,7 +385,7 @@ pub fn log_normal(mean: f64, std: f64) -> (f64, f64) {
 }
 
 impl RadiusDistribution {
-    /// The mean of the cube of the radii it draws, E[R³] \[L³\] (by the midpoint rule for
+    /// The mean of the cube of the radii it draws, E\[R³\] \[L³\] (by the midpoint rule for
     /// the truncated normal and log-normal: 4,000 intervals of [min, max]).
     pub fn mean_cube(&self) -> f64 {
         let truncated = |min: f64, max: f64, density: &dyn Fn(f64) -> f64| {
