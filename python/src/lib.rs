@@ -444,12 +444,10 @@ impl Simulation {
                 x: x[k],
                 radius: r[k],
                 v: v[k],
-                q: DQuat::IDENTITY,
                 w: w[k],
                 tag,
                 material,
-                fixed: false,
-                body: None,
+                ..Default::default()
             })
             .collect();
         let ids = self

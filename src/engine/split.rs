@@ -8,8 +8,8 @@ use crate::model::bodies::Body as RigidBody;
 use crate::neighbours::{Entries, Periodic};
 use crate::parallel::comm::{Comm, Reach, Reader, Writer};
 use crate::parallel::domain::{
-    Domain, GHOST_STATE, Placement, REBALANCE, Tree, agree, gather_by_id, get_body, get_entry,
-    get_particle, put_body, put_entry, put_particle,
+    Domain, Placement, REBALANCE, Tree, agree, gather_by_id, get_body, get_entry, get_particle,
+    put_body, put_entry, put_particle,
 };
 use rustc_hash::{FxHashMap, FxHashSet};
 
@@ -535,32 +535,21 @@ pub(super) fn refresh_ghosts(d: &Domain, p: &mut Particles) {
         .enumerate()
         .filter(|(_, list)| !list.is_empty())
         .map(|(q, list)| {
-            let mut w = Writer(Vec::with_capacity(list.len() * GHOST_STATE));
-            for &i in list {
-                let i = i as usize;
-                w.vec3(p.x[i]);
-                w.vec3(p.v[i]);
-                w.quat(p.q[i]);
-                w.vec3(p.w[i]);
-                w.u32(p.tag[i]);
-            }
-            (q, w.0)
+            let mut out = Vec::with_capacity(list.len() * Particles::GHOST_STATE);
+            list.iter()
+                .for_each(|&i| p.put_ghost_state(i as usize, &mut out));
+            (q, out)
         })
         .collect();
     // Only the processes that hold ghosts of ours, or ours of theirs, hear from us.
     let from: Vec<(usize, usize)> = (0..d.recv.len())
         .filter(|&q| !d.recv[q].is_empty())
-        .map(|q| (q, d.recv[q].len() * GHOST_STATE))
+        .map(|q| (q, d.recv[q].len() * Particles::GHOST_STATE))
         .collect();
     for (m, &(q, _)) in d.comm.exchange(messages, &from).iter().zip(&from) {
-        let mut r = Reader::new(m);
-        for &i in &d.recv[q] {
-            let i = i as usize;
-            p.x[i] = r.vec3();
-            p.v[i] = r.vec3();
-            p.q[i] = r.quat();
-            p.w[i] = r.vec3();
-            p.tag[i] = r.u32();
-        }
+        let mut bytes = &m[..];
+        d.recv[q]
+            .iter()
+            .for_each(|&i| p.take_ghost_state(i as usize, &mut bytes));
     }
 }

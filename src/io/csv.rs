@@ -392,7 +392,7 @@ fn particle(v: [f64; 14], ints: [u64; 5], n: usize, file: &str) -> Result<Partic
         material: u16::try_from(ints[2])
             .map_err(|_| anyhow::anyhow!("{file}:{n}: material {} is out of range", ints[2]))?,
         fixed: ints[3] == 1,
-        body: None,
+        ..Default::default()
     })
 }
 

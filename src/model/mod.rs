@@ -13,3 +13,4 @@ pub mod particles;
 pub mod rigid;
 pub mod servo;
 pub mod springs;
+pub mod value;

@@ -518,6 +518,12 @@ impl<'a> Reader<'a> {
     pub fn quat(&mut self) -> DQuat {
         DQuat::from_xyzw(self.f64(), self.f64(), self.f64(), self.f64())
     }
+    /// The next `n` bytes: a record that its type reads.
+    pub fn record(&mut self, n: usize) -> &'a [u8] {
+        let b = &self.data[self.at..self.at + n];
+        self.at += n;
+        b
+    }
     pub fn bytes(&mut self) -> &'a [u8] {
         let n = self.u64() as usize;
         let b = &self.data[self.at..self.at + n];

@@ -272,10 +272,6 @@ fn halve(cells: &mut Vec<Cell>, grp: Group, x: &[DVec3], (axis, at): (usize, f64
     ]
 }
 
-/// The bytes of a ghost's new state each step: position, velocity, orientation, angular
-/// velocity and tag.
-pub(crate) const GHOST_STATE: usize = 3 * 8 + 3 * 8 + 4 * 8 + 3 * 8 + 4;
-
 /// Where a redistribution places the particles (for their owners, ghosts and lists).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Placement {
@@ -315,17 +311,10 @@ impl Domain {
     }
 }
 
+/// A particle's record in a message: its id, then its fields ([`Particle::put`]).
 pub(crate) fn put_particle(w: &mut Writer, id: Id, p: &Particle) {
     w.u64(id);
-    w.f64(p.radius);
-    w.vec3(p.x);
-    w.vec3(p.v);
-    w.quat(p.q);
-    w.vec3(p.w);
-    w.u32(p.tag);
-    w.u16(p.material);
-    w.u8(p.fixed as u8);
-    w.u64(p.body.map_or(0, |b| b.first() + 1));
+    p.put(&mut w.0);
 }
 
 /// A rigid body's record in a message (beside its spheres, which name it).
@@ -362,18 +351,7 @@ pub(crate) fn get_body(r: &mut Reader) -> Body {
 
 pub(crate) fn get_particle(r: &mut Reader) -> (Id, Particle) {
     let id = r.u64();
-    let p = Particle {
-        radius: r.f64(),
-        x: r.vec3(),
-        v: r.vec3(),
-        q: r.quat(),
-        w: r.vec3(),
-        tag: r.u32(),
-        material: r.u16(),
-        fixed: r.u8() != 0,
-        body: r.u64().checked_sub(1).map(BodyId::new),
-    };
-    (id, p)
+    (id, Particle::take(&mut r.record(Particle::SIZE)))
 }
 
 pub(crate) fn put_entry(w: &mut Writer, (a, b, s): &Entry) {

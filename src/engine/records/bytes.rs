@@ -83,7 +83,7 @@ pub fn encode(snapshot: &Snapshot, fingerprint: u64) -> Vec<u8> {
 
 /// The bytes a checkpoint of `snapshot` takes (a bound).
 fn encoded_size(s: &Snapshot) -> usize {
-    let records = s.particles.len() * (126 + 24)
+    let records = s.particles.len() * (8 + Particle::checkpoint_size(VERSION) + 24)
         + s.lonely.len() * 12
         + (s.pair_history.len() + s.face_history.len()) * 72;
     256 + records
@@ -120,16 +120,7 @@ fn encode_as(out: &mut Vec<u8>, snapshot: &Snapshot, fingerprint: u64, version: 
     out.extend_from_slice(&(p.len() as u64).to_le_bytes());
     for (k, q) in p.iter().enumerate() {
         put_id(out, p.id[k], wide);
-        put_f64s(
-            out,
-            &[
-                q.x.x, q.x.y, q.x.z, q.radius, q.v.x, q.v.y, q.v.z, q.q.w, q.q.x, q.q.y, q.q.z,
-                q.w.x, q.w.y, q.w.z,
-            ],
-        );
-        out.extend_from_slice(&q.tag.to_le_bytes());
-        out.extend_from_slice(&q.material.to_le_bytes());
-        out.push(q.fixed as u8);
+        q.put_checkpoint(out);
     }
     let built = snapshot.anchors.len() == p.len() && !p.is_empty();
     out.push(built as u8);
@@ -445,31 +436,13 @@ impl Cursor<'_> {
     /// lists were built.
     fn particles(&mut self, version: u32, next_id: Id) -> Result<(Particles, Vec<DVec3>)> {
         let r = self;
-        let (v3, v5) = (version >= 3, version >= 5);
-        let n = r.count(r.id_size() + 14 * 8 + 4 + 2 * v3 as usize + v5 as usize)?;
+        let size = Particle::checkpoint_size(version);
+        let n = r.count(r.id_size() + size)?;
         let mut particles = Particles::default();
         let mut ids = Vec::with_capacity(n);
         for _ in 0..n {
             ids.push(r.id()?);
-            let x = r.vec3()?;
-            let radius = r.f64()?;
-            let v = r.vec3()?;
-            let (w0, q1, q2, q3) = (r.f64()?, r.f64()?, r.f64()?, r.f64()?);
-            let w = r.vec3()?;
-            let tag = r.u32()?;
-            let material = if v3 { r.u16()? } else { 0 };
-            let fixed = v5 && r.u8()? != 0;
-            particles.push(Particle {
-                x,
-                radius,
-                v,
-                q: DQuat::from_xyzw(q1, q2, q3, w0),
-                w,
-                tag,
-                material,
-                fixed,
-                body: None,
-            });
+            particles.push(Particle::take_checkpoint(&mut r.take(size)?, version));
         }
         let anchors = match r.u8()? {
             0 => Vec::new(),

@@ -147,9 +147,7 @@ mod tests {
             q: DQuat::from_rotation_y(0.7),
             w: DVec3::new(1.0, 2.0, 3.0),
             tag: 7,
-            material: 0,
-            fixed: false,
-            body: None,
+            ..Default::default()
         });
         let s = Springs {
             u_s: DVec3::new(1e-5, 2e-6, 0.0),
