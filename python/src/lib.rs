@@ -7,10 +7,12 @@ use std::sync::Arc;
 
 use glam::{DQuat, DVec3};
 use numpy::ndarray::{Array1, Array2};
-use numpy::{AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArrayLike1, PyArrayLike2};
+use numpy::{
+    AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArrayLike1, PyArrayLike2, PyArrayLikeDyn,
+};
 use pyo3::exceptions::{
-    PyFileExistsError, PyFileNotFoundError, PyOSError, PyPermissionError, PyRuntimeError,
-    PyRuntimeWarning, PyValueError,
+    PyFileExistsError, PyFileNotFoundError, PyKeyError, PyOSError, PyPermissionError,
+    PyRuntimeError, PyRuntimeWarning, PyValueError,
 };
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -145,6 +147,22 @@ struct Simulation {
 }
 
 impl Simulation {
+    /// The number of components of the optional field `name`, if the particles hold it.
+    fn held(&self, name: &str) -> PyResult<usize> {
+        let active = self.sim.particles.active;
+        let held = active.fields();
+        match held.iter().find(|f| f.name == name) {
+            Some(f) => Ok(f.suffixes.len()),
+            None => Err(PyKeyError::new_err(format!(
+                "the particles hold no field '{name}' (they hold: {})",
+                match held.is_empty() {
+                    true => "none".to_string(),
+                    false => held.iter().map(|f| f.name).collect::<Vec<_>>().join(", "),
+                }
+            ))),
+        }
+    }
+
     /// Particle indices in id order.
     fn order(&self) -> Vec<usize> {
         self.sim.particles.id_order()
@@ -552,6 +570,68 @@ impl Simulation {
     fn tags<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
         let p = &self.sim.particles;
         Array1::from_iter(self.order().into_iter().map(|i| p.tag[i] as i64)).into_pyarray(py)
+    }
+
+    /// The names of the optional per-particle fields the particles hold (those a feature
+    /// of the scenario asked for, or a column of the particle file brought).
+    #[getter]
+    fn fields(&self) -> Vec<&'static str> {
+        let active = self.sim.particles.active;
+        active.fields().into_iter().map(|f| f.name).collect()
+    }
+
+    /// The optional per-particle field `name` (see `fields`) in id order: (N,) for a
+    /// scalar, (N, k) for k components.
+    fn field<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
+        let (p, k) = (&self.sim.particles, self.held(name)?);
+        let mut numbers = Vec::with_capacity(k * p.len());
+        self.order()
+            .into_iter()
+            .for_each(|i| p.numbers(name, i, &mut numbers));
+        Ok(match k {
+            1 => Array1::from_vec(numbers).into_pyarray(py).into_any(),
+            _ => Array2::from_shape_vec((numbers.len() / k, k), numbers)
+                .expect("k per particle")
+                .into_pyarray(py)
+                .into_any(),
+        })
+    }
+
+    /// Sets the optional per-particle field `name` (see `fields`) from `values`, in id
+    /// order: (N,) for a scalar, (N, k) for k components.
+    fn set_field(
+        &mut self,
+        name: &str,
+        values: PyArrayLikeDyn<'_, f64, AllowTypeChange>,
+    ) -> PyResult<()> {
+        let k = self.held(name)?;
+        let a = values.as_array();
+        let n = self.sim.particles.len();
+        let shape = a.shape().to_vec();
+        let fits = match k {
+            1 => shape == [n] || shape == [n, 1],
+            _ => shape == [n, k],
+        };
+        if !fits {
+            return Err(PyValueError::new_err(format!(
+                "{name}: expected an array of shape ({n}{}), found one of shape {shape:?}",
+                if k == 1 {
+                    String::new()
+                } else {
+                    format!(", {k}")
+                }
+            )));
+        }
+        let flat: Vec<f64> = a.iter().copied().collect();
+        for (row, i) in self.order().into_iter().enumerate() {
+            let value = &flat[row * k..(row + 1) * k];
+            if !self.sim.particles.set_numbers(name, i, value) {
+                return Err(PyValueError::new_err(format!(
+                    "{name}[{row}] = {value:?} is not a valid {name}"
+                )));
+            }
+        }
+        Ok(())
     }
 
     /// Material indices (into the scenario's [[materials]]), (N,), in id order.

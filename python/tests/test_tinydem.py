@@ -92,6 +92,16 @@ def test_arrays_are_numpy_in_id_order(study):
     assert np.all((sim.radii >= 0.002) & (sim.radii <= 0.01))
 
 
+def test_optional_fields_are_named_and_a_missing_one_is_a_key_error(study):
+    s, _ = study
+    sim = tinydem.Simulation(s)
+    assert sim.fields == []
+    with pytest.raises(KeyError, match="no field 'temperature'.*hold: none"):
+        sim.field("temperature")
+    with pytest.raises(KeyError):
+        sim.set_field("temperature", np.zeros(len(sim)))
+
+
 def test_velocities_can_be_set(study):
     s, _ = study
     sim = tinydem.Simulation(s)

@@ -157,7 +157,8 @@ impl<'a> Frames<'a> {
         };
         let list = self.dir.join(format!("particles{k:06}.pvtu"));
         let forces = sim.scenario.forces;
-        vtk::write_particle_list(&list, &pieces("particles", "vtu"), bodies, forces)?;
+        let (sources, active) = (pieces("particles", "vtu"), sim.particles.active);
+        vtk::write_particle_list(&list, &sources, (bodies, forces), active)?;
         self.collection("particles", k, "pvtu")?;
         if contacts.is_some() {
             let list = self.dir.join(format!("contacts{k:06}.pvtp"));

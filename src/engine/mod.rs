@@ -35,6 +35,8 @@ mod edit;
 pub use edit::{DEEPEST_ADDED, Overlap};
 mod faces;
 mod loads;
+#[cfg(test)]
+mod open_core_tests;
 mod pairs;
 pub mod records;
 mod regions;
@@ -602,6 +604,8 @@ impl Simulation {
         let t = self.stage_times.add(Stage::Bodies, t);
         let non_finite = advance::run(&self.model, (dt, g), &mut self.particles, &mut self.loads)
             | bodies_non_finite;
+        #[cfg(test)]
+        open_core_tests::walk(&mut self.particles, dt);
         let t = self.stage_times.add(Stage::Integrate, t);
         regions::tag(&self.scenario.tags, &mut self.particles);
         let t = self.stage_times.add(Stage::Tag, t);

@@ -149,10 +149,7 @@ impl Simulation {
         let (mut pairs, mut faces) = self.neighbours.entries_by_id(&p.id);
         let (anchors, _) = self.neighbours.anchors();
         let own_ids = self.own_ids().expect("a split run");
-        let mut own = Particles {
-            next_id: p.next_id,
-            ..Particles::default()
-        };
+        let mut own = p.empty_like();
         let mut own_anchors = Vec::with_capacity(own_ids.len());
         for k in (0..p.len()).filter(|&k| d.owned[k]) {
             own.insert(p.id[k], p.get(k));
@@ -535,7 +532,7 @@ pub(super) fn refresh_ghosts(d: &Domain, p: &mut Particles) {
         .enumerate()
         .filter(|(_, list)| !list.is_empty())
         .map(|(q, list)| {
-            let mut out = Vec::with_capacity(list.len() * Particles::GHOST_STATE);
+            let mut out = Vec::with_capacity(list.len() * p.ghost_state_size());
             list.iter()
                 .for_each(|&i| p.put_ghost_state(i as usize, &mut out));
             (q, out)
@@ -544,7 +541,7 @@ pub(super) fn refresh_ghosts(d: &Domain, p: &mut Particles) {
     // Only the processes that hold ghosts of ours, or ours of theirs, hear from us.
     let from: Vec<(usize, usize)> = (0..d.recv.len())
         .filter(|&q| !d.recv[q].is_empty())
-        .map(|q| (q, d.recv[q].len() * Particles::GHOST_STATE))
+        .map(|q| (q, d.recv[q].len() * p.ghost_state_size()))
         .collect();
     for (m, &(q, _)) in d.comm.exchange(messages, &from).iter().zip(&from) {
         let mut bytes = &m[..];

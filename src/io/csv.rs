@@ -11,7 +11,8 @@ use anyhow::{Context, Result, bail};
 use glam::{DQuat, DVec3};
 
 use crate::engine::records::{ContactRecord, Partner};
-use crate::model::particles::{Id, MAX_ID, Particle, Particles};
+use crate::model::fields::Optional;
+use crate::model::particles::{Id, MAX_ID, OPTIONAL, Particle, Particles};
 
 pub const COLUMNS: [&str; 14] = [
     "x", "y", "z", "R", "vx", "vy", "vz", "q0", "q1", "q2", "q3", "wx", "wy", "wz",
@@ -47,30 +48,44 @@ pub struct Extra<'a> {
     pub loads: Option<&'a crate::engine::records::Loads>,
 }
 
-/// Writes all particles as CSV text in id order, with the `extra` columns.
-pub fn write_particles(out: &mut impl Write, p: &Particles, extra: Extra) -> std::io::Result<()> {
-    let mut line = String::with_capacity(512);
-    out.write_all(COLUMNS.join(",").as_bytes())?;
+/// The header line of a frame of `p` with the `extra` columns; and whether it has the
+/// `fixed` and `clump` columns.
+fn header(p: &Particles, extra: &Extra) -> (String, bool, bool) {
+    let mut line = COLUMNS.join(",");
     if extra.tag {
-        out.write_all(b",tag")?;
+        line.push_str(",tag");
     }
     if extra.ids {
-        out.write_all(b",id,material")?;
+        line.push_str(",id,material");
     }
     let fixed = extra.fixed || p.fixed.contains(&true);
     if fixed {
-        out.write_all(b",fixed")?;
+        line.push_str(",fixed");
     }
     let clump = extra.clump || !p.bodies.is_empty();
     if clump {
-        out.write_all(b",clump")?;
+        line.push_str(",clump");
+    }
+    for f in p.active.fields() {
+        line.push_str(&format!(",{}", f.columns().join(",")));
     }
     if extra.loads.is_some() {
-        out.write_all(format!(",{}", FORCE_COLUMNS.join(",")).as_bytes())?;
+        line.push_str(&format!(",{}", FORCE_COLUMNS.join(",")));
     }
-    out.write_all(b"\n")?;
+    line.push('\n');
+    (line, fixed, clump)
+}
+
+/// Writes all particles as CSV text in id order, with the `extra` columns.
+pub fn write_particles(out: &mut impl Write, p: &Particles, extra: Extra) -> std::io::Result<()> {
+    let mut line = String::with_capacity(512);
+    let (header, fixed, clump) = header(p, &extra);
+    out.write_all(header.as_bytes())?;
+    let optional = p.active.fields();
+    let mut numbers = Vec::new();
     let mut buf = ryu::Buffer::new();
-    for (id, mut q) in p.iter_by_id() {
+    for i in p.id_order() {
+        let (id, mut q) = (p.id[i], p.get(i));
         // A rigid body: one row, by its first sphere, with the body's motion.
         let mut template = -1;
         if let Some(b) = q.body {
@@ -108,6 +123,14 @@ pub fn write_particles(out: &mut impl Write, p: &Particles, extra: Extra) -> std
         if clump {
             line.push(',');
             line.push_str(itoa::Buffer::new().format(template));
+        }
+        numbers.clear();
+        optional
+            .iter()
+            .for_each(|f| p.numbers(f.name, i, &mut numbers));
+        for value in &numbers {
+            line.push(',');
+            line.push_str(buf.format(*value));
         }
         if let Some(loads) = extra.loads {
             let (f, t) = loads.get(&id).copied().unwrap_or_default();
@@ -249,6 +272,10 @@ struct Header {
     int_column: [Option<usize>; 5],
     /// The quantity (of the 14) each column holds.
     quantity_of_column: Vec<usize>,
+    /// The optional particle fields the file holds, each with its columns.
+    optional: Vec<(&'static Optional, Vec<usize>)>,
+    /// Their columns, in that order.
+    optional_columns: Vec<usize>,
 }
 
 impl Header {
@@ -260,9 +287,30 @@ impl Header {
         // The optional whole-number columns: tag, id, material, fixed.
         let mut int_column = [None; 5];
         let mut passed = Vec::new();
+        let mut optional = Vec::new();
         for (col, name) in names.iter().enumerate() {
             if FORCE_COLUMNS.contains(name) {
                 passed.push(col);
+                continue;
+            }
+            if let Some(f) = OPTIONAL
+                .iter()
+                .find(|f| f.columns().iter().any(|c| c == name))
+            {
+                let at = optional.iter().position(|(g, _): &(&Optional, _)| g == &f);
+                let at = at.unwrap_or_else(|| {
+                    optional.push((f, vec![usize::MAX; f.suffixes.len()]));
+                    optional.len() - 1
+                });
+                let k = f
+                    .columns()
+                    .iter()
+                    .position(|c| c == name)
+                    .expect("its column");
+                if optional[at].1[k] != usize::MAX {
+                    bail!("{file}:1: column '{name}' appears twice");
+                }
+                optional[at].1[k] = col;
                 continue;
             }
             if let Some(k) = INT_COLUMNS.iter().position(|c| c == name) {
@@ -292,6 +340,16 @@ impl Header {
             );
         }
 
+        for (f, columns) in &optional {
+            if let Some(k) = columns.iter().position(|&c| c == usize::MAX) {
+                bail!(
+                    "{file}:1: column '{}' is missing: the field {} has the columns {}",
+                    f.columns()[k],
+                    f.name,
+                    f.columns().join(",")
+                );
+            }
+        }
         // Column of each of the 14 quantities, and which quantity each column holds.
         let mut quantity_of_column = vec![usize::MAX; names.len()];
         for (k, &col) in slot.iter().enumerate() {
@@ -302,23 +360,44 @@ impl Header {
             passed,
             int_column,
             quantity_of_column,
+            optional_columns: optional.iter().flat_map(|o| o.1.clone()).collect(),
+            optional,
         })
     }
 
     /// The values of row `line` (line `n` of `file`): the 14 quantities and the whole
     /// numbers.
-    fn row(&self, line: &str, n: usize, file: &str) -> Result<([f64; 14], [u64; 5])> {
+    /// The numbers of the optional fields go to `numbers`, in the order of `optional`.
+    fn row(
+        &self,
+        line: &str,
+        (n, file): (usize, &str),
+        numbers: &mut Vec<f64>,
+    ) -> Result<([f64; 14], [u64; 5])> {
         let (names, int_column, quantity_of_column) =
             (self.columns, &self.int_column, &self.quantity_of_column);
         let mut values = [0.0f64; 14];
         let mut count = 0;
         let mut ints = [0u64; 5];
+        let fields = &self.optional_columns;
+        numbers.clear();
+        numbers.resize(fields.len(), 0.0);
         for (col, text) in line.split(',').enumerate() {
             count += 1;
             if col >= names || self.passed.contains(&col) {
                 continue;
             }
             let text = text.trim();
+            if let Some(k) = fields.iter().position(|&c| c == col) {
+                numbers[k] = text.parse().map_err(|_| {
+                    anyhow::anyhow!(
+                        "{file}:{n}: column {} ('{}'): expected a number, found '{text}'",
+                        col + 1,
+                        self.name(col)
+                    )
+                })?;
+                continue;
+            }
             if let Some(k) = int_column.iter().position(|&c| c == Some(col)) {
                 let parsed = if k == 4 {
                     text.parse::<i64>()
@@ -358,6 +437,41 @@ impl Header {
             bail!("{file}:{n}: expected {names} values, found {count}");
         }
         Ok((values, ints))
+    }
+
+    /// The name of optional column `col`.
+    fn name(&self, col: usize) -> String {
+        let mut names = self.optional.iter().flat_map(|(f, cols)| {
+            let names = f.columns();
+            cols.iter()
+                .zip(names)
+                .map(|(&c, name)| (c, name))
+                .collect::<Vec<_>>()
+        });
+        names
+            .find(|&(c, _)| c == col)
+            .map(|(_, name)| name)
+            .unwrap_or_default()
+    }
+
+    /// Sets the optional fields of the particle stored last in `particles` to the row's
+    /// `numbers`.
+    fn set_optional(
+        &self,
+        particles: &mut Particles,
+        numbers: &[f64],
+        (n, file): (usize, &str),
+    ) -> Result<()> {
+        let (last, mut at) = (particles.len() - 1, 0);
+        for (f, cols) in &self.optional {
+            let values = &numbers[at..at + cols.len()];
+            if !particles.set_numbers(f.name, last, values) {
+                let names = f.columns().join(",");
+                bail!("{file}:{n}: {names}: {values:?} is not a valid {}", f.name);
+            }
+            at += cols.len();
+        }
+        Ok(())
     }
 }
 
@@ -556,6 +670,10 @@ fn read_grains(
     }
     let columns = Header::parse(&header, file)?;
     let mut particles = Particles::default();
+    for (f, _) in &columns.optional {
+        particles.activate(f.name);
+    }
+    let mut numbers = Vec::new();
     let mut ids = Vec::new();
     let mut clumps = Vec::new();
     let mut reader = lines;
@@ -573,12 +691,13 @@ fn read_grains(
         if line.is_empty() {
             continue;
         }
-        let (values, ints) = columns.row(line, n, file)?;
+        let (values, ints) = columns.row(line, (n, file), &mut numbers)?;
         let p = particle(values, ints, n, file)?;
         if let Some(limits) = limits {
             limits.check(&p, n, file)?;
         }
         particles.push(p);
+        columns.set_optional(&mut particles, &numbers, (n, file))?;
         if columns.int_column[1].is_some() {
             ids.push(ints[1]);
         }
@@ -695,9 +814,7 @@ mod tests {
             q: DQuat::from_rotation_x(0.3),
             w: DVec3::new(1.0, 2.0, 3.0),
             tag: 42,
-            material: 0,
-            fixed: false,
-            body: None,
+            ..Default::default()
         }]
         .into_iter()
         .collect();
@@ -721,13 +838,8 @@ mod tests {
             .map(|k| Particle {
                 x: DVec3::new(k as f64, 0.0, 0.0),
                 radius: 0.004,
-                v: DVec3::ZERO,
-                q: DQuat::IDENTITY,
-                w: DVec3::ZERO,
-                tag: 0,
                 material: k as u16,
-                fixed: false,
-                body: None,
+                ..Default::default()
             })
             .collect();
         // Ids with gaps (particles 1, 4 and 6 removed), stored out of id order.

@@ -9,7 +9,7 @@ use anyhow::{Result, bail};
 
 use crate::engine::records::ContactRecord;
 use crate::io::csv::{ClumpColumn, load_contacts, load_grains};
-use crate::model::particles::{Id, Particle, Particles};
+use crate::model::particles::{Active, Id, Particle, Particles};
 
 /// The number of the frame a file of an output directory names: `particlesNNNNNN.csv`, or
 /// the first piece `particlesNNNNNN_0.csv` of a frame written in pieces (the other pieces
@@ -136,10 +136,11 @@ pub fn load_frame(path: &Path) -> Result<(Particles, Option<ClumpColumn>)> {
         return load_grains(path);
     };
     let mut rows: Vec<(Id, Particle, Option<u16>)> = Vec::new();
-    let mut clumps = false;
+    let (mut clumps, mut active) = (false, Active::default());
     for piece in pieces? {
         let (p, c) = load_grains(&piece)?;
         clumps |= c.is_some();
+        active = p.active; // (every piece has the same columns)
         let template = |i: usize| c.as_ref().and_then(|c| c.templates[i]);
         rows.extend((0..p.len()).map(|i| (p.id[i], p.get(i), template(i))));
     }
@@ -150,6 +151,7 @@ pub fn load_frame(path: &Path) -> Result<(Particles, Option<ClumpColumn>)> {
     }
     let mut particles = Particles {
         next_id: rows.last().map_or(0, |r| r.0 + 1),
+        active,
         ..Particles::default()
     };
     let mut templates = Vec::with_capacity(rows.len());

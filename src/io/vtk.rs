@@ -14,7 +14,7 @@ use anyhow::{Context, Result};
 
 use crate::engine::records::{ContactRecord, Loads, Partner};
 use crate::geometry::mesh::{Mesh, Primitive};
-use crate::model::particles::{Id, Particles};
+use crate::model::particles::{Active, Id, Particles};
 
 /// Where an array goes in the file.
 #[derive(Clone, Copy, PartialEq)]
@@ -273,20 +273,21 @@ pub fn write_particle_piece(
 }
 
 /// Writes the `.pvtu` file that makes the pieces `sources` (of [`write_particle_piece`])
-/// one data set for ParaView; `forces`: they hold `force` and `torque`.
+/// one data set for ParaView; `forces`: they hold `force` and `torque`; `active`: the
+/// optional fields they hold.
 pub fn write_particle_list(
     path: &Path,
     sources: &[String],
-    bodies: bool,
-    forces: bool,
+    (bodies, forces): (bool, bool),
+    active: Active,
 ) -> Result<()> {
     let none = Loads::default();
     let loads = forces.then_some(&none);
-    particles_vtu(&Particles::default(), bodies, loads).write_list(
-        path,
-        "PUnstructuredGrid",
-        sources,
-    )
+    let p = Particles {
+        active,
+        ..Particles::default()
+    };
+    particles_vtu(&p, bodies, loads).write_list(path, "PUnstructuredGrid", sources)
 }
 
 /// The particles' file, in id order; with the `body` array if `bodies`, and `force` and
@@ -328,6 +329,12 @@ fn particles_vtu(p: &Particles, bodies: bool, loads: Option<&Loads>) -> Vtu {
         let load = |i: usize| loads.get(&p.id[i]).copied().unwrap_or_default();
         v.vectors(PointData, "force", n, by_id().map(|i| load(i).0));
         v.vectors(PointData, "torque", n, by_id().map(|i| load(i).1));
+    }
+    for f in p.active.fields() {
+        let k = f.suffixes.len();
+        let mut numbers = Vec::with_capacity(k * n);
+        by_id().for_each(|i| p.numbers(f.name, i, &mut numbers));
+        v.array(PointData, f.name, k, k * n, numbers.into_iter());
     }
     v.vectors(Points, "points", n, by_id().map(|i| p.x[i]));
     v.array(Cells, "connectivity", 1, n, 0..n as i64);

@@ -4,6 +4,7 @@ pub mod bodies;
 pub mod clump;
 pub mod contact;
 pub mod exact;
+pub mod fields;
 pub mod id;
 pub mod integrate;
 pub mod lanes;

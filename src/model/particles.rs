@@ -8,113 +8,16 @@
 use glam::{DQuat, DVec3};
 
 use crate::model::bodies::{Bodies, Body, BodyId};
-use crate::model::value::Value;
+use crate::model::fields::{Value, particle_fields};
 
 pub use crate::model::id::{Id, MAX_ID};
 
-/// The per-particle fields, declared once: from this table follow the storage
-/// ([`Particles`], a vector per field), the one-particle record ([`Particle`]), `insert`,
-/// `get` and `permute`, the records of the split run's messages (every field), the state
-/// sent to ghosts each step (the fields marked `ghost`) and the checkpoint record (the
-/// fields with a `checkpoint` format, from that format on, in the table's order).
-///
-/// A row: its doc (meaning and unit), `name: type`, then `ghost: bool` and
-/// `checkpoint: Option<format>`. The type is a [`Value`] (its bytes); its `Default` is the
-/// value of a particle that does not say (and of a checkpoint older than the field).
-macro_rules! particle_fields {
-    ($(
-        $(#[doc = $doc:literal])*
-        $name:ident: $ty:ty, ghost: $ghost:literal, checkpoint: $since:expr;
-    )*) => {
-        /// The state of every particle.
-        #[derive(Clone, Debug, Default, PartialEq)]
-        pub struct Particles {
-            /// The id of the particle stored at each index.
-            pub id: Vec<Id>,
-            /// The id the next particle created gets.
-            pub next_id: Id,
-            $($(#[doc = $doc])* pub $name: Vec<$ty>,)*
-            /// The rigid bodies (clumps) of several particles.
-            pub bodies: Bodies,
-        }
-
-        /// One particle's state: a row of [`Particles`].
-        #[derive(Clone, Copy, Debug, Default, PartialEq)]
-        pub struct Particle {
-            $($(#[doc = $doc])* pub $name: $ty,)*
-        }
-
-        impl Particles {
-            /// Adds a particle that has its id already (one made elsewhere: by another
-            /// process of a split run); `next_id` stays.
-            pub fn insert(&mut self, id: Id, p: Particle) {
-                self.id.push(id);
-                $(self.$name.push(p.$name);)*
-            }
-
-            /// The particle stored at `i`.
-            pub fn get(&self, i: usize) -> Particle {
-                Particle { $($name: self.$name[i],)* }
-            }
-
-            /// Puts the fields of the particle stored at `order[k]` at index `k`.
-            fn gather_fields(&mut self, order: &[u32]) {
-                gather(&mut self.id, order);
-                $(gather(&mut self.$name, order);)*
-            }
-
-            /// The bytes of the state sent to a particle's ghosts each step.
-            pub const GHOST_STATE: usize = 0 $(+ if $ghost { <$ty as Value>::SIZE } else { 0 })*;
-
-            /// Appends the state sent to the ghosts of the particle stored at `i`.
-            pub fn put_ghost_state(&self, i: usize, out: &mut Vec<u8>) {
-                $(if $ghost { self.$name[i].put(out); })*
-            }
-
-            /// Sets the ghost stored at `i` to the state `bytes` begin with.
-            pub fn take_ghost_state(&mut self, i: usize, bytes: &mut &[u8]) {
-                $(if $ghost { self.$name[i] = Value::take(bytes); })*
-            }
-        }
-
-        impl Particle {
-            /// The bytes of a particle in a message.
-            pub const SIZE: usize = 0 $(+ <$ty as Value>::SIZE)*;
-
-            /// Appends the particle's bytes in a message: every field.
-            pub fn put(&self, out: &mut Vec<u8>) {
-                $(self.$name.put(out);)*
-            }
-
-            /// The particle whose message `bytes` begin with.
-            pub fn take(bytes: &mut &[u8]) -> Particle {
-                Particle { $($name: Value::take(bytes),)* }
-            }
-
-            /// The bytes of a particle's record in a checkpoint of format `version`.
-            pub fn checkpoint_size(version: u32) -> usize {
-                0 $(+ match $since { Some(since) if version >= since => <$ty as Value>::SIZE, _ => 0 })*
-            }
-
-            /// Appends the particle's record in a checkpoint of the newest format.
-            pub fn put_checkpoint(&self, out: &mut Vec<u8>) {
-                $(if $since.is_some() { self.$name.put(out); })*
-            }
-
-            /// The particle whose record in a checkpoint of format `version` `bytes` begin
-            /// with (fields newer than the format at their defaults).
-            pub fn take_checkpoint(bytes: &mut &[u8], version: u32) -> Particle {
-                let mut p = Particle::default();
-                $(if matches!($since, Some(since) if version >= since) {
-                    p.$name = Value::take(bytes);
-                })*
-                p
-            }
-        }
-    };
-}
-
+// The per-particle fields, declared once (the machinery: `model/fields.rs`). A row: its doc
+// (meaning and unit) and `name: type`; a core field then says whether ghosts receive it each
+// step and from which checkpoint format on the record holds it; an optional field (held
+// only when a run asks for it) whether ghosts receive it and its unit.
 particle_fields! {
+    core {
     /// x \[L\]
     x: DVec3, ghost: true, checkpoint: Some(2);
     /// R \[L\]
@@ -137,6 +40,12 @@ particle_fields! {
     /// The rigid body (clump) each particle is a sphere of, if any: its state is the
     /// body's, which `bodies` holds (and checkpoints hold apart).
     body: Option<BodyId>, ghost: false, checkpoint: None::<u32>;
+    }
+    optional {
+    #[cfg(test)]
+    /// A number the tests carry through messages, checkpoints and frames.
+    probe: f64, ghost: true, unit: "-";
+    }
 }
 
 fn gather<T: Copy + Send + Sync>(v: &mut Vec<T>, order: &[u32]) {

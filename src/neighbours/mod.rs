@@ -467,13 +467,7 @@ mod tests {
             .map(|(&x, &radius)| crate::model::particles::Particle {
                 x,
                 radius,
-                v: DVec3::ZERO,
-                q: glam::DQuat::IDENTITY,
-                w: DVec3::ZERO,
-                tag: 0,
-                material: 0,
-                fixed: false,
-                body: None,
+                ..Default::default()
             })
             .collect()
     }

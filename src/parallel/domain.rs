@@ -39,7 +39,7 @@ use anyhow::{Result, bail};
 use glam::DVec3;
 
 use crate::model::bodies::{Body, BodyId};
-use crate::model::particles::{Id, Particle, Particles};
+use crate::model::particles::{Active, Id, Particle, Particles};
 use crate::model::springs::Springs;
 use crate::neighbours::Entry;
 use crate::parallel::comm::{Comm, Reach, Reader, Writer};
@@ -311,10 +311,11 @@ impl Domain {
     }
 }
 
-/// A particle's record in a message: its id, then its fields ([`Particle::put`]).
-pub(crate) fn put_particle(w: &mut Writer, id: Id, p: &Particle) {
+/// A particle's record in a message between processes that hold the optional fields
+/// `active`: its id, then its fields ([`Particle::put`]).
+pub(crate) fn put_particle(w: &mut Writer, active: &Active, id: Id, p: &Particle) {
     w.u64(id);
-    p.put(&mut w.0);
+    p.put(active, &mut w.0);
 }
 
 /// A rigid body's record in a message (beside its spheres, which name it).
@@ -349,9 +350,12 @@ pub(crate) fn get_body(r: &mut Reader) -> Body {
     }
 }
 
-pub(crate) fn get_particle(r: &mut Reader) -> (Id, Particle) {
+pub(crate) fn get_particle(r: &mut Reader, active: &Active) -> (Id, Particle) {
     let id = r.u64();
-    (id, Particle::take(&mut r.record(Particle::SIZE)))
+    (
+        id,
+        Particle::take(active, &mut r.record(Particle::size(active))),
+    )
 }
 
 pub(crate) fn put_entry(w: &mut Writer, (a, b, s): &Entry) {
@@ -386,7 +390,7 @@ pub(crate) fn gather_by_id(
     let picked: Vec<usize> = (0..p.len()).filter(|&i| pick(i)).collect();
     w.u64(picked.len() as u64);
     for &i in &picked {
-        put_particle(&mut w, p.id[i], &p.get(i));
+        put_particle(&mut w, &p.active, p.id[i], &p.get(i));
     }
     // The bodies of the spheres picked (all of a body's spheres, if any).
     let bodies: Vec<usize> = p.bodies_where(&pick).collect();
@@ -399,17 +403,14 @@ pub(crate) fn gather_by_id(
     for m in comm.gather_to(reach, w.0) {
         let mut r = Reader::new(&m);
         for _ in 0..r.u64() {
-            all.push(get_particle(&mut r));
+            all.push(get_particle(&mut r, &p.active));
         }
         for _ in 0..r.u64() {
             all_bodies.push(get_body(&mut r));
         }
     }
     all.sort_unstable_by_key(|e| e.0);
-    let mut out = Particles {
-        next_id: p.next_id,
-        ..Particles::default()
-    };
+    let mut out = p.empty_like();
     for (id, particle) in all {
         out.insert(id, particle);
     }

@@ -422,19 +422,12 @@ pub fn mean_height_of_large(p: &Particles, r: f64) -> Option<f64> {
 mod tests {
     use super::*;
     use crate::model::particles::Particle;
-    use glam::DQuat;
 
     fn at(x: f64, z: f64, r: f64) -> Particle {
         Particle {
             x: DVec3::new(x, 0.0, z),
             radius: r,
-            v: DVec3::ZERO,
-            q: DQuat::IDENTITY,
-            w: DVec3::ZERO,
-            tag: 0,
-            material: 0,
-            fixed: false,
-            body: None,
+            ..Default::default()
         }
     }
 

@@ -17,7 +17,11 @@
 //! format 6 the rigid bodies (clumps): count (u64) and per body the id of its first sphere
 //! (u64; its spheres are the particles of the next ids), template (u16), scale, x, v,
 //! q0..q3, w, mass, principal moments, bounding radius (19 f64) and its spheres' offsets
-//! (count u32, 3 f64 each); last a CRC-32 of everything before it.
+//! (count u32, 3 f64 each); from format 8 (written when the particles hold optional fields,
+//! `model/fields.rs`; without them, format 7) the optional fields: count (u32) and per field
+//! its name (length u8, bytes) and its values in storage order; last a CRC-32 of everything
+//! before it. A particle's record is the table's (`model/particles.rs`, the core fields with
+//! a checkpoint format, from that format on, in the table's order).
 //!
 //! The storage order and the positions of the last rebuild let a resumed run rebuild the
 //! very lists the interrupted one had; its results depend on them (the order in which
@@ -29,13 +33,16 @@ use glam::{DQuat, DVec3};
 use super::{Outflow, Removed, Snapshot, Wrench};
 use crate::engine::spawn::{RegionState, SpawnerState};
 use crate::model::bodies::{Body, BodyId};
-use crate::model::particles::{Id, Particle, Particles};
+use crate::model::particles::{Id, OPTIONAL, Particle, Particles};
 use crate::model::servo::State;
 use crate::model::springs::Springs;
 use crate::neighbours::Entry;
 
 const MAGIC: &[u8; 12] = b"TINYDEM CKPT";
-const VERSION: u32 = 7;
+const VERSION: u32 = 8;
+/// The format of a checkpoint without optional particle fields: 7, whose bytes format 8
+/// adds the section of the optional fields to.
+const WITHOUT_OPTIONAL: u32 = 7;
 /// The oldest version this program reads.
 const OLDEST: u32 = 2;
 
@@ -98,7 +105,9 @@ fn encoded_size(s: &Snapshot) -> usize {
 
 /// Appends the checkpoint of `snapshot` to `out` (its checksum covers what it appends).
 pub fn encode_into(out: &mut Vec<u8>, snapshot: &Snapshot, fingerprint: u64) {
-    encode_as(out, snapshot, fingerprint, VERSION);
+    let optional = !snapshot.particles.active.fields().is_empty();
+    let version = if optional { VERSION } else { WITHOUT_OPTIONAL };
+    encode_as(out, snapshot, fingerprint, version);
 }
 
 /// The checkpoint of `snapshot` in format `version`: the newest, or 6 (ids of 4 bytes;
@@ -171,8 +180,23 @@ fn encode_as(out: &mut Vec<u8>, snapshot: &Snapshot, fingerprint: u64, version: 
         put_f64s(out, &[s.position, s.speed, s.built, s.load]);
     }
     put_bodies(out, &p.bodies.list, wide);
+    if version >= 8 {
+        put_optional(out, p);
+    }
     let crc = crc32fast::hash(&out[start..]);
     out.extend_from_slice(&crc.to_le_bytes());
+}
+
+/// The optional fields the particles hold: their count (u32), and per field its name
+/// (length u8, bytes) and its values in storage order.
+fn put_optional(out: &mut Vec<u8>, p: &Particles) {
+    let fields = p.active.fields();
+    out.extend_from_slice(&(fields.len() as u32).to_le_bytes());
+    for f in fields {
+        out.push(f.name.len() as u8);
+        out.extend_from_slice(f.name.as_bytes());
+        p.put_field(f.name, out);
+    }
 }
 
 fn put_bodies(out: &mut Vec<u8>, bodies: &[Body], wide: bool) {
@@ -359,6 +383,9 @@ pub fn decode(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<Snapsho
         let bodies = r.bodies()?;
         join_bodies(&mut particles, bodies)?;
     }
+    if version >= 8 {
+        r.optional(&mut particles)?;
+    }
     if r.at != r.bytes.len() {
         bail!(
             "corrupt checkpoint: {} unexpected bytes at the end",
@@ -456,6 +483,27 @@ impl Cursor<'_> {
         }
         (particles.id, particles.next_id) = (ids, next_id);
         Ok((particles, anchors))
+    }
+
+    /// The optional fields of `particles` (format 8): each known to this program, once,
+    /// with a value for every particle.
+    fn optional(&mut self, particles: &mut Particles) -> Result<()> {
+        let r = self;
+        for _ in 0..r.u32()? {
+            let length = r.u8()? as usize;
+            let name = String::from_utf8_lossy(r.take(length)?).into_owned();
+            let Some(field) = OPTIONAL.iter().find(|f| f.name == name) else {
+                bail!(
+                    "the checkpoint holds the particle field '{name}', which this tinydem does not know"
+                );
+            };
+            if particles.active.fields().contains(&field) {
+                bail!("corrupt checkpoint: the particle field '{name}' twice");
+            }
+            let bytes = r.take(field.size * particles.len())?;
+            particles.take_field(&name, &mut &bytes[..]);
+        }
+        Ok(())
     }
 
     /// The rigid bodies (format 6), finite, ascending by id.

@@ -5,17 +5,14 @@ use anyhow::{Result, bail, ensure};
 use glam::DVec3;
 
 use super::Snapshot;
-use crate::model::particles::{Id, Particle, Particles};
+use crate::model::particles::{Id, Particle};
 use crate::neighbours::Entry;
 
 /// The state all pieces of a snapshot share: `piece` without its particles, anchors and
 /// springs (the piece of a process that holds none).
 pub fn shared_part(piece: &Snapshot) -> Snapshot {
     Snapshot {
-        particles: Particles {
-            next_id: piece.particles.next_id,
-            ..Particles::default()
-        },
+        particles: piece.particles.empty_like(),
         anchors: Vec::new(),
         lonely: Vec::new(),
         pair_history: Vec::new(),
@@ -63,10 +60,7 @@ pub fn join(pieces: Vec<Snapshot>) -> Result<Snapshot> {
     if let Some(w) = all.windows(2).find(|w| w[0].0 == w[1].0) {
         bail!("corrupt: particle {} is in two parts", w[0].0);
     }
-    let mut particles = Particles {
-        next_id: first.particles.next_id,
-        ..Particles::default()
-    };
+    let mut particles = first.particles.empty_like();
     let mut anchors = Vec::with_capacity(all.len());
     for (id, particle, anchor) in all {
         particles.insert(id, particle);

@@ -59,10 +59,7 @@ pub(super) fn migrate(
             false => to.message(q, &p, carry.then_some(&*place), &entries),
         })
         .collect();
-    let mut held = Particles {
-        next_id: p.next_id,
-        ..Particles::default()
-    };
+    let mut held = p.empty_like();
     let mut held_at = carry.then(Vec::new);
     for &i in &to.particles[me] {
         held.insert(p.id[i as usize], p.get(i as usize));
@@ -210,7 +207,7 @@ impl Destinations {
         let mut w = Writer::default();
         w.u64(self.particles[q].len() as u64);
         for &i in &self.particles[q] {
-            put_particle(&mut w, p.id[i as usize], &p.get(i as usize));
+            put_particle(&mut w, &p.active, p.id[i as usize], &p.get(i as usize));
             if let Some(place) = place {
                 w.vec3(place[i as usize]);
             }
@@ -240,7 +237,7 @@ fn receive(
     (pairs, faces): &mut Entries,
 ) {
     for _ in 0..r.u64() {
-        let (id, particle) = get_particle(r);
+        let (id, particle) = get_particle(r, &held.active);
         held.insert(id, particle);
         if let Some(at) = held_at.as_mut() {
             at.push(r.vec3());
@@ -275,7 +272,12 @@ pub(super) fn exchange_ghosts(
             let mut w = Writer::default();
             w.u64(ghosts_to[q].len() as u64);
             for &i in &ghosts_to[q] {
-                put_particle(&mut w, held.id[i as usize], &held.get(i as usize));
+                put_particle(
+                    &mut w,
+                    &held.active,
+                    held.id[i as usize],
+                    &held.get(i as usize),
+                );
                 if let Some(at) = held_at.as_ref() {
                     w.vec3(at[i as usize]);
                 }
@@ -295,7 +297,7 @@ pub(super) fn exchange_ghosts(
     for (q, m) in d.comm.all_to_all(messages).into_iter().enumerate() {
         let mut r = Reader::new(&m);
         for _ in 0..r.u64() {
-            let (id, particle) = get_particle(&mut r);
+            let (id, particle) = get_particle(&mut r, &held.active);
             held.insert(id, particle);
             if let Some(at) = held_at.as_mut() {
                 at.push(r.vec3());

@@ -49,12 +49,7 @@ fn particle(x: DVec3, v: DVec3, radius: f64) -> Particle {
         x,
         radius,
         v,
-        q: glam::DQuat::IDENTITY,
-        w: DVec3::ZERO,
-        tag: 0,
-        material: 0,
-        fixed: false,
-        body: None,
+        ..Default::default()
     }
 }
 

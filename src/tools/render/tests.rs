@@ -2,7 +2,6 @@
 
 use super::*;
 use crate::model::particles::Particle;
-use glam::DQuat;
 
 #[test]
 fn a_sphere_is_drawn_in_the_middle() {
@@ -33,12 +32,7 @@ fn one(x: DVec3, v: DVec3) -> Particles {
         x,
         radius: 1.0,
         v,
-        q: DQuat::IDENTITY,
-        w: DVec3::ZERO,
-        tag: 0,
-        material: 0,
-        fixed: false,
-        body: None,
+        ..Default::default()
     }]
     .into_iter()
     .collect()
