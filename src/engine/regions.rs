@@ -3,6 +3,18 @@
 
 use super::*;
 
+/// A grain removed: a particle, or a rigid body by its first sphere.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Gone {
+    pub first: Id,
+    /// The outlet (an index of `[[outlets]]`), or the domain (past them).
+    pub fate: u32,
+    /// \[M\]
+    pub mass: f64,
+    /// The ids it had: `first..first + ids`.
+    pub ids: u64,
+}
+
 impl Simulation {
     /// Stage 7: particles whose centre has entered an outlet or left the domain are
     /// removed (counted, with their mass, by the outlet or the domain: the first outlet
@@ -28,51 +40,77 @@ impl Simulation {
             }
             outside(x).then_some(outlets.len() as u32)
         };
-        if self.domain.is_some() {
-            return self.remove_split(fate);
+        let (mine, gone) = self.leaving(fate);
+        if gone.is_empty() {
+            return;
         }
+        // Counted in id order (over all processes), so the masses sum in an order of their
+        // own.
+        for g in &gone {
+            let out = match self.removed.outlets.get_mut(g.fate as usize) {
+                Some(o) => o,
+                None => &mut self.removed.domain,
+            };
+            out.count += 1;
+            out.mass += g.mass;
+        }
+        match &self.domain {
+            None => self.drop_stored(&mine),
+            Some(_) => {
+                let ids = gone.iter().flat_map(|g| g.first..g.first + g.ids);
+                self.redistribute(&ids.collect(), crate::parallel::domain::Placement::Now);
+            }
+        }
+    }
+
+    /// What leaves through `fate` (an outlet's index, or that of the domain past them):
+    /// the storage indices of the own particles that go (a rigid body whole, where its
+    /// centre of mass goes); and, over all processes (collective) in id order, each grain
+    /// gone (a sphere, or a body by its first sphere).
+    fn leaving(&self, fate: impl Fn(DVec3) -> Option<u32> + Sync) -> (Vec<u32>, Vec<Gone>) {
         let p = &self.particles;
-        // A rigid body goes whole, where its centre of mass goes.
+        let own = |i: usize| self.domain.as_ref().is_none_or(|d| d.owned[i]);
         let centre = |i: usize| match p.body[i] {
             Some(b) => p.bodies.list[p.bodies.index_of(b).expect("a listed body")].x,
             None => p.x[i],
         };
-        let gone: Vec<(u32, u32)> = (0..p.len())
+        let mine: Vec<u32> = (0..p.len())
             .into_par_iter()
             .with_min_len(4 * MIN_PARALLEL_LEN)
-            .filter_map(|i| fate(centre(i)).map(|f| (i as u32, f)))
+            .filter(|&i| own(i) && fate(centre(i)).is_some())
+            .map(|i| i as u32)
             .collect();
-        if gone.is_empty() {
-            return;
-        }
-        // Counted in id order, so the masses sum in an order of their own.
-        let mut by_id: Vec<(Id, u32, u32)> = gone
-            .iter()
-            .map(|&(i, f)| (p.id[i as usize], i, f))
-            .collect();
-        by_id.sort_unstable();
         let densities = &self.model.densities;
-        for &(id, i, f) in &by_id {
-            let out = match self.removed.outlets.get_mut(f as usize) {
-                Some(o) => o,
-                None => &mut self.removed.domain,
-            };
-            let mass = match p.body[i as usize] {
+        let mut gone: Vec<Gone> = Vec::new();
+        for &i in &mine {
+            let i = i as usize;
+            let grain = match p.body[i] {
                 // A body counts once, by its first sphere, with its mass.
-                Some(b) if id != b.first() => continue,
-                Some(b) => p.bodies.mass_of(b),
+                Some(b) if p.id[i] != b.first() => continue,
+                Some(b) => {
+                    let body = &p.bodies.list[p.bodies.index_of(b).expect("a listed body")];
+                    (body.mass, body.offsets.len() as u64)
+                }
                 None => {
-                    let material = densities[p.material[i as usize] as usize];
-                    Inertia::mass_with(p.radius[i as usize], material.mass_per_r3)
+                    let density = densities[p.material[i] as usize];
+                    (Inertia::mass_with(p.radius[i], density.mass_per_r3), 1)
                 }
             };
-            out.count += 1;
-            out.mass += mass;
+            let (mass, ids) = grain;
+            let fate = fate(centre(i)).expect("it leaves");
+            gone.push(Gone {
+                first: p.id[i],
+                fate,
+                mass,
+                ids,
+            });
         }
-        let gone: Vec<u32> = gone.into_iter().map(|(i, _)| i).collect();
-        self.drop_stored(&gone);
+        if let Some(d) = &self.domain {
+            gone = split::all_gone(d, &gone);
+        }
+        gone.sort_unstable_by_key(|g| g.first);
+        (mine, gone)
     }
-
     /// Whether frames name each particle's id and material: particles can be removed (or
     /// were, in an earlier stage), so the line of a particle is not its id, or there are
     /// several materials.

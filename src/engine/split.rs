@@ -4,6 +4,7 @@
 //! removal over all processes, and the gathers of particles, contacts and snapshots.
 
 use super::*;
+use crate::engine::regions::Gone;
 use crate::model::bodies::Body as RigidBody;
 use crate::neighbours::{Entries, Periodic};
 use crate::parallel::comm::{Comm, Reach, Reader, Writer};
@@ -439,56 +440,6 @@ impl Simulation {
         self.particles.locate_bodies();
     }
 
-    /// Stage 7 of a split run (collective): the own particles that left, counted over all
-    /// processes in id order; then every process rebuilds without them.
-    pub(crate) fn remove_split(&mut self, fate: impl Fn(DVec3) -> Option<u32>) {
-        let d = self.domain.as_ref().expect("a split run");
-        let p = &self.particles;
-        let mut w = Writer::default();
-        for i in (0..p.len()).filter(|&i| d.owned[i] && p.body[i].is_none()) {
-            if let Some(f) = fate(p.x[i]) {
-                let density = self.model.densities[p.material[i] as usize];
-                w.u64(p.id[i]);
-                w.u32(f);
-                w.f64(Inertia::mass_with(p.radius[i], density.mass_per_r3));
-                w.u64(1);
-            }
-        }
-        // A rigid body goes whole, where its centre of mass goes (as in one process).
-        for b in p.bodies_where(|i| d.owned[i]) {
-            let b = &p.bodies.list[b];
-            if let Some(f) = fate(b.x) {
-                w.u64(b.id.first());
-                w.u32(f);
-                w.f64(b.mass);
-                w.u64(b.offsets.len() as u64);
-            }
-        }
-        // (first id, fate, mass, count of ids)
-        let mut gone: Vec<(Id, u32, f64, u64)> = Vec::new();
-        for m in d.comm.all_gather(w.0) {
-            let mut r = Reader::new(&m);
-            while !r.done() {
-                gone.push((r.u64(), r.u32(), r.f64(), r.u64()));
-            }
-        }
-        if gone.is_empty() {
-            return;
-        }
-        // Counted in id order, as in one process.
-        gone.sort_unstable_by_key(|g| g.0);
-        for &(_, f, mass, _) in &gone {
-            let out: &mut Outflow = match self.removed.outlets.get_mut(f as usize) {
-                Some(o) => o,
-                None => &mut self.removed.domain,
-            };
-            out.count += 1;
-            out.mass += mass;
-        }
-        let ids: FxHashSet<Id> = gone.iter().flat_map(|g| g.0..g.0 + g.3).collect();
-        self.redistribute(&ids, Placement::Now);
-    }
-
     /// The wall loads of this step over all processes (collective): exact sums, merged.
     pub(crate) fn reduce_walls(&self, step: &mut [Sum6]) {
         let Some(d) = &self.domain else { return };
@@ -549,4 +500,29 @@ pub(super) fn refresh_ghosts(d: &Domain, p: &mut Particles) {
             .iter()
             .for_each(|&i| p.take_ghost_state(i as usize, &mut bytes));
     }
+}
+
+/// The grains `gone` of every process (collective), in the order of the ranks.
+pub(super) fn all_gone(d: &Domain, gone: &[Gone]) -> Vec<Gone> {
+    let mut w = Writer::default();
+    for g in gone {
+        w.u64(g.first);
+        w.u32(g.fate);
+        w.f64(g.mass);
+        w.u64(g.ids);
+    }
+    let mut all = Vec::new();
+    for m in d.comm.all_gather(w.0) {
+        let mut r = Reader::new(&m);
+        while !r.done() {
+            let (first, fate, mass, ids) = (r.u64(), r.u32(), r.f64(), r.u64());
+            all.push(Gone {
+                first,
+                fate,
+                mass,
+                ids,
+            });
+        }
+    }
+    all
 }
