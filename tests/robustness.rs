@@ -353,7 +353,7 @@ fn forged_checkpoints_are_refused_by_their_content() {
     } else {
         &mut snapshot.pair_history
     };
-    history.first_mut().expect("a contact").2.u_t = f64::INFINITY;
+    history.first_mut().expect("a contact").2.springs.u_t = f64::INFINITY;
     std::fs::write(
         t.path().join("springs.bin"),
         checkpoint::encode(&snapshot, fingerprint),

@@ -255,15 +255,16 @@ impl FaceStage<'_> {
                 for (c, fate) in near[a..b].iter().zip(fates.iter()) {
                     let Fate::Absorbed(s) = *fate else { continue };
                     let (k, s) = (c.slot, near[a + s].slot);
-                    let none =
-                        |e: u32| e == NONE || store.springs[e as usize] == Springs::default();
+                    let none = |e: u32| {
+                        e == NONE || store.state.get(e as usize) == ContactState::default()
+                    };
                     if none(contact[s]) && contact[k] != NONE {
                         if contact[s] == NONE {
                             // The absorbing contact takes over the entry.
                             (contact[s], contact[k]) = (contact[k], NONE);
                         } else {
-                            let e = contact[k] as usize;
-                            store.springs[contact[s] as usize] = store.springs[e];
+                            let e = store.state.get(contact[k] as usize);
+                            store.state.set(contact[s] as usize, e);
                         }
                     }
                 }

@@ -47,6 +47,7 @@ mod split;
 mod walls;
 use crate::engine::spawn::{Spawner, SpawnerState};
 use crate::geometry::surface::{self, Candidate, Fate};
+use crate::model::contact_state::ContactState;
 use crate::model::springs::Springs;
 use crate::scenario::{Scenario, TagRegion};
 use loads::Load;
@@ -176,7 +177,7 @@ fn pieces<'a>(
 fn gather_springs(store: &Store, c: [u32; WIDTH]) -> Springs<Group> {
     let (mut u_s, mut u_r, mut u_t) = ([DVec3::ZERO; WIDTH], [DVec3::ZERO; WIDTH], [0.0; WIDTH]);
     for l in 0..WIDTH {
-        let s = &store.springs[c[l] as usize];
+        let s = &store.state.springs[c[l] as usize];
         (u_s[l], u_r[l], u_t[l]) = (s.u_s, s.u_r, s.u_t);
     }
     Springs {
@@ -190,13 +191,15 @@ fn gather_springs(store: &Store, c: [u32; WIDTH]) -> Springs<Group> {
 /// lanes).
 #[inline(always)]
 fn scatter_springs(lanes: Springs<Group>, store: &mut Store, c: &[u32]) {
+    #[cfg(test)]
+    open_core_tests::touch(store, c);
     let (u_s, u_r, u_t) = (
         Group::scatter_vec(lanes.u_s),
         Group::scatter_vec(lanes.u_r),
         lanes.u_t.scatter(),
     );
     for (l, &c) in c.iter().enumerate() {
-        store.springs[c as usize] = Springs {
+        store.state.springs[c as usize] = Springs {
             u_s: u_s[l],
             u_r: u_r[l],
             u_t: u_t[l],
@@ -494,6 +497,7 @@ impl Simulation {
         faces.sort_unstable_by_key(|e| (e.0, e.1));
         let (anchors, lonely) = self.neighbours.anchors();
         Ok(Snapshot {
+            contact_state: self.neighbours.state,
             steps: self.steps,
             built_at: self.built_at,
             particles: p.clone(),

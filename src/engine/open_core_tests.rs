@@ -1,8 +1,10 @@
 //! The recipes of the open core, tried: a per-particle field only the tests have (`probe`,
 //! an optional row of the table in `model/particles.rs`) and the code that uses it (each
-//! particle's path length, summed in the step), carried through ghosts, migration,
-//! checkpoints resumed on another number of processes, and frames, with the same bits as
-//! a run in one process.
+//! particle's path length, summed in the step); and a member of a contact's state only the
+//! tests have (`touches`, an optional row of `model/contact_state.rs`) with the code that
+//! uses it (the steps each contact has touched, counted where the law updates the
+//! springs). Both are carried through ghosts, migration, checkpoints resumed on another
+//! number of processes, and frames, with the same bits as a run in one process.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
@@ -24,6 +26,14 @@ pub(super) fn walk(p: &mut Particles, dt: f64) {
     }
 }
 
+/// The code that uses the contact's state: each contact of entries `c` of `store` has
+/// touched one step more.
+pub(super) fn touch(store: &mut crate::neighbours::Store, c: &[u32]) {
+    if store.state.active.touches {
+        c.iter().for_each(|&c| store.state.touches[c as usize] += 1);
+    }
+}
+
 /// A silo filling through its outlet: spawning, grains changing hands between processes,
 /// removal.
 fn silo() -> Scenario {
@@ -39,8 +49,29 @@ fn silo() -> Scenario {
 
 fn with_probe(mut sim: Simulation) -> Simulation {
     assert!(sim.particles.activate("probe"));
+    assert!(sim.neighbours.state.activate("touches"));
     sim
 }
+
+/// How many steps each contact with one of the particles `sim` owns has touched: by
+/// (lower id, higher id) for pairs, (id, face) for faces.
+fn touches(sim: &Simulation) -> BTreeMap<(Id, Id, bool), u32> {
+    let p = &sim.particles;
+    let own = |id: Id| {
+        let i = p.id.iter().position(|&j| j == id).expect("held");
+        sim.domain().is_none_or(|d| d.owned[i])
+    };
+    let (pairs, faces) = sim.neighbours.entries_by_id(&p.id);
+    let pairs = pairs.into_iter().filter(|e| own(e.0) || own(e.1));
+    let faces = faces.into_iter().filter(|e| own(e.0));
+    let pairs = pairs.map(|e| ((e.0, e.1, true), e.2.touches));
+    pairs
+        .chain(faces.map(|e| ((e.0, e.1, false), e.2.touches)))
+        .collect()
+}
+
+/// Every so many steps the contacts' states are compared.
+const EVERY: u64 = 50;
 
 /// Each held particle's probe, by id.
 fn probes(p: &Particles) -> BTreeMap<Id, u64> {
@@ -49,24 +80,35 @@ fn probes(p: &Particles) -> BTreeMap<Id, u64> {
         .collect()
 }
 
+/// What the run in one process holds after each step: the particles' probes, and every
+/// [`EVERY`] steps the contacts' touches.
+struct Reference {
+    probes: Vec<BTreeMap<Id, u64>>,
+    touches: Vec<BTreeMap<(Id, Id, bool), u32>>,
+}
+
 /// `steps` more steps of `sim`, checking after each that every particle held (own or ghost)
-/// has the probe of the run in one process, `reference`. Returns the ids it ever owned.
-fn step_checking_ghosts(
-    sim: &mut Simulation,
-    steps: u64,
-    reference: &[BTreeMap<Id, u64>],
-) -> BTreeSet<Id> {
+/// has the probe of the run in one process, and every [`EVERY`] steps that every contact
+/// of an own particle has its touches. Returns the ids it ever owned.
+fn step_checking_ghosts(sim: &mut Simulation, steps: u64, reference: &Reference) -> BTreeSet<Id> {
     let (mut ghosts, mut owned) = (0, BTreeSet::new());
     for _ in 0..steps {
         sim.step().expect("stable");
-        let want = &reference[sim.steps as usize];
+        let want = &reference.probes[sim.steps as usize];
         for (id, bits) in probes(&sim.particles) {
-            assert_eq!(
-                want.get(&id),
-                Some(&bits),
-                "particle {id} at step {}",
-                sim.steps
-            );
+            let step = sim.steps;
+            assert_eq!(want.get(&id), Some(&bits), "particle {id} at step {step}");
+        }
+        if sim.steps.is_multiple_of(EVERY) {
+            let want = &reference.touches[(sim.steps / EVERY) as usize];
+            for (contact, n) in touches(sim) {
+                let step = sim.steps;
+                assert_eq!(
+                    want.get(&contact),
+                    Some(&n),
+                    "contact {contact:?} at step {step}"
+                );
+            }
         }
         let d = sim.domain().expect("a split run");
         ghosts += d.owned.iter().filter(|&&o| !o).count();
@@ -88,20 +130,32 @@ fn migrated(owned: &[BTreeSet<Id>]) -> bool {
         .any(|(a, ids)| owned[a + 1..].iter().any(|other| !ids.is_disjoint(other)))
 }
 
-/// The probes of the run in one process after each step (0 to `steps`).
-fn one_process(steps: u64) -> Vec<BTreeMap<Id, u64>> {
+/// The run in one process for `steps` steps.
+fn one_process(steps: u64) -> Reference {
     let mut sim = with_probe(Simulation::new(silo()).unwrap());
-    let mut all = vec![probes(&sim.particles)];
+    let mut reference = Reference {
+        probes: vec![probes(&sim.particles)],
+        touches: vec![touches(&sim)],
+    };
     for _ in 0..steps {
         sim.step().unwrap();
-        all.push(probes(&sim.particles));
+        reference.probes.push(probes(&sim.particles));
+        if sim.steps.is_multiple_of(EVERY) {
+            reference.touches.push(touches(&sim));
+        }
     }
+    let last = &reference.probes[steps as usize];
+    assert!(last.values().any(|&b| f64::from_bits(b) > 0.0));
+    let last = reference.touches.last().unwrap();
     assert!(
-        all[steps as usize]
-            .values()
-            .any(|&b| f64::from_bits(b) > 0.0)
+        last.iter().any(|(c, &n)| c.2 && n > 100),
+        "long pair contacts"
     );
-    all
+    assert!(
+        last.iter().any(|(c, &n)| !c.2 && n > 100),
+        "long wall contacts"
+    );
+    reference
 }
 
 /// On `k` threads: each runs `body` on its share and returns what it returns.
@@ -121,11 +175,11 @@ fn on_threads<T: Send + 'static>(
 }
 
 #[test]
-fn a_field_declared_once_travels_through_ghosts_migration_checkpoints_and_frames() {
+fn a_field_and_a_contact_state_declared_once_travel_through_ghosts_migrations_and_checkpoints() {
     let (first, then) = (2500, 2500);
     let reference = Arc::new(one_process(first + then));
-    // `first` steps on 2 processes, every held probe checked each step; then the
-    // checkpoint's bytes.
+    // `first` steps on 2 processes, every held probe checked each step (and the touches
+    // every `EVERY`); then the checkpoint's bytes.
     let r = reference.clone();
     let checkpoints = on_threads(2, move |comm| {
         let sim = with_probe(Simulation::new(silo()).unwrap());
@@ -147,7 +201,7 @@ fn a_field_declared_once_travels_through_ghosts_migration_checkpoints_and_frames
     let owned = on_threads(3, move |comm| {
         let snapshot = bytes::decode(&c, Some(7)).unwrap();
         let sim = Simulation::restore(silo(), snapshot).unwrap();
-        assert!(sim.particles.active.probe);
+        assert!(sim.particles.active.probe && sim.neighbours.state.touches);
         let mut sim = sim.split(comm).unwrap();
         step_checking_ghosts(&mut sim, then, &r)
     });

@@ -146,7 +146,9 @@ fn wrapped(
                 if contact[k] == NONE {
                     contact[k] = store.open();
                 }
-                let springs = &mut store.springs[contact[k] as usize];
+                #[cfg(test)]
+                super::open_core_tests::touch(store, &[contact[k]]);
+                let springs = &mut store.state.springs[contact[k] as usize];
                 let other = Other::Particle {
                     r: p.radius[j],
                     m: model.mass(p, j),

@@ -251,7 +251,7 @@ fn open_contacts(list: &ContactList) -> Vec<(usize, usize, Springs, usize)> {
         for i in list.pieces[piece] as usize..list.pieces[piece + 1] as usize {
             for k in list.run(i) {
                 if list.contact[k] != NONE {
-                    let springs = store.springs[list.contact[k] as usize];
+                    let springs = store.state.springs[list.contact[k] as usize];
                     v.push((i, list.partner[k] as usize, springs, k));
                 }
             }

@@ -104,6 +104,7 @@ impl Simulation {
                 .map_err(misfit)?,
         };
         sim.particles = snapshot.particles;
+        sim.neighbours.state = snapshot.contact_state;
         sim.spawner = Spawner::resume(sim.scenario.simulation.seed, snapshot.spawner);
         sim.removed.domain = snapshot.removed.domain;
         sim.removed.outlets[..snapshot.removed.outlets.len()]
@@ -118,8 +119,10 @@ impl Simulation {
             sim.steps = snapshot.steps;
             sim.time = sim.steps as f64 * dt;
             sim.walls.move_to(sim.time);
+            let state = sim.neighbours.state;
             sim.neighbours =
                 Neighbours::with_periodic(sim.neighbours.skin, sim.neighbours.periodic);
+            sim.neighbours.state = state;
             return Ok(sim);
         }
         // The lists of the last rebuild, built again with the mesh (and sheared images)

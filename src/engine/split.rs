@@ -163,6 +163,7 @@ impl Simulation {
         pairs.retain(|e| own_ids.contains(&e.0) || own_ids.contains(&e.1));
         faces.retain(|e| own_ids.contains(&e.0));
         Snapshot {
+            contact_state: self.neighbours.state,
             steps: self.steps,
             built_at: self.built_at,
             particles: own,
@@ -299,8 +300,13 @@ impl Simulation {
         self.neighbours.clear_lists();
         let old = std::mem::take(&mut self.particles);
         let periodic = self.neighbours.periodic;
-        let (mut held, mut held_at, (pairs, faces)) =
-            migrate(&mut d, (old, periodic), anchors, gone, springs);
+        let (mut held, mut held_at, (pairs, faces)) = migrate(
+            &mut d,
+            (old, periodic),
+            anchors,
+            gone,
+            (springs, self.neighbours.state),
+        );
         let n_own = held.len();
         let r_max = d.comm.max(held.max_radius()).max(0.0);
         let reach = (r_max, self.neighbours.skin, self.neighbours.periodic);

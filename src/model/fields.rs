@@ -357,3 +357,229 @@ macro_rules! particle_fields {
 }
 
 pub(crate) use particle_fields;
+
+/// What checkpoints know of an optional member of a contact's state.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct OptionalState {
+    pub name: &'static str,
+    /// The bytes of one value.
+    pub size: usize,
+}
+
+/// Makes a contact's state and its stores from the table of its members (one use, in
+/// `model/contact_state.rs`): each member is the state of a part of the contact law,
+/// kept from step to step while the contact touches. Core members are held by every run
+/// (their bytes in each entry of a checkpoint's contact history, from format 2); optional
+/// members only when a run asks for them (`States::activate`), in messages and in a
+/// checkpoint's section by name (format 8). A member's type is a [`Value`].
+macro_rules! contact_fields {
+    (
+        core {$(
+            $(#[doc = $doc:literal])*
+            $name:ident: $ty:ty;
+        )*}
+        optional {$(
+            $(#[cfg($cfg:meta)])?
+            $(#[doc = $odoc:literal])*
+            $oname:ident: $oty:ty;
+        )*}
+    ) => {
+        /// The state of one contact: what the parts of the contact law keep from step to
+        /// step (optional members not held at their defaults). A contact whose state is
+        /// the default one has nothing to keep.
+        #[derive(Clone, Copy, Debug, Default, PartialEq)]
+        pub struct ContactState {
+            $($(#[doc = $doc])* pub $name: $ty,)*
+            $($(#[cfg($cfg)])? $(#[doc = $odoc])* pub $oname: $oty,)*
+        }
+
+        /// Which optional members of a contact's state are held.
+        #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+        pub struct ActiveState {
+            $($(#[cfg($cfg)])? pub $oname: bool,)*
+        }
+
+        /// The optional members of a contact's state.
+        pub const OPTIONAL_STATE: &[$crate::model::fields::OptionalState] = &[$(
+            $(#[cfg($cfg)])?
+            $crate::model::fields::OptionalState {
+                name: stringify!($oname),
+                size: <$oty as Value>::SIZE,
+            },
+        )*];
+
+        impl ActiveState {
+            /// The optional members held.
+            pub fn fields(&self) -> Vec<&'static $crate::model::fields::OptionalState> {
+                #[allow(unused_mut)]
+                let mut held = Vec::new();
+                $($(#[cfg($cfg)])?
+                if self.$oname {
+                    held.extend(OPTIONAL_STATE.iter().find(|f| f.name == stringify!($oname)));
+                })*
+                held
+            }
+
+            /// Holds the optional member `name` from now on; false if there is none.
+            pub fn activate(&mut self, name: &str) -> bool {
+                $($(#[cfg($cfg)])?
+                if name == stringify!($oname) {
+                    self.$oname = true;
+                    return true;
+                })*
+                let _ = name;
+                false
+            }
+        }
+
+        /// The states of the entries of a store: a vector per member (the optional ones
+        /// empty unless held).
+        #[derive(Clone, Debug, Default)]
+        pub struct States {
+            $($(#[doc = $doc])* pub $name: Vec<$ty>,)*
+            $($(#[cfg($cfg)])? $(#[doc = $odoc])* pub $oname: Vec<$oty>,)*
+            pub active: ActiveState,
+        }
+
+        impl States {
+            /// No entries, holding the optional members `active`.
+            pub fn new(active: ActiveState) -> States {
+                States { active, ..States::default() }
+            }
+
+            pub fn len(&self) -> usize {
+                0 $(.max(self.$name.len()))*
+            }
+
+            pub fn is_empty(&self) -> bool {
+                self.len() == 0
+            }
+
+            /// A new entry of state `s`.
+            #[inline]
+            pub fn push(&mut self, s: ContactState) {
+                $(self.$name.push(s.$name);)*
+                $($(#[cfg($cfg)])?
+                if self.active.$oname {
+                    self.$oname.push(s.$oname);
+                })*
+            }
+
+            /// Entry `k`'s state.
+            #[inline]
+            pub fn get(&self, k: usize) -> ContactState {
+                let mut s = ContactState::default();
+                $(s.$name = self.$name[k];)*
+                $($(#[cfg($cfg)])?
+                if self.active.$oname {
+                    s.$oname = self.$oname[k];
+                })*
+                s
+            }
+
+            /// Sets entry `k`'s state.
+            #[inline]
+            pub fn set(&mut self, k: usize, s: ContactState) {
+                $(self.$name[k] = s.$name;)*
+                $($(#[cfg($cfg)])?
+                if self.active.$oname {
+                    self.$oname[k] = s.$oname;
+                })*
+            }
+
+            /// Room for `n` more entries, exactly.
+            pub fn reserve_exact(&mut self, n: usize) {
+                $(self.$name.reserve_exact(n);)*
+                $($(#[cfg($cfg)])?
+                if self.active.$oname {
+                    self.$oname.reserve_exact(n);
+                })*
+            }
+
+            /// Whether the next entry needs more room.
+            #[inline]
+            pub fn full(&self) -> bool {
+                true $(&& self.$name.len() == self.$name.capacity())*
+            }
+
+            pub fn shrink_to_fit(&mut self) {
+                $(self.$name.shrink_to_fit();)*
+                $($(#[cfg($cfg)])?
+                self.$oname.shrink_to_fit();)*
+            }
+        }
+
+        impl ContactState {
+            /// The bytes of a contact's state in a message between processes that hold the
+            /// optional members `active`.
+            pub fn size(active: &ActiveState) -> usize {
+                #[allow(unused_mut)]
+                let mut n = 0 $(+ <$ty as Value>::SIZE)*;
+                $($(#[cfg($cfg)])?
+                if active.$oname {
+                    n += <$oty as Value>::SIZE;
+                })*
+                let _ = active;
+                n
+            }
+
+            /// Appends the state's bytes in a message (of the optional members, those
+            /// `active`).
+            pub fn put(&self, active: &ActiveState, out: &mut Vec<u8>) {
+                $(self.$name.put(out);)*
+                $($(#[cfg($cfg)])?
+                if active.$oname {
+                    self.$oname.put(out);
+                })*
+                let _ = active;
+            }
+
+            /// The state whose bytes (in a message) `bytes` begin with.
+            pub fn take(active: &ActiveState, bytes: &mut &[u8]) -> ContactState {
+                let mut s = ContactState::default();
+                $(s.$name = Value::take(bytes);)*
+                $($(#[cfg($cfg)])?
+                if active.$oname {
+                    s.$oname = Value::take(bytes);
+                })*
+                let _ = active;
+                s
+            }
+
+            /// The bytes of the core members in an entry of a checkpoint.
+            pub const CHECKPOINT_SIZE: usize = 0 $(+ <$ty as Value>::SIZE)*;
+
+            /// Appends the core members' bytes in an entry of a checkpoint.
+            pub fn put_checkpoint(&self, out: &mut Vec<u8>) {
+                $(self.$name.put(out);)*
+            }
+
+            /// The state whose core members' bytes (in a checkpoint) `bytes` begin with.
+            pub fn take_checkpoint(bytes: &mut &[u8]) -> ContactState {
+                let mut s = ContactState::default();
+                $(s.$name = Value::take(bytes);)*
+                s
+            }
+
+            /// Appends the bytes of the optional member `name`.
+            pub fn put_member(&self, name: &str, out: &mut Vec<u8>) {
+                $($(#[cfg($cfg)])?
+                if name == stringify!($oname) {
+                    self.$oname.put(out);
+                })*
+                let _ = (name, out);
+            }
+
+            /// Sets the optional member `name` to the value `bytes` begin with.
+            pub fn take_member(&mut self, name: &str, bytes: &mut &[u8]) {
+                $($(#[cfg($cfg)])?
+                if name == stringify!($oname) {
+                    self.$oname = Value::take(bytes);
+                })*
+                let _ = (name, bytes);
+            }
+        }
+    };
+}
+
+pub(crate) use contact_fields;

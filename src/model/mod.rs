@@ -3,6 +3,7 @@
 pub mod bodies;
 pub mod clump;
 pub mod contact;
+pub mod contact_state;
 pub mod exact;
 pub mod fields;
 pub mod id;

@@ -2,6 +2,7 @@
 //! kept from step to step while the contact lasts (the contact law updates them, the
 //! neighbour lists carry them across rebuilds, checkpoints store them).
 
+use crate::model::fields::Value;
 use crate::model::lanes::Lanes;
 
 /// Displacements of the three static friction springs of one contact (Table 3):
@@ -11,4 +12,22 @@ pub struct Springs<T: Lanes = f64> {
     pub u_s: T::Vec,
     pub u_r: T::Vec,
     pub u_t: T,
+}
+
+/// u_s, u_r, u_t: 7 numbers.
+impl Value for Springs {
+    const SIZE: usize = 56;
+    fn put(&self, out: &mut Vec<u8>) {
+        self.u_s.put(out);
+        self.u_r.put(out);
+        self.u_t.put(out);
+    }
+    fn take(bytes: &mut &[u8]) -> Self {
+        let (u_s, u_r) = (glam::DVec3::take(bytes), glam::DVec3::take(bytes));
+        Springs {
+            u_s,
+            u_r,
+            u_t: f64::take(bytes),
+        }
+    }
 }

@@ -12,7 +12,7 @@ pub struct History {
     /// The entries of `a` are `start[a]..start[a+1]`, ordered by the other key.
     pub(crate) start: Vec<u32>,
     pub(crate) other: Vec<u32>,
-    pub(crate) springs: Vec<Springs>,
+    pub(crate) state: Vec<ContactState>,
 }
 
 impl History {
@@ -21,7 +21,7 @@ impl History {
     /// entries in the same order each time it is called (twice: to count, then to place).
     pub(crate) fn from_visits(
         keys: usize,
-        visit: impl Fn(&mut dyn FnMut(u32, u32, Springs)),
+        visit: impl Fn(&mut dyn FnMut(u32, u32, ContactState)),
     ) -> History {
         let mut start = vec![0u32; keys + 1];
         visit(&mut |a, _, _| start[a as usize + 1] += 1);
@@ -31,10 +31,10 @@ impl History {
         let total = start[keys] as usize;
         let mut fill = start.clone();
         let mut other = vec![0u32; total];
-        let mut springs = vec![Springs::default(); total];
+        let mut state = vec![ContactState::default(); total];
         visit(&mut |a, o, s| {
             let k = fill[a as usize] as usize;
-            (other[k], springs[k]) = (o, s);
+            (other[k], state[k]) = (o, s);
             fill[a as usize] += 1;
         });
         drop(fill);
@@ -45,7 +45,7 @@ impl History {
                 let mut m = k;
                 while m > run.start && other[m - 1] > other[m] {
                     other.swap(m - 1, m);
-                    springs.swap(m - 1, m);
+                    state.swap(m - 1, m);
                     m -= 1;
                 }
             }
@@ -53,7 +53,7 @@ impl History {
         History {
             start,
             other,
-            springs,
+            state,
         }
     }
 
@@ -116,11 +116,11 @@ impl History {
 
     /// Every entry, ordered by the first key and then by the other.
     #[cfg(test)]
-    pub(crate) fn entries(&self) -> Vec<(u32, u32, Springs)> {
+    pub(crate) fn entries(&self) -> Vec<(u32, u32, ContactState)> {
         (0..self.start.len().saturating_sub(1))
             .flat_map(|a| {
                 (self.start[a] as usize..self.start[a + 1] as usize)
-                    .map(move |k| (a as u32, self.other[k], self.springs[k]))
+                    .map(move |k| (a as u32, self.other[k], self.state[k]))
             })
             .collect()
     }
@@ -135,18 +135,18 @@ impl History {
 
     /// The entries of `a`: the other keys (ascending) and their springs.
     #[inline]
-    pub(crate) fn run(&self, a: usize) -> (&[u32], &[Springs]) {
+    pub(crate) fn run(&self, a: usize) -> (&[u32], &[ContactState]) {
         if a + 1 >= self.start.len() {
             return (&[], &[]);
         }
         let run = self.start[a] as usize..self.start[a + 1] as usize;
-        (&self.other[run.clone()], &self.springs[run])
+        (&self.other[run.clone()], &self.state[run])
     }
 }
 
-/// A saved contact's springs by id: of a particle pair (lower id, higher id, springs), or of
-/// a particle-face contact (id, face index, springs).
-pub type Entry = (Id, Id, Springs);
+/// A saved contact's state by id: of a particle pair (lower id, higher id, state), or of a
+/// particle-face contact (id, face index, state).
+pub type Entry = (Id, Id, ContactState);
 
 /// Contact histories as lists of entries: particle pairs and particle-face contacts.
 pub type Entries = (Vec<Entry>, Vec<Entry>);

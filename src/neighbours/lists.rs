@@ -8,31 +8,32 @@ use super::*;
 /// A slot without a contact.
 pub const NONE: u32 = u32::MAX;
 
-/// The friction springs of the touching contacts of one piece of a list, and its free
-/// entries. A contact stage runs a piece in one task, which opens and closes entries in the
-/// piece's own store.
+/// The states of the touching contacts of one piece of a list (`ContactState`: the
+/// friction springs, and what other parts of the law keep), and its free entries. A
+/// contact stage runs a piece in one task, which opens and closes entries in the piece's
+/// own store.
 #[derive(Clone, Debug, Default)]
 pub struct Store {
-    pub springs: Vec<Springs>,
+    pub state: States,
     pub(crate) free: Vec<u32>,
 }
 
 impl Store {
-    /// A new entry, with zero springs.
+    /// A new entry, in the state of a first touch (zero springs).
     #[inline]
     pub fn open(&mut self) -> u32 {
         match self.free.pop() {
             Some(k) => {
-                self.springs[k as usize] = Springs::default();
+                self.state.set(k as usize, ContactState::default());
                 k
             }
             None => {
-                if self.springs.len() == self.springs.capacity() {
+                if self.state.full() {
                     // A little room at a time: contacts come and go, the count changes slowly.
-                    self.springs.reserve_exact(self.springs.len() / 8 + 8);
+                    self.state.reserve_exact(self.state.len() / 8 + 8);
                 }
-                self.springs.push(Springs::default());
-                (self.springs.len() - 1) as u32
+                self.state.push(ContactState::default());
+                (self.state.len() - 1) as u32
             }
         }
     }
@@ -45,7 +46,7 @@ impl Store {
 
     /// Entries in use.
     pub fn len(&self) -> usize {
-        self.springs.len() - self.free.len()
+        self.state.len() - self.free.len()
     }
 
     pub fn is_empty(&self) -> bool {
@@ -55,7 +56,7 @@ impl Store {
 
 /// A compressed list: for each owner `i` (a storage index), a run of partners; each slot
 /// whose pair touches holds its contact, an entry of the store of the slot's piece (the
-/// pieces are runs of owners). Springs are kept only for touching pairs, those of a
+/// pieces are runs of owners). States are kept only for touching pairs, those of a
 /// particle pair as seen from the particle of the lower id (body i of the contact law),
 /// whatever the storage order.
 #[derive(Clone, Debug, Default)]
@@ -94,17 +95,17 @@ impl ContactList {
         self.stores.iter().map(Store::len).sum()
     }
 
-    /// Calls `f` with owner, slot and springs of every slot with non-zero springs, in slot
-    /// order.
-    pub(crate) fn for_each_live(&self, mut f: impl FnMut(usize, usize, Springs)) {
+    /// Calls `f` with owner, slot and state of every slot whose contact has a state to
+    /// keep (not that of a first touch), in slot order.
+    pub(crate) fn for_each_live(&self, mut f: impl FnMut(usize, usize, ContactState)) {
         for p in 0..self.pieces.len().saturating_sub(1) {
             let store = &self.stores[p];
             for i in self.pieces[p] as usize..self.pieces[p + 1] as usize {
                 for k in self.run(i) {
                     let c = self.contact[k];
                     if c != NONE {
-                        let s = store.springs[c as usize];
-                        if s != Springs::default() {
+                        let s = store.state.get(c as usize);
+                        if s != ContactState::default() {
                             f(i, k, s);
                         }
                     }
@@ -150,6 +151,7 @@ impl ContactList {
         partner: Vec<u32>,
         pieces: Vec<u32>,
         history: &History,
+        active: ActiveState,
     ) -> ContactList {
         let mut contact = vec![NONE; partner.len()];
         let slots: Vec<usize> = pieces.iter().map(|&o| start[o as usize] as usize).collect();
@@ -159,7 +161,10 @@ impl ContactList {
             .into_par_iter()
             .map(|(p, contact)| {
                 let first = slots[p];
-                let mut store = Store::default();
+                let mut store = Store {
+                    state: States::new(active),
+                    ..Store::default()
+                };
                 for i in pieces[p] as usize..pieces[p + 1] as usize {
                     let run = start[i] as usize..start[i + 1] as usize;
                     let (other, carried) = history.run(i);
@@ -169,13 +174,13 @@ impl ContactList {
                         while h < other.len() && other[h] < j {
                             h += 1;
                         }
-                        if other.get(h) == Some(&j) && carried[h] != Springs::default() {
-                            contact[k - first] = store.springs.len() as u32;
-                            store.springs.push(carried[h]);
+                        if other.get(h) == Some(&j) && carried[h] != ContactState::default() {
+                            contact[k - first] = store.state.len() as u32;
+                            store.state.push(carried[h]);
                         }
                     }
                 }
-                store.springs.shrink_to_fit();
+                store.state.shrink_to_fit();
                 store
             })
             .collect();

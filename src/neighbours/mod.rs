@@ -17,8 +17,8 @@ use glam::{DVec3, IVec3};
 use rayon::prelude::*;
 
 use crate::geometry::mesh::Face;
+use crate::model::contact_state::{ActiveState, ContactState, States};
 use crate::model::particles::{Id, Particles};
-use crate::model::springs::Springs;
 
 mod build;
 mod grid;
@@ -115,6 +115,8 @@ pub struct Neighbours {
     lonely_idle: bool,
     /// Number of rebuilds so far.
     pub rebuilds: u64,
+    /// The optional members of a contact's state the stores hold.
+    pub state: ActiveState,
 }
 
 /// The fewest owners in a slab (a task of the pair stage).
@@ -562,9 +564,15 @@ mod tests {
     fn histories_by_id_name_or_skip_the_particles_absent() {
         let x = vec![DVec3::ZERO, DVec3::X, DVec3::Y];
         let p = particles(&x, &[0.1; 3]);
-        let s = |u_t: f64| Springs {
-            u_t,
-            ..Springs::default()
+        let s = |u_t: f64| {
+            let springs = crate::model::springs::Springs {
+                u_t,
+                ..Default::default()
+            };
+            ContactState {
+                springs,
+                ..ContactState::default()
+            }
         };
         let entries = [(0, 2, s(1.0)), (1, 7, s(2.0)), (2, 1, s(3.0))];
         let err = History::in_storage(&p, &entries, true).unwrap_err();
@@ -629,7 +637,7 @@ mod tests {
             for k in list.start[i] as usize..list.start[i + 1] as usize {
                 let id = p.id[i].min(p.id[list.partner[k] as usize]);
                 let e = list.stores[piece].open();
-                list.stores[piece].springs[e as usize].u_t = id as f64 + 1.0;
+                list.stores[piece].state.springs[e as usize].u_t = id as f64 + 1.0;
                 list.contact[k] = e;
             }
         }
@@ -643,7 +651,7 @@ mod tests {
         assert_eq!(
             pairs
                 .iter()
-                .map(|e| (e.0, e.1, e.2.u_t))
+                .map(|e| (e.0, e.1, e.2.springs.u_t))
                 .collect::<Vec<_>>(),
             vec![(0, 3, 1.0), (1, 2, 2.0)]
         );

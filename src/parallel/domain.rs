@@ -39,8 +39,8 @@ use anyhow::{Result, bail};
 use glam::DVec3;
 
 use crate::model::bodies::{Body, BodyId};
+use crate::model::contact_state::{ActiveState, ContactState};
 use crate::model::particles::{Active, Id, Particle, Particles};
-use crate::model::springs::Springs;
 use crate::neighbours::Entry;
 use crate::parallel::comm::{Comm, Reach, Reader, Writer};
 
@@ -358,23 +358,20 @@ pub(crate) fn get_particle(r: &mut Reader, active: &Active) -> (Id, Particle) {
     )
 }
 
-pub(crate) fn put_entry(w: &mut Writer, (a, b, s): &Entry) {
+/// A contact's record in a message between processes whose stores hold the optional
+/// members `active`: its particle ids (or id and face), then its state.
+pub(crate) fn put_entry(w: &mut Writer, active: &ActiveState, (a, b, s): &Entry) {
     w.u64(*a);
     w.u64(*b);
-    w.vec3(s.u_s);
-    w.vec3(s.u_r);
-    w.f64(s.u_t);
+    s.put(active, &mut w.0);
 }
 
-pub(crate) fn get_entry(r: &mut Reader) -> Entry {
+pub(crate) fn get_entry(r: &mut Reader, active: &ActiveState) -> Entry {
+    let (a, b) = (r.u64(), r.u64());
     (
-        r.u64(),
-        r.u64(),
-        Springs {
-            u_s: r.vec3(),
-            u_r: r.vec3(),
-            u_t: r.f64(),
-        },
+        a,
+        b,
+        ContactState::take(active, &mut r.record(ContactState::size(active))),
     )
 }
 

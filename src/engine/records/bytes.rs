@@ -33,9 +33,9 @@ use glam::{DQuat, DVec3};
 use super::{Outflow, Removed, Snapshot, Wrench};
 use crate::engine::spawn::{RegionState, SpawnerState};
 use crate::model::bodies::{Body, BodyId};
+use crate::model::contact_state::{ActiveState, ContactState, OPTIONAL_STATE};
 use crate::model::particles::{Id, OPTIONAL, Particle, Particles};
 use crate::model::servo::State;
-use crate::model::springs::Springs;
 use crate::neighbours::Entry;
 
 const MAGIC: &[u8; 12] = b"TINYDEM CKPT";
@@ -66,10 +66,7 @@ fn put_history(out: &mut Vec<u8>, h: &[Entry], wide: bool) {
     for &(i, j, s) in h {
         put_id(out, i, wide);
         put_id(out, j, wide);
-        put_f64s(
-            out,
-            &[s.u_s.x, s.u_s.y, s.u_s.z, s.u_r.x, s.u_r.y, s.u_r.z, s.u_t],
-        );
+        s.put_checkpoint(out);
     }
 }
 
@@ -105,7 +102,8 @@ fn encoded_size(s: &Snapshot) -> usize {
 
 /// Appends the checkpoint of `snapshot` to `out` (its checksum covers what it appends).
 pub fn encode_into(out: &mut Vec<u8>, snapshot: &Snapshot, fingerprint: u64) {
-    let optional = !snapshot.particles.active.fields().is_empty();
+    let optional = !snapshot.particles.active.fields().is_empty()
+        || !snapshot.contact_state.fields().is_empty();
     let version = if optional { VERSION } else { WITHOUT_OPTIONAL };
     encode_as(out, snapshot, fingerprint, version);
 }
@@ -182,6 +180,7 @@ fn encode_as(out: &mut Vec<u8>, snapshot: &Snapshot, fingerprint: u64, version: 
     put_bodies(out, &p.bodies.list, wide);
     if version >= 8 {
         put_optional(out, p);
+        put_optional_state(out, snapshot);
     }
     let crc = crc32fast::hash(&out[start..]);
     out.extend_from_slice(&crc.to_le_bytes());
@@ -196,6 +195,20 @@ fn put_optional(out: &mut Vec<u8>, p: &Particles) {
         out.push(f.name.len() as u8);
         out.extend_from_slice(f.name.as_bytes());
         p.put_field(f.name, out);
+    }
+}
+
+/// The optional members of the contacts' states: their count (u32), and per member its
+/// name (length u8, bytes) and its values, of the pair entries, then of the face entries.
+fn put_optional_state(out: &mut Vec<u8>, s: &Snapshot) {
+    let members = s.contact_state.fields();
+    out.extend_from_slice(&(members.len() as u32).to_le_bytes());
+    for m in members {
+        out.push(m.name.len() as u8);
+        out.extend_from_slice(m.name.as_bytes());
+        for e in s.pair_history.iter().chain(&s.face_history) {
+            e.2.put_member(m.name, out);
+        }
     }
 }
 
@@ -296,21 +309,19 @@ impl Cursor<'_> {
         Ok(n as usize)
     }
     fn history(&mut self) -> Result<Vec<Entry>> {
-        let n = self.count(2 * self.id_size() + 56)?;
+        let size = ContactState::CHECKPOINT_SIZE;
+        let n = self.count(2 * self.id_size() + size)?;
         (0..n)
             .map(|_| {
                 let (i, j) = (self.id()?, self.id()?);
-                let s = Springs {
-                    u_s: self.vec3()?,
-                    u_r: self.vec3()?,
-                    u_t: self.f64()?,
-                };
+                let state = ContactState::take_checkpoint(&mut self.take(size)?);
+                let s = state.springs;
                 if !(bounded(s.u_s) && bounded(s.u_r) && bounded(DVec3::splat(s.u_t))) {
                     bail!(
                         "corrupt checkpoint: the friction springs of contact ({i}, {j}) are {s:?}"
                     );
                 }
-                Ok((i, j, s))
+                Ok((i, j, state))
             })
             .collect()
     }
@@ -383,8 +394,12 @@ pub fn decode(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<Snapsho
         let bodies = r.bodies()?;
         join_bodies(&mut particles, bodies)?;
     }
+    let mut contact_state = ActiveState::default();
+    let (mut pair_history, mut face_history) = (pair_history, face_history);
     if version >= 8 {
         r.optional(&mut particles)?;
+        let histories = (&mut pair_history[..], &mut face_history[..]);
+        contact_state = r.optional_state(histories)?;
     }
     if r.at != r.bytes.len() {
         bail!(
@@ -393,6 +408,7 @@ pub fn decode(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<Snapsho
         );
     }
     Ok(Snapshot {
+        contact_state,
         steps,
         built_at,
         particles,
@@ -504,6 +520,34 @@ impl Cursor<'_> {
             particles.take_field(&name, &mut &bytes[..]);
         }
         Ok(())
+    }
+
+    /// The optional members of the contacts' states (format 8), each known to this
+    /// program, once, with a value for every entry of `histories` (pairs, then faces).
+    fn optional_state(
+        &mut self,
+        (pairs, faces): (&mut [Entry], &mut [Entry]),
+    ) -> Result<ActiveState> {
+        let r = self;
+        let mut active = ActiveState::default();
+        for _ in 0..r.u32()? {
+            let length = r.u8()? as usize;
+            let name = String::from_utf8_lossy(r.take(length)?).into_owned();
+            let Some(member) = OPTIONAL_STATE.iter().find(|f| f.name == name) else {
+                bail!(
+                    "the checkpoint holds the contact state '{name}', which this tinydem does not know"
+                );
+            };
+            if active.fields().contains(&member) {
+                bail!("corrupt checkpoint: the contact state '{name}' twice");
+            }
+            active.activate(&name);
+            let mut bytes = r.take(member.size * (pairs.len() + faces.len()))?;
+            for e in pairs.iter_mut().chain(faces.iter_mut()) {
+                e.2.take_member(&name, &mut bytes);
+            }
+        }
+        Ok(active)
     }
 
     /// The rigid bodies (format 6), finite, ascending by id.

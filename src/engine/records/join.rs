@@ -79,6 +79,7 @@ pub fn join(pieces: Vec<Snapshot>) -> Result<Snapshot> {
         dedup(pieces.iter().flat_map(|p| of(p).iter().copied()).collect())
     };
     Ok(Snapshot {
+        contact_state: first.contact_state,
         steps: first.steps,
         built_at: first.built_at,
         particles,

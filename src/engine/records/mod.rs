@@ -41,6 +41,8 @@ pub struct Snapshot {
     pub mesh_files: Vec<(u64, u64)>,
     /// The state of each servo, with its mesh file (format 4).
     pub servos: Vec<(u32, crate::model::servo::State)>,
+    /// The optional members of a contact's state the histories hold (format 8).
+    pub contact_state: crate::model::contact_state::ActiveState,
 }
 
 /// The partner of a particle in a contact.

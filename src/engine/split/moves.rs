@@ -4,6 +4,7 @@
 //! rigid body moves whole, to the process of its centre of mass.
 
 use super::*;
+use crate::model::contact_state::ActiveState;
 
 /// The boxes cut anew (collective) when the counts of own particles, at `own`, are out of
 /// balance (or never cut).
@@ -34,7 +35,7 @@ pub(super) fn migrate(
     (p, periodic): (Particles, Option<Periodic>),
     anchors: Option<Vec<DVec3>>,
     gone: &FxHashSet<Id>,
-    entries: Entries,
+    (entries, active): (Entries, ActiveState),
 ) -> (Particles, Option<Vec<DVec3>>, Entries) {
     let carry = anchors.is_some();
     // Where each particle is placed: at its anchor, or where it is now.
@@ -56,7 +57,7 @@ pub(super) fn migrate(
     let messages: Vec<Vec<u8>> = (0..d.comm.size())
         .map(|q| match q == me {
             true => Vec::new(), // what stays, stays
-            false => to.message(q, &p, carry.then_some(&*place), &entries),
+            false => to.message(q, &p, carry.then_some(&*place), (&entries, &active)),
         })
         .collect();
     let mut held = p.empty_like();
@@ -79,7 +80,8 @@ pub(super) fn migrate(
     drop(p);
     for (q, m) in d.comm.all_to_all(messages).iter().enumerate() {
         if q != me {
-            receive(&mut Reader::new(m), &mut held, held_at.as_mut(), &mut kept);
+            let mut r = Reader::new(m);
+            receive(&mut r, &mut held, held_at.as_mut(), (&mut kept, &active));
         }
     }
     // A pair whose partners had two owners came from both.
@@ -202,7 +204,7 @@ impl Destinations {
         q: usize,
         p: &Particles,
         place: Option<&[DVec3]>,
-        (pairs, faces): &Entries,
+        ((pairs, faces), active): (&Entries, &ActiveState),
     ) -> Vec<u8> {
         let mut w = Writer::default();
         w.u64(self.particles[q].len() as u64);
@@ -219,22 +221,23 @@ impl Destinations {
         w.u64(self.pairs[q].len() as u64);
         self.pairs[q]
             .iter()
-            .for_each(|&e| put_entry(&mut w, &pairs[e]));
+            .for_each(|&e| put_entry(&mut w, active, &pairs[e]));
         w.u64(self.faces[q].len() as u64);
         self.faces[q]
             .iter()
-            .for_each(|&e| put_entry(&mut w, &faces[e]));
+            .for_each(|&e| put_entry(&mut w, active, &faces[e]));
         w.0
     }
 }
 
 /// Adds what a [`Destinations::message`] holds to the particles `held` (and their places to
-/// `held_at`, if carried) and the springs `kept`.
+/// `held_at`, if carried) and the contacts' states `kept` (holding the optional members
+/// `active`).
 fn receive(
     r: &mut Reader,
     held: &mut Particles,
     mut held_at: Option<&mut Vec<DVec3>>,
-    (pairs, faces): &mut Entries,
+    ((pairs, faces), active): (&mut Entries, &ActiveState),
 ) {
     for _ in 0..r.u64() {
         let (id, particle) = get_particle(r, &held.active);
@@ -247,10 +250,10 @@ fn receive(
         held.bodies.insert(get_body(r));
     }
     for _ in 0..r.u64() {
-        pairs.push(get_entry(r));
+        pairs.push(get_entry(r, active));
     }
     for _ in 0..r.u64() {
-        faces.push(get_entry(r));
+        faces.push(get_entry(r, active));
     }
 }
 

@@ -134,6 +134,7 @@ mod tests {
     use crate::engine::records::bytes::encode_v6;
     use crate::engine::records::{Outflow, Removed, Wrench};
     use crate::engine::spawn::{RegionState, SpawnerState};
+    use crate::model::contact_state::ContactState;
     use crate::model::particles::{Particle, Particles};
     use crate::model::springs::Springs;
     use glam::{DQuat, DVec3};
@@ -149,14 +150,19 @@ mod tests {
             tag: 7,
             ..Default::default()
         });
-        let s = Springs {
+        let springs = Springs {
             u_s: DVec3::new(1e-5, 2e-6, 0.0),
             u_r: DVec3::ZERO,
             u_t: -3e-7,
         };
+        let s = ContactState {
+            springs,
+            ..ContactState::default()
+        };
         particles.id = vec![3];
         particles.next_id = 5;
         Snapshot {
+            contact_state: Default::default(),
             steps: 12345,
             built_at: 12300,
             particles,
