@@ -6,7 +6,7 @@
 //! feature, over MPI. Every operation is collective: each process calls it, in the same
 //! order.
 
-use std::sync::{Arc, Barrier, Mutex};
+use std::sync::{Arc, Condvar, Mutex};
 
 use glam::{DQuat, DVec3};
 
@@ -117,7 +117,41 @@ impl Comm for Solo {
 struct Hub {
     /// For each sender, its messages to each receiver.
     posted: Mutex<Vec<Vec<Vec<u8>>>>,
-    barrier: Barrier,
+    gate: Mutex<Gate>,
+    opened: Condvar,
+}
+
+/// A barrier that a thread of the group which panics breaks, so that the others panic too
+/// instead of waiting for it forever (a test fails, it does not hang).
+#[derive(Default)]
+struct Gate {
+    waiting: usize,
+    round: u64,
+    broken: bool,
+}
+
+impl Hub {
+    /// Waits until all `k` threads of the group are here.
+    fn wait(&self, k: usize) {
+        let broken = || panic!("another thread of the group panicked");
+        let mut gate = self.gate.lock().unwrap_or_else(|e| e.into_inner());
+        if gate.broken {
+            broken();
+        }
+        let round = gate.round;
+        gate.waiting += 1;
+        if gate.waiting == k {
+            (gate.waiting, gate.round) = (0, round + 1);
+            self.opened.notify_all();
+            return;
+        }
+        while gate.round == round && !gate.broken {
+            gate = self.opened.wait(gate).unwrap_or_else(|e| e.into_inner());
+        }
+        if gate.round == round {
+            broken();
+        }
+    }
 }
 
 /// One of `k` simulations that run as the processes of one split run, each in a thread of
@@ -133,7 +167,8 @@ impl Threads {
     pub fn group(k: usize) -> Vec<Threads> {
         let hub = Arc::new(Hub {
             posted: Mutex::new(vec![Vec::new(); k]),
-            barrier: Barrier::new(k),
+            gate: Mutex::new(Gate::default()),
+            opened: Condvar::new(),
         });
         (0..k)
             .map(|rank| Threads {
@@ -142,6 +177,17 @@ impl Threads {
                 hub: hub.clone(),
             })
             .collect()
+    }
+}
+
+impl Drop for Threads {
+    /// A thread that panics breaks the group's gate: the others panic at it.
+    fn drop(&mut self) {
+        if std::thread::panicking() {
+            let mut gate = self.hub.gate.lock().unwrap_or_else(|e| e.into_inner());
+            gate.broken = true;
+            self.hub.opened.notify_all();
+        }
     }
 }
 
@@ -155,7 +201,7 @@ impl Comm for Threads {
     fn all_to_all(&self, send: Vec<Vec<u8>>) -> Vec<Vec<u8>> {
         assert_eq!(send.len(), self.size, "one message per process");
         self.hub.posted.lock().expect("not poisoned")[self.rank] = send;
-        self.hub.barrier.wait();
+        self.hub.wait(self.size);
         let received = {
             let mut posted = self.hub.posted.lock().expect("not poisoned");
             (0..self.size)
@@ -163,7 +209,7 @@ impl Comm for Threads {
                 .collect()
         };
         // Nobody posts again before everyone has taken theirs.
-        self.hub.barrier.wait();
+        self.hub.wait(self.size);
         received
     }
     fn all_gather(&self, data: Vec<u8>) -> Vec<Vec<u8>> {
@@ -535,6 +581,26 @@ impl<'a> Reader<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A thread of a group that panics makes the others panic at their next exchange,
+    /// instead of leaving them waiting for it forever.
+    #[test]
+    fn a_thread_that_panics_breaks_its_group() {
+        let handles: Vec<_> = Threads::group(3)
+            .into_iter()
+            .map(|c| {
+                std::thread::spawn(move || {
+                    c.all_gather(vec![1]);
+                    if c.rank() == 1 {
+                        panic!("rank 1 fails");
+                    }
+                    c.all_gather(vec![2]);
+                })
+            })
+            .collect();
+        let ends: Vec<bool> = handles.into_iter().map(|h| h.join().is_err()).collect();
+        assert_eq!(ends, vec![true; 3]);
+    }
 
     #[test]
     fn threads_exchange_what_each_sends_to_each() {
