@@ -32,13 +32,3 @@ pub mod driver;
 
 // Layer 9: render, plot, text, analyze, bench.
 pub mod tools;
-
-// The public paths of the front ends (main.rs, python/) and the tests.
-pub use driver::{check, run};
-pub use engine as simulation;
-pub use engine::{records, spawn};
-pub use geometry::{mesh, surface};
-pub use io::{checkpoint, csv, files, lock, output, vtk};
-pub use model::{contact, exact, integrate, lanes, motion, particles, springs};
-pub use parallel::{comm, domain};
-pub use tools::{analyze, bench, fields, plot, render, text};

@@ -74,7 +74,7 @@ fn the_readmes_scenario_parses() {
     let t = tempfile::tempdir().unwrap();
     let path = t.path().join("pour.toml");
     std::fs::write(&path, &found[0].1).unwrap();
-    let mut sim = tinydem::simulation::Simulation::new(Scenario::load(&path).unwrap()).unwrap();
+    let mut sim = tinydem::engine::Simulation::new(Scenario::load(&path).unwrap()).unwrap();
     for _ in 0..2000 {
         sim.step().unwrap();
     }

@@ -652,7 +652,7 @@ fn tag_regions_label_particles_and_add_a_tag_column() {
         assert_eq!(r[14], if r[0] <= 0.0 { 3.0 } else { 4.0 }, "{r:?}");
     }
     // The tagged frame reads back, tags included.
-    let p = tinydem::csv::load_particles(&t.path().join("output/particles000002.csv")).unwrap();
+    let p = tinydem::io::csv::load_particles(&t.path().join("output/particles000002.csv")).unwrap();
     assert!(p.tag.iter().all(|&t| t == 3 || t == 4));
 }
 
@@ -956,7 +956,7 @@ fn output_of_another_run_is_not_mixed_in() {
     );
     // A live process holds the directory (this test, with the lock), then nobody: the file
     // left by a killed run names a process that lives (this test's, a reused id) or not.
-    let held = tinydem::lock::Lock::take(&out).unwrap();
+    let held = tinydem::io::lock::Lock::take(&out).unwrap();
     let o = tinydem(&["run", "short.toml", "-q", "--overwrite"], t.path());
     fails_with(&o, &["another tinydem run (process", "is writing into"]);
     drop(held);
@@ -1084,7 +1084,9 @@ fn the_log_follows_the_state_frame_by_frame() {
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
     assert_eq!(
         header,
-        tinydem::run::LOG_HEADER.split(',').collect::<Vec<_>>()
+        tinydem::driver::run::LOG_HEADER
+            .split(',')
+            .collect::<Vec<_>>()
     );
     let rows: Vec<Vec<f64>> = lines
         .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())

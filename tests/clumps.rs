@@ -5,10 +5,10 @@
 use crate::common;
 
 use glam::{DQuat, DVec3};
-use tinydem::particles::Particles;
-use tinydem::records::Partner;
+use tinydem::engine::records::Partner;
+use tinydem::engine::{Overlap, Simulation};
+use tinydem::model::particles::Particles;
 use tinydem::scenario::Scenario;
-use tinydem::simulation::{Overlap, Simulation};
 
 const R: f64 = 0.005;
 const G: f64 = 9.81;
@@ -285,8 +285,8 @@ fn a_snapshot_of_clumps_resumes_bit_for_bit() {
     for _ in 0..700 {
         a.step().unwrap();
     }
-    let bytes = tinydem::records::encode(&a.snapshot().unwrap(), 7);
-    let snapshot = tinydem::records::decode(&bytes, Some(7)).unwrap();
+    let bytes = tinydem::engine::records::encode(&a.snapshot().unwrap(), 7);
+    let snapshot = tinydem::engine::records::decode(&bytes, Some(7)).unwrap();
     assert_eq!(snapshot.particles, a.particles);
     let mut b = Simulation::restore(common::scenario(POUR), snapshot).unwrap();
     for _ in 0..500 {
@@ -557,7 +557,7 @@ fn a_fixed_box_holds_the_clumps_whose_centre_it_holds() {
     let other = &s.particles.bodies.list[1];
     assert!(other.x.z < 0.04 && other.x.z > 0.005, "{}", other.x.z);
     let mut csv = Vec::new();
-    tinydem::csv::write_particles(&mut csv, &s.particles, Default::default()).unwrap();
+    tinydem::io::csv::write_particles(&mut csv, &s.particles, Default::default()).unwrap();
     let csv = String::from_utf8(csv).unwrap();
     let rows: Vec<&str> = csv.lines().collect();
     assert!(rows[0].ends_with(",fixed,clump"), "{}", rows[0]);

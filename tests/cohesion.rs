@@ -7,10 +7,10 @@ use crate::common;
 use std::f64::consts::PI;
 
 use glam::{DQuat, DVec3};
-use tinydem::integrate::Inertia;
-use tinydem::mesh::Mesh;
-use tinydem::particles::{Particle, Particles};
-use tinydem::simulation::Simulation;
+use tinydem::engine::Simulation;
+use tinydem::geometry::mesh::Mesh;
+use tinydem::model::integrate::Inertia;
+use tinydem::model::particles::{Particle, Particles};
 
 const R: f64 = 0.005;
 const E: f64 = 1e6;

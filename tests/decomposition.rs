@@ -6,10 +6,10 @@
 
 use crate::common;
 
-use tinydem::comm::{Comm, Threads};
-use tinydem::particles::Particles;
+use tinydem::engine::{Simulation, Wrench};
+use tinydem::model::particles::Particles;
+use tinydem::parallel::comm::{Comm, Threads};
 use tinydem::scenario::Scenario;
-use tinydem::simulation::{Simulation, Wrench};
 
 /// Each particle's id with the bits of its state, in id order.
 fn state_by_id(sim: &Simulation) -> Vec<(u64, Vec<u64>)> {
@@ -326,9 +326,9 @@ fn checkpoint_on_2_resumes_on_3(
     let path = dir.path().join("checkpoint.bin");
     for (k, piece) in pieces.iter().enumerate() {
         assert!(piece.particles.len() < snapshot.particles.len());
-        tinydem::checkpoint::save_part(&path, k, 2, piece, 7).unwrap();
+        tinydem::io::checkpoint::save_part(&path, k, 2, piece, 7).unwrap();
     }
-    let joined = tinydem::checkpoint::load(&path, Some(7)).unwrap();
+    let joined = tinydem::io::checkpoint::load(&path, Some(7)).unwrap();
     assert!(joined == snapshot, "the parts should join to the snapshot");
     // Resumed on 3 processes, and in one.
     let resumed = {
@@ -345,7 +345,7 @@ fn checkpoint_on_2_resumes_on_3(
         let (path, make, n) = (path.clone(), make.clone(), snapshot.particles.len());
         let open = move |comm: Threads| {
             let share = (comm.rank(), comm.size());
-            let piece = tinydem::checkpoint::load_share(&path, Some(7), share).unwrap();
+            let piece = tinydem::io::checkpoint::load_share(&path, Some(7), share).unwrap();
             let piece = piece.expect("a checkpoint in parts");
             assert!(piece.particles.len() < n, "no process reads all parts");
             let (sim, pending) = Simulation::restore_share(make(), piece).unwrap();
@@ -401,7 +401,7 @@ fn split_resume(
 
 #[test]
 fn the_output_of_a_split_run_is_that_of_one_process_byte_for_byte() {
-    use tinydem::run::{Options, Verbosity, run_on};
+    use tinydem::driver::run::{Options, Verbosity, run_on};
     let mut text = silo(0.5);
     text.push_str("contacts = true\nformats = [\"csv\", \"vtk\"]\n");
     text = text.replace(
@@ -417,7 +417,7 @@ fn the_output_of_a_split_run_is_that_of_one_process_byte_for_byte() {
         requests: None,
     };
     let one = tempfile::tempdir().unwrap();
-    tinydem::run::run(common::scenario(&text), one.path(), options).unwrap();
+    tinydem::driver::run::run(common::scenario(&text), one.path(), options).unwrap();
     let split = tempfile::tempdir().unwrap();
     let handles: Vec<_> = Threads::group(3)
         .into_iter()

@@ -7,10 +7,10 @@ use crate::common;
 use std::collections::{BTreeMap, BTreeSet};
 
 use glam::{DQuat, DVec3};
-use tinydem::integrate::Inertia;
-use tinydem::mesh::Mesh;
-use tinydem::particles::{Particle, Particles};
-use tinydem::simulation::Simulation;
+use tinydem::engine::Simulation;
+use tinydem::geometry::mesh::Mesh;
+use tinydem::model::integrate::Inertia;
+use tinydem::model::particles::{Particle, Particles};
 
 const R: f64 = 0.004;
 const RHO: f64 = 1000.0;
@@ -302,7 +302,7 @@ fn a_run_logs_outlets_and_wall_loads_and_resumes_them() {
 /// balance under its contacts and gravity, and each contact point lies r_i from the centre.
 #[test]
 fn the_contact_network_of_a_settled_bed_balances_every_grain() {
-    use tinydem::simulation::Partner;
+    use tinydem::engine::Partner;
     let sim = settled_bed(14_000);
     let network = sim.contact_network();
     let p = &sim.particles;
@@ -416,7 +416,7 @@ fn ids_beyond_2_to_the_32_round_trip_through_frames_and_checkpoints() {
     std::fs::write(dir.path().join("s1.toml"), one_step).unwrap();
     run(&["run", "s1.toml", "-o", "step", "-q"]);
     let snapshot =
-        tinydem::checkpoint::load(&dir.path().join("step/checkpoint.bin"), None).unwrap();
+        tinydem::io::checkpoint::load(&dir.path().join("step/checkpoint.bin"), None).unwrap();
     assert_eq!(snapshot.particles.next_id, (1 << 40) + 1);
     assert!(
         snapshot

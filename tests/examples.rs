@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use tinydem::run::{Options, Verbosity, run};
+use tinydem::driver::run::{Options, Verbosity, run};
 use tinydem::scenario::Scenario;
 
 #[test]

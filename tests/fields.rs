@@ -6,10 +6,10 @@
 use crate::common;
 
 use glam::{DQuat, DVec3};
-use tinydem::fields::{Grid, Kernel, Sums};
-use tinydem::integrate::Inertia;
-use tinydem::particles::{Particle, Particles};
-use tinydem::simulation::Simulation;
+use tinydem::engine::Simulation;
+use tinydem::model::integrate::Inertia;
+use tinydem::model::particles::{Particle, Particles};
+use tinydem::tools::fields::{Grid, Kernel, Sums};
 
 const RHO: f64 = 2500.0;
 const G: f64 = 9.81;

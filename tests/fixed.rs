@@ -5,11 +5,11 @@
 use crate::common;
 
 use glam::DVec3;
-use tinydem::csv::{Extra, read_particles, write_particles};
-use tinydem::integrate::Inertia;
-use tinydem::mesh::Mesh;
-use tinydem::particles::{Particle, Particles};
-use tinydem::simulation::Simulation;
+use tinydem::engine::Simulation;
+use tinydem::geometry::mesh::Mesh;
+use tinydem::io::csv::{Extra, read_particles, write_particles};
+use tinydem::model::integrate::Inertia;
+use tinydem::model::particles::{Particle, Particles};
 
 const R: f64 = 0.005;
 const RHO: f64 = 1000.0;

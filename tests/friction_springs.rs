@@ -6,11 +6,11 @@
 use crate::common;
 
 use glam::DVec3;
-use tinydem::integrate::Inertia;
-use tinydem::mesh::Mesh;
-use tinydem::particles::{Particle, Particles};
+use tinydem::engine::Simulation;
+use tinydem::geometry::mesh::Mesh;
+use tinydem::model::integrate::Inertia;
+use tinydem::model::particles::{Particle, Particles};
 use tinydem::scenario::Scenario;
-use tinydem::simulation::Simulation;
 
 const R: f64 = 0.005;
 const RHO: f64 = 1000.0;

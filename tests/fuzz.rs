@@ -5,9 +5,9 @@
 use std::path::Path;
 
 use proptest::prelude::*;
-use tinydem::checkpoint;
-use tinydem::csv::read_particles;
-use tinydem::mesh::Mesh;
+use tinydem::geometry::mesh::Mesh;
+use tinydem::io::checkpoint;
+use tinydem::io::csv::read_particles;
 use tinydem::scenario::Scenario;
 
 fn config() -> ProptestConfig {
@@ -153,8 +153,8 @@ proptest! {
     }
 }
 
-fn sample_snapshot() -> tinydem::simulation::Snapshot {
-    let sim = tinydem::simulation::Simulation::from_parts(
+fn sample_snapshot() -> tinydem::engine::Snapshot {
+    let sim = tinydem::engine::Simulation::from_parts(
         Scenario::parse("[simulation]\nframes = 1\n", Path::new("s.toml")).unwrap(),
         Mesh::default(),
         read_particles(CSV.as_bytes(), "fuzz.csv").unwrap(),

@@ -5,11 +5,11 @@
 use std::path::Path;
 
 use glam::{DQuat, DVec3};
-use tinydem::bench::proc_status_bytes;
-use tinydem::mesh::Mesh;
-use tinydem::particles::{Particle, Particles};
+use tinydem::engine::Simulation;
+use tinydem::geometry::mesh::Mesh;
+use tinydem::model::particles::{Particle, Particles};
 use tinydem::scenario::Scenario;
-use tinydem::simulation::Simulation;
+use tinydem::tools::bench::proc_status_bytes;
 
 fn pair(speed: f64) -> Simulation {
     let s = Scenario::parse(

@@ -5,10 +5,10 @@
 use crate::common;
 
 use glam::DVec3;
-use tinydem::integrate::Inertia;
-use tinydem::mesh::{Contacts, Mesh};
-use tinydem::particles::{Particle, Particles};
-use tinydem::simulation::Simulation;
+use tinydem::engine::Simulation;
+use tinydem::geometry::mesh::{Contacts, Mesh};
+use tinydem::model::integrate::Inertia;
+use tinydem::model::particles::{Particle, Particles};
 
 const R: f64 = 0.005;
 const RHO: f64 = 1000.0;

@@ -2,8 +2,8 @@
 
 use std::path::Path;
 
+use tinydem::engine::Simulation;
 use tinydem::scenario::Scenario;
-use tinydem::simulation::Simulation;
 
 const R: f64 = 0.005;
 

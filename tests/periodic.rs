@@ -5,9 +5,9 @@
 use crate::common;
 
 use glam::{DQuat, DVec3};
-use tinydem::integrate::Inertia;
-use tinydem::particles::{Particle, Particles};
-use tinydem::simulation::Simulation;
+use tinydem::engine::Simulation;
+use tinydem::model::integrate::Inertia;
+use tinydem::model::particles::{Particle, Particles};
 
 const R: f64 = 0.004;
 

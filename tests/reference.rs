@@ -5,10 +5,10 @@
 
 use crate::common;
 
-use tinydem::csv::{frame_name, load_particles};
-use tinydem::particles::Particle;
+use tinydem::engine::Simulation;
+use tinydem::io::csv::{frame_name, load_particles};
+use tinydem::model::particles::Particle;
 use tinydem::scenario::Scenario;
-use tinydem::simulation::Simulation;
 
 fn column(p: &Particle, c: &str) -> f64 {
     match c {

@@ -8,8 +8,8 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use tinydem::checkpoint;
-use tinydem::csv::load_particles;
+use tinydem::io::checkpoint;
+use tinydem::io::csv::load_particles;
 
 const HEADER: &str = "x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz\n";
 
@@ -322,7 +322,7 @@ fn forged_checkpoints_are_refused_by_their_content() {
     let fingerprint = u64::from_le_bytes(bytes[16..24].try_into().unwrap());
     let good = checkpoint::decode(&bytes, Some(fingerprint)).unwrap();
     assert!(good.particles.len() > 10);
-    type Forge = fn(&mut tinydem::particles::Particles);
+    type Forge = fn(&mut tinydem::model::particles::Particles);
     let forgeries: [(Forge, &str); 5] = [
         (
             |p| p.material[0] = 7,
@@ -367,7 +367,7 @@ fn forged_checkpoints_are_refused_by_their_content() {
         &["the friction springs of contact"],
     );
     // Counts that do not fit the scenario: spawn regions, mesh files, outlets.
-    type Recount = fn(&mut tinydem::simulation::Snapshot);
+    type Recount = fn(&mut tinydem::engine::Snapshot);
     let recounts: [(Recount, &str); 3] = [
         (
             |s| s.spawner.regions = vec![Default::default(); 2],
@@ -533,8 +533,8 @@ fn a_pair_squeezed_past_the_smaller_radius_goes_on_with_one_warning() {
     // (15 m* v² / (16 E* sqrt(R*)))^(2/5) = 2.5 mm, lies between the small radius and its
     // diameter. The grain rebounds; the run goes on with one warning for the pair.
     use glam::{DQuat, DVec3};
-    use tinydem::particles::{Particle, Particles};
-    use tinydem::simulation::Simulation;
+    use tinydem::engine::Simulation;
+    use tinydem::model::particles::{Particle, Particles};
     let s = common::scenario(
         "[geometry]\nradius_min = 0.002\nradius_max = 0.01\n\
          [material]\nrestitution = 1.0\nfriction_sliding = 0.0\nfriction_rolling = 0.0\n\

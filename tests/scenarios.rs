@@ -3,9 +3,9 @@
 
 use std::path::{Path, PathBuf};
 
-use tinydem::mesh::Contacts;
+use tinydem::engine::Simulation;
+use tinydem::geometry::mesh::Contacts;
 use tinydem::scenario::{FrictionSprings, Scenario};
-use tinydem::simulation::Simulation;
 
 fn files(kind: &str) -> Vec<PathBuf> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -5,8 +5,8 @@
 
 use crate::common;
 
-use tinydem::integrate::Inertia;
-use tinydem::simulation::Simulation;
+use tinydem::engine::Simulation;
+use tinydem::model::integrate::Inertia;
 
 /// A stage `text` started from the state of `before` (or fresh), stepped `steps` times;
 /// `each` sees the simulation after every step.

@@ -7,14 +7,14 @@ use crate::common;
 use std::f64::consts::PI;
 
 use glam::DVec3;
-use tinydem::check;
-use tinydem::contact::damping_factor;
-use tinydem::integrate::Inertia;
+use tinydem::driver::check;
+use tinydem::engine::Simulation;
+use tinydem::engine::setup::Inputs;
 use tinydem::io::inputs;
-use tinydem::particles::Particles;
+use tinydem::model::contact::damping_factor;
+use tinydem::model::integrate::Inertia;
+use tinydem::model::particles::Particles;
 use tinydem::scenario::Scenario;
-use tinydem::simulation::Simulation;
-use tinydem::simulation::setup::Inputs;
 
 const R: f64 = 0.005;
 const RHO: f64 = 1000.0;

@@ -3,7 +3,7 @@
 
 use crate::common;
 
-use tinydem::simulation::Simulation;
+use tinydem::engine::Simulation;
 
 fn sim(spawn: &str, extra: &str, attempts: u32) -> Simulation {
     common::simulate(

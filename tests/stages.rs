@@ -73,7 +73,7 @@ fn a_stage_that_only_adds_frames_gives_the_bits_of_one_run() {
         said.contains("spawning continues the random stream"),
         "{said}"
     );
-    let snapshot = tinydem::checkpoint::load(&d.join("first/checkpoint.bin"), None).unwrap();
+    let snapshot = tinydem::io::checkpoint::load(&d.join("first/checkpoint.bin"), None).unwrap();
     // 47 touching pairs of the 300 grains (measured).
     assert!(
         snapshot.pair_history.len() > 30,

@@ -133,7 +133,10 @@ fn time_and_removals_end_a_run_at_their_frame() {
     pour(t.path(), 2, "", "");
     run(t.path(), &["run", "s.toml", "-q", "-o", "plain"]);
     let text = std::fs::read_to_string(t.path().join("plain/log.csv")).unwrap();
-    assert_eq!(text.lines().next().unwrap(), tinydem::run::LOG_HEADER);
+    assert_eq!(
+        text.lines().next().unwrap(),
+        tinydem::driver::run::LOG_HEADER
+    );
 }
 
 #[test]

@@ -2,7 +2,7 @@
 
 use std::sync::atomic::Ordering;
 
-use tinydem::run::{Options, Verbosity};
+use tinydem::driver::run::{Options, Verbosity};
 
 use super::*;
 
@@ -25,7 +25,7 @@ pub(crate) fn run(
     let s = Scenario::load(&scenario).map_err(input_error)?;
     let out = output.unwrap_or_else(|| s.output_dir.clone());
     let pool = pool(threads)?;
-    let requests = tinydem::run::Requests::default();
+    let requests = tinydem::driver::run::Requests::default();
     let options = Options {
         verbosity: if quiet {
             Verbosity::Quiet
@@ -42,7 +42,7 @@ pub(crate) fn run(
     // after its current step with a checkpoint (as on the command line).
     let mut interrupt = None;
     let result = std::thread::scope(|scope| {
-        let running = scope.spawn(|| pool.install(|| tinydem::run::run(s, &out, options)));
+        let running = scope.spawn(|| pool.install(|| tinydem::driver::run::run(s, &out, options)));
         while !running.is_finished() {
             py.detach(|| std::thread::sleep(std::time::Duration::from_millis(20)));
             if let Err(e) = py.check_signals() {
@@ -76,7 +76,9 @@ pub(crate) fn run(
         }
         (Err(e), Some(signal)) => {
             // A stop with its checkpoint is said by the run itself.
-            if e.downcast_ref::<tinydem::run::Interrupted>().is_none() {
+            if e.downcast_ref::<tinydem::driver::run::Interrupted>()
+                .is_none()
+            {
                 eprintln!("{e:#}");
             }
             Err(signal)
@@ -110,7 +112,7 @@ pub(crate) fn render<'py>(
     scale_bar: bool,
     scenario: Option<PathBuf>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    use tinydem::render::{Animation, ColorBy, Fixed, Style, View};
+    use tinydem::tools::render::{Animation, ColorBy, Fixed, Style, View};
     let color = match color {
         "speed" => ColorBy::Speed,
         "height" => ColorBy::Height,
@@ -154,7 +156,7 @@ pub(crate) fn render<'py>(
     let animation = Animation::of(gif, movie);
     let done = guarded(|| {
         py.detach(|| {
-            tinydem::render::render_path(
+            tinydem::tools::render::render_path(
                 &path,
                 output.as_deref(),
                 scenario.as_deref(),
@@ -199,7 +201,7 @@ pub(crate) fn fields<'py>(
     average: bool,
     bounds: Option<([f64; 3], [f64; 3])>,
 ) -> PyResult<Vec<Bound<'py, PyDict>>> {
-    use tinydem::fields::{Options, Shape, of_directory};
+    use tinydem::tools::fields::{Options, Shape, of_directory};
     let shape = match kernel {
         "gaussian" => Shape::Gaussian,
         "lucy" => Shape::Lucy,
@@ -281,7 +283,7 @@ pub(crate) fn read_csv<'py>(
     py: Python<'py>,
     path: PathBuf,
 ) -> PyResult<(Vec<String>, Bound<'py, PyArray2<f64>>)> {
-    let text = tinydem::files::read_to_string(&path)
+    let text = tinydem::io::files::read_to_string(&path)
         .map_err(|e| os_error(e.kind(), format!("cannot read {}: {e}", path.display())))?;
     let mut lines = text.lines();
     let header: Vec<String> = lines

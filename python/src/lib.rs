@@ -17,14 +17,14 @@ use pyo3::exceptions::{
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use tinydem::csv::Extra;
+use tinydem::io::csv::Extra;
 use tinydem::scenario::Scenario;
 
 /// An error of the engine as a Python exception, with its whole chain of causes: a file
 /// not found, there already or not permitted as the OSError of its kind, other failures to
 /// read or write as OSError, and the rest as RuntimeError.
 fn error(e: anyhow::Error) -> PyErr {
-    if e.downcast_ref::<tinydem::run::Refused>().is_some() {
+    if e.downcast_ref::<tinydem::driver::run::Refused>().is_some() {
         return PyValueError::new_err(pythonic(&format!("{e:#}")));
     }
     match io_kind(&e) {
@@ -140,7 +140,7 @@ fn guarded<T>(f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
 /// `force=True`.
 #[pyclass(module = "tinydem")]
 struct Simulation {
-    sim: tinydem::simulation::Simulation,
+    sim: tinydem::engine::Simulation,
     pool: Arc<rayon::ThreadPool>,
     /// The diagnosis of the step that became unstable, if one did.
     unstable: Option<String>,
@@ -246,14 +246,16 @@ impl Simulation {
         let pool = pool(threads)?;
         let s = Scenario::load(&scenario).map_err(input_error)?;
         let (sim, _) = guarded(|| {
-            pool.install(|| tinydem::run::open(s, resume.as_deref(), from_checkpoint.as_deref()))
-                .map_err(input_error)
+            pool.install(|| {
+                tinydem::driver::run::open(s, resume.as_deref(), from_checkpoint.as_deref())
+            })
+            .map_err(input_error)
         })?;
         // What the command line refuses (unless --force) and what it warns of.
-        let n = tinydem::check::most_particles(&sim.scenario, sim.particle_count())
+        let n = tinydem::driver::check::most_particles(&sim.scenario, sim.particle_count())
             + sim.removed.count() as usize;
         let out = sim.scenario.output_dir.clone();
-        let refused = tinydem::check::refusals(&sim.scenario, n, &out);
+        let refused = tinydem::driver::check::refusals(&sim.scenario, n, &out);
         if !refused.is_empty() && !force {
             return Err(PyValueError::new_err(format!(
                 "{} (pass force=True to run it anyway)",
@@ -263,7 +265,7 @@ impl Simulation {
         for why in refused {
             warn(py, &format!("{why} (forced)"))?;
         }
-        for caution in tinydem::check::cautions(&sim.scenario) {
+        for caution in tinydem::driver::check::cautions(&sim.scenario) {
             warn(py, &caution)?;
         }
         Ok(Simulation {
@@ -302,7 +304,7 @@ impl Simulation {
                                 sim.step()?;
                                 done += 1;
                             }
-                            Ok::<u64, tinydem::simulation::Unstable>(done)
+                            Ok::<u64, tinydem::engine::Unstable>(done)
                         })
                     })
                     .map_err(|e| e.to_string()))
@@ -457,8 +459,8 @@ impl Simulation {
                 r[k]
             )));
         }
-        let new: Vec<tinydem::particles::Particle> = (0..n)
-            .map(|k| tinydem::particles::Particle {
+        let new: Vec<tinydem::model::particles::Particle> = (0..n)
+            .map(|k| tinydem::model::particles::Particle {
                 x: x[k],
                 radius: r[k],
                 v: v[k],
@@ -673,7 +675,7 @@ impl Simulation {
             .file_name()
             .ok_or_else(|| PyValueError::new_err("write_frame needs a file name"))?;
         guarded(|| {
-            tinydem::csv::write_frame_as(
+            tinydem::io::csv::write_frame_as(
                 dir.unwrap_or(std::path::Path::new(".")),
                 &name.to_string_lossy(),
                 &self.sim.particles_in_domain(),
@@ -687,7 +689,7 @@ impl Simulation {
     /// Writes a checkpoint: `tinydem run --resume` (or `Simulation(..., resume=path)`)
     /// continues it exactly; `--from` starts a new stage from it.
     fn checkpoint(&self, path: PathBuf) -> PyResult<()> {
-        guarded(|| tinydem::run::write_checkpoint(&path, &self.sim).map_err(error))
+        guarded(|| tinydem::driver::run::write_checkpoint(&path, &self.sim).map_err(error))
     }
 
     fn __repr__(&self) -> String {
@@ -723,10 +725,10 @@ fn _tinydem(m: &Bound<'_, PyModule>) -> PyResult<()> {
 }
 
 /// The engine's overlap rule for an `allow_overlap` argument.
-fn overlap(allow: bool) -> tinydem::simulation::Overlap {
+fn overlap(allow: bool) -> tinydem::engine::Overlap {
     match allow {
-        true => tinydem::simulation::Overlap::Allowed,
-        false => tinydem::simulation::Overlap::Refused,
+        true => tinydem::engine::Overlap::Allowed,
+        false => tinydem::engine::Overlap::Refused,
     }
 }
 

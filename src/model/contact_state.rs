@@ -10,12 +10,12 @@ use crate::model::springs::Springs;
 // optional ones when a run asks for them.
 contact_fields! {
     core {
-    /// The static friction springs (Table 3): sliding, rolling and twisting.
-    springs: Springs;
+        /// The static friction springs (Table 3): sliding, rolling and twisting.
+        springs: Springs;
     }
     optional {
-    #[cfg(test)]
-    /// The steps the contact has touched (the state of the tests' sub-model).
-    touches: u32;
+        #[cfg(test)]
+        /// The steps the contact has touched (the state of the tests' sub-model).
+        touches: u32;
     }
 }

@@ -18,33 +18,33 @@ pub use crate::model::id::{Id, MAX_ID};
 // only when a run asks for it) whether ghosts receive it and its unit.
 particle_fields! {
     core {
-    /// x \[L\]
-    x: DVec3, ghost: true, checkpoint: Some(2);
-    /// R \[L\]
-    radius: f64, ghost: false, checkpoint: Some(2);
-    /// v [L/T]
-    v: DVec3, ghost: true, checkpoint: Some(2);
-    /// Orientation q̂, mapping body to world coordinates.
-    q: DQuat, ghost: true, checkpoint: Some(2);
-    /// ω [1/T], world frame.
-    w: DVec3, ghost: true, checkpoint: Some(2);
-    /// A label per particle (0 by default), set by `[[tags]]` regions, e.g. to dye grains by
-    /// the path they took.
-    tag: u32, ghost: true, checkpoint: Some(2);
-    /// The index of each particle's material in `[[materials]]` (0: the first, or the one
-    /// `[material]`).
-    material: u16, ghost: false, checkpoint: Some(3);
-    /// Whether each particle is fixed: held in place and at rest, whatever acts on it
-    /// (`[[fixed]]` boxes, the `fixed` column, Python's `freeze`).
-    fixed: bool, ghost: false, checkpoint: Some(5);
-    /// The rigid body (clump) each particle is a sphere of, if any: its state is the
-    /// body's, which `bodies` holds (and checkpoints hold apart).
-    body: Option<BodyId>, ghost: false, checkpoint: None::<u32>;
+        /// x \[L\]
+        x: DVec3, ghost: true, checkpoint: Some(2);
+        /// R \[L\]
+        radius: f64, ghost: false, checkpoint: Some(2);
+        /// v [L/T]
+        v: DVec3, ghost: true, checkpoint: Some(2);
+        /// Orientation q̂, mapping body to world coordinates.
+        q: DQuat, ghost: true, checkpoint: Some(2);
+        /// ω [1/T], world frame.
+        w: DVec3, ghost: true, checkpoint: Some(2);
+        /// A label per particle (0 by default), set by `[[tags]]` regions, e.g. to dye grains by
+        /// the path they took.
+        tag: u32, ghost: true, checkpoint: Some(2);
+        /// The index of each particle's material in `[[materials]]` (0: the first, or the one
+        /// `[material]`).
+        material: u16, ghost: false, checkpoint: Some(3);
+        /// Whether each particle is fixed: held in place and at rest, whatever acts on it
+        /// (`[[fixed]]` boxes, the `fixed` column, Python's `freeze`).
+        fixed: bool, ghost: false, checkpoint: Some(5);
+        /// The rigid body (clump) each particle is a sphere of, if any: its state is the
+        /// body's, which `bodies` holds (and checkpoints hold apart).
+        body: Option<BodyId>, ghost: false, checkpoint: None::<u32>;
     }
     optional {
-    #[cfg(test)]
-    /// A number the tests carry through messages, checkpoints and frames.
-    probe: f64, ghost: true, unit: "-";
+        #[cfg(test)]
+        /// A number the tests carry through messages, checkpoints and frames.
+        probe: f64, ghost: true, unit: "-";
     }
 }
 

@@ -5,9 +5,9 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use glam::{DQuat, DVec3};
-use tinydem::particles::Particle;
+use tinydem::engine::Simulation;
+use tinydem::model::particles::Particle;
 use tinydem::scenario::Scenario;
-use tinydem::simulation::Simulation;
 
 pub fn data(path: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -6,12 +6,12 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use clap::Args;
 
-use tinydem::analyze::{
+use tinydem::model::particles::Particles;
+use tinydem::scenario::Scenario;
+use tinydem::tools::analyze::{
     NoPile, ReposeWindow, angle_of_repose, coordination_number, drum_angle, kinetic_energy,
     mean_height_of_large, packing_fraction,
 };
-use tinydem::particles::Particles;
-use tinydem::scenario::Scenario;
 
 #[derive(Args)]
 pub struct AnalyzeArgs {
@@ -131,7 +131,7 @@ enum AxisArg {
 impl FieldArgs {
     /// The fields of the frames of `dir`, with a line per file written.
     fn execute(&self, dir: &Path, scenario: Option<&Path>) -> Result<()> {
-        use tinydem::fields::{Options, Shape, of_directory};
+        use tinydem::tools::fields::{Options, Shape, of_directory};
         if self.frames.as_ref().is_some_and(|f| f.len() != 2) {
             anyhow::bail!("--frames takes two frame numbers, FROM,TO");
         }
@@ -191,7 +191,7 @@ impl AnalyzeArgs {
             .transpose()?;
         let s = match self
             .scenario
-            .or_else(|| tinydem::output::run_toml(&self.dir))
+            .or_else(|| tinydem::io::output::run_toml(&self.dir))
         {
             Some(p) => Scenario::load(&p)?,
             None => Scenario::parse("", Path::new("defaults"))?,
@@ -238,7 +238,7 @@ impl AnalyzeArgs {
         }
         if let Some(path) = self.plot {
             let text = format!("{}\n{}\n", header.join(","), rows.join("\n"));
-            let table = tinydem::plot::Table::parse(&text, "the table")?;
+            let table = tinydem::tools::plot::Table::parse(&text, "the table")?;
             let y: Vec<&str> = self.column.iter().map(String::as_str).collect();
             crate::plot::draw(&table, "time", &y, self.style, &path)?;
         }
@@ -253,7 +253,7 @@ fn frames_in(dir: &Path) -> Result<Vec<(u64, PathBuf)>> {
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter_map(|p| {
             let k = tinydem::io::pieces::frame_number(p.file_name()?.to_str()?)?;
-            Some((k, dir.join(tinydem::csv::frame_name(k))))
+            Some((k, dir.join(tinydem::io::csv::frame_name(k))))
         })
         .collect();
     frames.sort();
@@ -276,7 +276,7 @@ const COLUMN: usize = 22;
 
 /// The drum of a scenario, for `--drum`: its centre, axis and the direction of gravity.
 fn drum_of(s: &Scenario) -> Result<(glam::DVec3, glam::DVec3, glam::DVec3)> {
-    use tinydem::motion::Motion;
+    use tinydem::model::motion::Motion;
     use tinydem::scenario::{MeshInput, Shape};
     let found = s.meshes.iter().find_map(|m| match (&m.input, m.motion) {
         (MeshInput::Shape(Shape::Drum { center, axis, .. }), _) => Some((*center, *axis)),

@@ -4,7 +4,7 @@
 use anyhow::{Context, Result};
 use clap::Args;
 
-use tinydem::comm::Comm;
+use tinydem::parallel::comm::Comm;
 
 #[derive(Args)]
 pub struct BenchArgs {
@@ -47,8 +47,10 @@ impl BenchArgs {
         anyhow::ensure!(self.repeats >= 1, "--repeats must be at least 1");
         if self.single {
             let n = self.sizes[0];
-            let steps = self.steps.unwrap_or(tinydem::bench::default_steps(n));
-            let m = tinydem::bench::measure((n, self.clumps), steps, self.repeats, world)?;
+            let steps = self
+                .steps
+                .unwrap_or(tinydem::tools::bench::default_steps(n));
+            let m = tinydem::tools::bench::measure((n, self.clumps), steps, self.repeats, world)?;
             if first {
                 println!("{}", m.row());
             }
@@ -73,7 +75,7 @@ impl BenchArgs {
             self.workers.clone()
         };
         let exe = std::env::current_exe().context("cannot locate the tinydem executable")?;
-        println!("{}", tinydem::bench::Measurement::HEADER);
+        println!("{}", tinydem::tools::bench::Measurement::HEADER);
         for &n in &self.sizes {
             for (&t, &r) in workers
                 .iter()

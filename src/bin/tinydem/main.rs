@@ -13,9 +13,9 @@ use std::process::ExitCode;
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
 
-use tinydem::check::{describe, describe_stage};
-use tinydem::comm::Comm;
-use tinydem::run::Interrupted;
+use tinydem::driver::check::{describe, describe_stage};
+use tinydem::driver::run::Interrupted;
+use tinydem::parallel::comm::Comm;
 use tinydem::scenario::Scenario;
 
 use run::RunOptions;
@@ -89,7 +89,7 @@ impl CheckpointCommand {
     fn execute(self) -> Result<()> {
         match self {
             CheckpointCommand::Merge { checkpoint } => {
-                let n = tinydem::checkpoint::merge(&checkpoint)?;
+                let n = tinydem::io::checkpoint::merge(&checkpoint)?;
                 eprintln!("joined {n} parts into {}", checkpoint.display());
                 Ok(())
             }
@@ -138,7 +138,7 @@ fn main() -> ExitCode {
     fix_mmap_threshold();
     let cli = Cli::parse();
     // Under mpirun, the first process speaks for all (they fail alike, see `domain::agree`).
-    let first = tinydem::comm::launched().is_none_or(|(_, rank)| rank == 0);
+    let first = tinydem::parallel::comm::launched().is_none_or(|(_, rank)| rank == 0);
     // Held to the end, after the last words: only then may the other processes exit
     // (see `Finalize`).
     let (world, _finalize) = match world() {
@@ -165,20 +165,20 @@ fn last_words(first: bool, outcome: Result<()>) -> ExitCode {
 
 /// Holds MPI initialized until dropped (nothing without the `mpi` feature).
 #[cfg(feature = "mpi")]
-type Finalize = Option<tinydem::comm::Finalize>;
+type Finalize = Option<tinydem::parallel::comm::Finalize>;
 #[cfg(not(feature = "mpi"))]
 type Finalize = ();
 
 /// The processes a run is split over when started by an MPI launcher (in a build with the
 /// `mpi` feature); none otherwise.
 fn world() -> Result<(Option<Box<dyn Comm>>, Finalize)> {
-    let Some((size, _)) = tinydem::comm::launched() else {
+    let Some((size, _)) = tinydem::parallel::comm::launched() else {
         return Ok((None, Finalize::default()));
     };
     #[cfg(feature = "mpi")]
     {
         let _ = size;
-        let (comm, finalize) = tinydem::comm::Mpi::init()?;
+        let (comm, finalize) = tinydem::parallel::comm::Mpi::init()?;
         // (For the test that a panic on one process ends them all, tests/mpi.rs.)
         let panic_on = std::env::var("TINYDEM_TEST_PANIC_RANK").ok();
         if panic_on.and_then(|r| r.parse().ok()) == Some(comm.rank()) {
@@ -206,7 +206,7 @@ fn real_main(cli: Cli, world: Option<Box<dyn Comm>>) -> Result<()> {
         pool = pool.num_threads(n);
     } else if world.is_some() {
         let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-        pool = pool.num_threads((cores / tinydem::comm::processes_on_this_node()).max(1));
+        pool = pool.num_threads((cores / tinydem::parallel::comm::processes_on_this_node()).max(1));
     }
     // The time loop runs on a worker of the pool, so that small parallel loops run inline
     // instead of waking another thread for every stage.

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use clap::Args;
 
-use tinydem::plot::{self, Plot, Table};
+use tinydem::tools::plot::{self, Plot, Table};
 
 /// `tinydem plot FILE --y a,b`.
 #[derive(Args)]

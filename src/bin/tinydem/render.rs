@@ -6,7 +6,7 @@ use anyhow::Result;
 use clap::Args;
 use glam::DVec3;
 
-use tinydem::render::{Animation, ColorBy, Fixed, Style, View};
+use tinydem::tools::render::{Animation, ColorBy, Fixed, Style, View};
 
 #[derive(Args)]
 pub struct RenderArgs {
@@ -64,7 +64,7 @@ impl RenderArgs {
         };
         let fixed = fixed(self.range, self.bounds)?;
         let animation = Animation::of(self.gif, self.movie);
-        let done = tinydem::render::render_path(
+        let done = tinydem::tools::render::render_path(
             &self.path,
             self.output.as_deref(),
             self.scenario.as_deref(),

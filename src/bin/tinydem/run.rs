@@ -7,10 +7,10 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use anyhow::{Context, Result};
 use clap::Args;
 
-use tinydem::comm::Comm;
-use tinydem::run::{Options, Requests, Summary, Verbosity, run_on};
+use tinydem::driver::run::{Options, Requests, Summary, Verbosity, run_on};
+use tinydem::engine::Stage;
+use tinydem::parallel::comm::Comm;
 use tinydem::scenario::Scenario;
-use tinydem::simulation::Stage;
 
 /// How a run goes: where it writes, what it says, what it continues. The same for
 /// `tinydem run SCENARIO` and the default run (`tinydem` with no command).
