@@ -94,7 +94,7 @@ fn split_run(
                 for _ in 0..steps {
                     sim.step().expect("stable");
                 }
-                let cuts = sim.domain().expect("split").cuts;
+                let cuts = sim.share().expect("split").cuts;
                 (rank, end_of(&mut sim), cuts)
             })
         })

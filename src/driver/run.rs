@@ -342,7 +342,7 @@ fn open_on(
         }
         let inputs = crate::io::inputs::read_share(&scenario, &*comm);
         let sim = inputs.and_then(|i| Simulation::from_inputs(scenario, i));
-        let sim = crate::parallel::domain::agree(&*comm, sim)?;
+        let sim = crate::parallel::decomposition::agree(&*comm, sim)?;
         return Ok((sim.split_shares(comm)?, Vec::new()));
     }
     if let Some(path) = options.resume {
@@ -352,7 +352,7 @@ fn open_on(
         }
     }
     let opened = open(scenario, options.resume, options.from);
-    let (sim, notes) = crate::parallel::domain::agree(&*comm, opened)?;
+    let (sim, notes) = crate::parallel::decomposition::agree(&*comm, opened)?;
     Ok((sim.split(comm)?, notes))
 }
 
@@ -372,7 +372,7 @@ fn resume_share(
         let share = (comm.rank(), comm.size());
         checkpoint::load_share(path, Some(fingerprint(&fresh)), share)
     };
-    let loaded = crate::parallel::domain::agree(comm, load())?;
+    let loaded = crate::parallel::decomposition::agree(comm, load())?;
     let (some, none) = (comm.any(loaded.is_some()), comm.any(loaded.is_none()));
     let Some(snapshot) = loaded.filter(|_| !none) else {
         anyhow::ensure!(
@@ -392,7 +392,7 @@ fn resume_share(
         path.display()
     );
     let restored = Simulation::restore_share(scenario.clone(), snapshot);
-    crate::parallel::domain::agree(comm, restored).map(Some)
+    crate::parallel::decomposition::agree(comm, restored).map(Some)
 }
 
 /// What `tinydem check` would refuse the run for (collective): an error naming it all.

@@ -50,7 +50,7 @@ impl Simulation {
             |k: usize| !(p.x[k].is_finite() && p.v[k].is_finite() && p.w[k].is_finite());
         // Split over processes: each reports on its own particles (a pair: the one of the
         // lower id), and all stop if one must.
-        let bad = match &self.domain {
+        let bad = match &self.share {
             Some(d) => {
                 deep.retain(|x| d.owned[x.i]);
                 let own_bad = (0..p.len()).any(|k| d.owned[k] && non_finite(k));
@@ -70,7 +70,7 @@ impl Simulation {
             return Ok(());
         }
         let told = self.told(deep, beyond_range);
-        let told = match &self.domain {
+        let told = match &self.share {
             Some(d) => gather_told(&*d.comm, told),
             None => told,
         };
@@ -142,9 +142,9 @@ impl Simulation {
     /// since the last call.
     pub fn take_new_warnings(&mut self) -> Vec<String> {
         let fresh = std::mem::take(&mut self.warnings.fresh);
-        match &self.domain {
+        match &self.share {
             // Every process's (collective).
-            Some(d) => crate::parallel::domain::gather_lines(&*d.comm, fresh),
+            Some(d) => crate::parallel::decomposition::gather_lines(&*d.comm, fresh),
             None => fresh,
         }
     }

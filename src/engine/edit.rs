@@ -225,7 +225,7 @@ impl Simulation {
     }
 
     fn refuse_split(&self, what: &str) -> Result<()> {
-        if self.domain.is_some() {
+        if self.share.is_some() {
             bail!("a run split over processes cannot {what} from outside its step");
         }
         Ok(())

@@ -1,11 +1,11 @@
 //! Stage 4 of the step: the contacts of particles with the faces of the mesh, one contact per
-//! touch of a surface (`surface.rs`), pieces of the particle-face list in parallel.
+//! touch of a surface (`surface.rs`), blocks of the particle-face list in parallel.
 
 use super::*;
 
 /// A face within reach of a particle, in stage 4.
 struct Near {
-    /// The particle, and the face's slot in the piece of the particle-face list.
+    /// The particle, and the face's slot in the block of the particle-face list.
     owner: u32,
     slot: usize,
     kin: Kinematics,
@@ -14,10 +14,10 @@ struct Near {
     interior: bool,
 }
 
-/// Buffers of one piece of the mesh-contact stage.
+/// Buffers of one block of the mesh-contact stage.
 #[derive(Default)]
 struct MeshScratch {
-    /// The piece's faces within reach.
+    /// The block's faces within reach.
     near: Vec<Near>,
     /// Which of `near` are contacts of their own, for the law.
     contacts: Vec<u32>,
@@ -27,7 +27,7 @@ struct MeshScratch {
     fates: Vec<Fate>,
 }
 
-/// What stage 4 reads, shared by the tasks of all pieces.
+/// What stage 4 reads, shared by the tasks of all blocks.
 struct FaceStage<'a> {
     p: &'a Particles,
     law: &'a ContactLaw,
@@ -51,7 +51,7 @@ struct FaceStage<'a> {
 /// Returns what it found, and the step's exact sums of the reactions on each mesh file
 /// (of the `owned` particles of a split run; empty unless wall loads are summed).
 ///
-/// Each piece of the list holds whole runs of owners. For each particle it finds the
+/// Each block of the list holds whole runs of owners. For each particle it finds the
 /// faces within reach (closest point, kinematics), decides which of them are contacts
 /// of their own (one per touch of a connected surface, `surface.rs`; with `per_face`
 /// every face is a surface of its own), hands the springs of the others to the contact
@@ -72,7 +72,7 @@ pub(super) fn run(
         start,
         partner,
         contact,
-        pieces: bounds,
+        blocks: bounds,
         stores,
     } = list;
     let stage = FaceStage {
@@ -91,19 +91,19 @@ pub(super) fn run(
     thread_local! {
         static SCRATCH: std::cell::RefCell<MeshScratch> = Default::default();
     }
-    let all = pieces(bounds, loads, start, contact, stores);
-    let pieces: Vec<(Vec<Sum6>, bool)> = all
+    let all = blocks(bounds, loads, start, contact, stores);
+    let blocks: Vec<(Vec<Sum6>, bool)> = all
         .into_par_iter()
-        .with_min_len(MIN_PARALLEL_LEN.div_ceil(FACE_PIECE))
-        .map(|piece| SCRATCH.with_borrow_mut(|scratch| stage.piece(piece, scratch, &found)))
+        .with_min_len(MIN_PARALLEL_LEN.div_ceil(FACE_BLOCK))
+        .map(|block| SCRATCH.with_borrow_mut(|scratch| stage.block(block, scratch, &found)))
         .collect();
     let mut found = found.into_inner();
-    // The pieces' sums of the loads on the mesh files, in order.
+    // The blocks' sums of the loads on the mesh files, in order.
     let mut step = vec![Sum6::default(); walls.sums.len()];
     if !step.is_empty() {
-        for (piece, fine) in pieces {
+        for (block, fine) in blocks {
             found.beyond_range |= !fine;
-            for (sum, w) in step.iter_mut().zip(&piece) {
+            for (sum, w) in step.iter_mut().zip(&block) {
                 sum.merge(w);
             }
         }
@@ -125,17 +125,17 @@ impl Simulation {
 }
 
 impl FaceStage<'_> {
-    /// One piece of the particle-face list: its contacts' loads added to its particles',
-    /// and the piece's sum of the reactions on each mesh file (and whether it was in range).
+    /// One block of the particle-face list: its contacts' loads added to its particles',
+    /// and the block's sum of the reactions on each mesh file (and whether it was in range).
     #[inline]
-    fn piece(&self, piece: Piece, scratch: &mut MeshScratch, found: &Found) -> (Vec<Sum6>, bool) {
-        let Piece {
+    fn block(&self, block: Block, scratch: &mut MeshScratch, found: &Found) -> (Vec<Sum6>, bool) {
+        let Block {
             owners,
             first,
             loads,
             contact,
             store,
-        } = piece;
+        } = block;
         let MeshScratch {
             near,
             candidates,
@@ -154,7 +154,7 @@ impl FaceStage<'_> {
         );
         // The law, `WIDTH` contacts at a time (as for particle pairs), added to the
         // particles' loads, and their reactions (of own particles, in a split run) to the
-        // piece's exact sum for each mesh file.
+        // block's exact sum for each mesh file.
         let (mut wall, mut wall_fine) = (vec![Sum6::default(); self.files], true);
         for group in contacts.chunks(WIDTH) {
             let loads = (&mut *loads, owners.start);

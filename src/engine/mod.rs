@@ -23,10 +23,10 @@ use crate::model::motion::{Motion, Pose, RigidVelocity};
 use crate::model::particles::{Id, Particles};
 use crate::model::servo;
 use crate::neighbours::{
-    ContactList, Entries, Entry, FACE_PIECE, FaceGrid, Histories, History, IdIndex,
+    ContactList, Entries, Entry, FACE_BLOCK, FaceGrid, Histories, History, IdIndex,
     MIN_PARALLEL_LEN, NONE, Neighbours, Store, cut,
 };
-use crate::parallel::domain::Domain;
+use crate::parallel::decomposition::Share;
 
 mod advance;
 mod bodies;
@@ -136,9 +136,9 @@ impl Found {
     }
 }
 
-/// A piece of owners `owners` of a contact list: their loads, and the contacts of their
-/// slots (which start at slot `first`) with the piece's store.
-struct Piece<'a> {
+/// A block of owners `owners` of a contact list: their loads, and the contacts of their
+/// slots (which start at slot `first`) with the block's store.
+struct Block<'a> {
     owners: std::ops::Range<usize>,
     first: usize,
     loads: &'a mut [Load],
@@ -146,15 +146,15 @@ struct Piece<'a> {
     store: &'a mut Store,
 }
 
-/// The pieces of a contact list (its run starts `start`, owner bounds `bounds` of its pieces,
+/// The blocks of a contact list (its run starts `start`, owner bounds `bounds` of its blocks,
 /// its slots' `contact` and its `stores`), each with the `loads` of its owners.
-fn pieces<'a>(
+fn blocks<'a>(
     bounds: &[u32],
     loads: &'a mut [Load],
     start: &[u32],
     contact: &'a mut [u32],
     stores: &'a mut [Store],
-) -> Vec<Piece<'a>> {
+) -> Vec<Block<'a>> {
     let owners: Vec<usize> = bounds.iter().map(|&o| o as usize).collect();
     let slots: Vec<usize> = owners.iter().map(|&o| start[o] as usize).collect();
     cut(loads, &owners)
@@ -162,7 +162,7 @@ fn pieces<'a>(
         .zip(cut(contact, &slots))
         .zip(stores.iter_mut())
         .enumerate()
-        .map(|(k, ((loads, contact), store))| Piece {
+        .map(|(k, ((loads, contact), store))| Block {
             owners: owners[k]..owners[k + 1],
             first: slots[k],
             loads,
@@ -479,15 +479,15 @@ pub struct Simulation {
     pub removed: Removed,
     /// The largest radius the faces are binned for.
     pub(crate) face_grid_radius: f64,
-    /// This process's share of a run split over several (`domain.rs`).
-    pub(crate) domain: Option<Domain>,
+    /// This process's share of a run split over several (`decomposition.rs`).
+    pub(crate) share: Option<Share>,
 }
 
 impl Simulation {
     /// The complete state of the run (collective in a split run, where it fails if the
     /// state of some process is not one a checkpoint may hold).
     pub fn snapshot(&self) -> Result<Snapshot> {
-        if self.domain.is_some() {
+        if self.share.is_some() {
             return self.snapshot_split();
         }
         let p = &self.particles;
@@ -537,7 +537,7 @@ impl Simulation {
     /// none on the others (they write nothing; [`Simulation::gather_particles`] gives all
     /// to all).
     pub fn particles_in_domain(&self) -> std::borrow::Cow<'_, Particles> {
-        let p = match (&self.domain, self.neighbours.periodic) {
+        let p = match (&self.share, self.neighbours.periodic) {
             (None, None) => return std::borrow::Cow::Borrowed(&self.particles),
             (None, Some(_)) => self.particles.clone(),
             (Some(_), _) => self.gather_particles_to(crate::parallel::comm::Reach::Writer),
@@ -552,7 +552,7 @@ impl Simulation {
         let p = &self.particles;
         let solo = crate::parallel::comm::Solo;
         let reach = crate::parallel::comm::Reach::Everyone;
-        let own = crate::parallel::domain::gather_by_id((&solo, reach), p, |i| self.own(i));
+        let own = crate::parallel::decomposition::gather_by_id((&solo, reach), p, |i| self.own(i));
         (self.put_in_domain(own), self.put_in_domain(p.clone()))
     }
 
@@ -585,7 +585,7 @@ impl Simulation {
         let p = &self.particles;
         let mut found = pairs::run(&self.model, p, &mut self.neighbours, &mut self.loads);
         let t = self.stage_times.add(Stage::ParticleContacts, t);
-        let owned = self.domain.as_ref().map(|d| &d.owned[..]);
+        let owned = self.share.as_ref().map(|d| &d.owned[..]);
         let list = &mut self.neighbours.faces;
         let (on_faces, walls) =
             faces::run(&self.model, p, &self.walls, owned, list, &mut self.loads);
@@ -597,7 +597,7 @@ impl Simulation {
             self.scenario.kinetics.gravity,
         );
         let periodic = self.neighbours.periodic;
-        let owned = self.domain.as_ref().map(|d| &d.owned[..]);
+        let owned = self.share.as_ref().map(|d| &d.owned[..]);
         let bodies_non_finite = bodies::run(
             &self.model,
             (dt, g),
@@ -613,7 +613,7 @@ impl Simulation {
         let t = self.stage_times.add(Stage::Integrate, t);
         regions::tag(&self.scenario.tags, &mut self.particles);
         let t = self.stage_times.add(Stage::Tag, t);
-        if let Some(d) = &self.domain {
+        if let Some(d) = &self.share {
             split::refresh_ghosts(d, &mut self.particles);
         }
         let t = self.stage_times.add(Stage::Exchange, t);
@@ -657,7 +657,7 @@ impl Simulation {
     /// Stage 1 (Section 3.1): new particles in the spawn box or the `[[spawn]]` regions.
     #[inline(never)] // a stage of its own in profiles
     fn spawn(&mut self) {
-        if self.domain.is_some() {
+        if self.share.is_some() {
             return self.spawn_split();
         }
         let s = &self.scenario;
@@ -695,11 +695,12 @@ impl Simulation {
             &self.walls.mesh.faces,
             self.walls.drift.max(self.neighbours.shear_drift()),
         );
-        match &self.domain {
+        match &self.share {
             // Split over processes: all rebuild when one must.
-            Some(d) if d.comm.any(stale) => {
-                self.redistribute(&Default::default(), crate::parallel::domain::Placement::Now)
-            }
+            Some(d) if d.comm.any(stale) => self.redistribute(
+                &Default::default(),
+                crate::parallel::decomposition::Placement::Now,
+            ),
             Some(_) => {}
             None if stale => self.rebuild_lists(self.walls.move_at_all()),
             None => {}
@@ -749,7 +750,7 @@ impl Simulation {
         self.walls.move_to(self.time);
     }
 
-    /// After a rebuild: loads for the particles, pieces of the face list, and the mesh pose
+    /// After a rebuild: loads for the particles, blocks of the face list, and the mesh pose
     /// the lists were built with.
     pub(crate) fn built(&mut self) {
         self.loads.clear();

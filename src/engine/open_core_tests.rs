@@ -3,8 +3,9 @@
 //! particle's path length, summed in the step); and a member of a contact's state only the
 //! tests have (`touches`, an optional row of `model/contact_state.rs`) with the code that
 //! uses it (the steps each contact has touched, counted where the law updates the
-//! springs). Both are carried through ghosts, migration, checkpoints resumed on another
-//! number of processes, and frames, with the same bits as a run in one process.
+//! springs). Both are carried through ghosts, migration and checkpoints resumed on another
+//! number of processes with the same bits as a run in one process (frames: `io/csv/tests.rs`,
+//! `io/vtk.rs`).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
@@ -59,7 +60,7 @@ fn touches(sim: &Simulation) -> BTreeMap<(Id, Id, bool), u32> {
     let p = &sim.particles;
     let own = |id: Id| {
         let i = p.id.iter().position(|&j| j == id).expect("held");
-        sim.domain().is_none_or(|d| d.owned[i])
+        sim.share().is_none_or(|d| d.owned[i])
     };
     let (pairs, faces) = sim.neighbours.entries_by_id(&p.id);
     let pairs = pairs.into_iter().filter(|e| own(e.0) || own(e.1));
@@ -110,7 +111,7 @@ fn step_checking_ghosts(sim: &mut Simulation, steps: u64, reference: &Reference)
                 );
             }
         }
-        let d = sim.domain().expect("a split run");
+        let d = sim.share().expect("a split run");
         ghosts += d.owned.iter().filter(|&&o| !o).count();
         owned.extend(
             (0..d.owned.len())
@@ -206,20 +207,6 @@ fn a_field_and_a_contact_state_declared_once_travel_through_ghosts_migrations_an
         step_checking_ghosts(&mut sim, then, &r)
     });
     assert!(migrated(&owned), "some particle should change hands");
-    // A frame holds the field's column and reads back with the same bits.
-    let snapshot = bytes::decode(&checkpoint, Some(7)).unwrap();
-    let p = &snapshot.particles;
-    let mut csv = Vec::new();
-    crate::io::csv::write_particles(&mut csv, p, Default::default()).unwrap();
-    let header = String::from_utf8_lossy(&csv[..csv.iter().position(|&b| b == b'\n').unwrap()]);
-    assert!(header.ends_with(",probe"), "{header}");
-    let back = crate::io::csv::read_particles(&csv[..], "frame.csv").unwrap();
-    let by_id: BTreeMap<Id, u64> = probes(p);
-    assert!(back.active.probe);
-    assert_eq!(
-        back.probe.iter().map(|s| s.to_bits()).collect::<Vec<_>>(),
-        by_id.values().copied().collect::<Vec<_>>()
-    );
 }
 
 #[test]
@@ -235,21 +222,4 @@ fn a_run_without_the_optional_fields_writes_the_format_without_them() {
     );
     let back = bytes::decode(&checkpoint, Some(7)).unwrap();
     assert!(!back.particles.active.probe && back.particles.probe.is_empty());
-    let mut csv = Vec::new();
-    crate::io::csv::write_particles(&mut csv, &sim.particles, Default::default()).unwrap();
-    assert!(!String::from_utf8_lossy(&csv).contains("probe"));
-}
-
-#[test]
-fn a_frame_missing_part_of_a_field_or_with_a_bad_value_is_refused() {
-    let header = "x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz,probe\n";
-    let ok = format!("{header}0,0,0,1,0,0,0,1,0,0,0,0,0,0,2.5\n");
-    let p = crate::io::csv::read_particles(ok.as_bytes(), "f.csv").unwrap();
-    assert_eq!(p.probe, vec![2.5]);
-    let bad = format!("{header}0,0,0,1,0,0,0,1,0,0,0,0,0,0,nan\n");
-    let e = crate::io::csv::read_particles(bad.as_bytes(), "f.csv").unwrap_err();
-    assert!(format!("{e:#}").contains("f.csv:2: probe"), "{e:#}");
-    let twice = "x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz,probe,probe\n";
-    let e = crate::io::csv::read_particles(twice.as_bytes(), "f.csv").unwrap_err();
-    assert!(format!("{e:#}").contains("'probe' appears twice"), "{e:#}");
 }

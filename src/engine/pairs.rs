@@ -1,4 +1,4 @@
-//! Stage 3 of the step: the contacts between particles, pieces of the pair list in parallel,
+//! Stage 3 of the step: the contacts between particles, blocks of the pair list in parallel,
 //! the law evaluated for groups of pairs in lanes, the loads summed exactly; and the pairs
 //! across periodic sides.
 
@@ -62,7 +62,7 @@ pub(super) fn run(
         start,
         partner,
         contact,
-        pieces: slabs,
+        blocks: slabs,
         stores,
     } = &mut lists.pairs;
     let (start, partner, slabs) = (&*start, &*partner, &*slabs);
@@ -80,12 +80,12 @@ pub(super) fn run(
         static TOUCHING: std::cell::RefCell<Vec<[u32; 3]>> = Default::default();
     }
     for phase in 0..2 {
-        let mut all: Vec<Option<Piece>> = pieces(slabs, loads, start, contact, stores)
+        let mut all: Vec<Option<Block>> = blocks(slabs, loads, start, contact, stores)
             .into_iter()
             .map(Some)
             .collect();
         // A slab, with the loads of the next one.
-        let tasks: Vec<(Piece, Option<Piece>)> = (phase..all.len())
+        let tasks: Vec<(Block, Option<Block>)> = (phase..all.len())
             .step_by(2)
             .map(|s| {
                 let own = all[s].take().expect("each slab once");
@@ -117,12 +117,12 @@ fn wrapped(
         start,
         partner,
         contact,
-        pieces,
+        blocks,
         stores,
     } = &mut nb.wrapped;
-    for piece in 0..pieces.len().saturating_sub(1) {
-        let store = &mut stores[piece];
-        for a in pieces[piece] as usize..pieces[piece + 1] as usize {
+    for block in 0..blocks.len().saturating_sub(1) {
+        let store = &mut stores[block];
+        for a in blocks[block] as usize..blocks[block + 1] as usize {
             for k in start[a] as usize..start[a + 1] as usize {
                 let b = partner[k] as usize;
                 // Seen from the lower id: the other at its image (and its velocity), as
@@ -199,8 +199,8 @@ impl PairStage<'_> {
     /// One slab of the pair list: its touching pairs, then the law for `WIDTH` of them at a
     /// time, added to the loads of the slab's particles and of the `next` slab's.
     #[inline]
-    fn slab(&self, slab: Piece, next: Option<Piece>, touching: &mut Vec<[u32; 3]>, found: &Found) {
-        let Piece {
+    fn slab(&self, slab: Block, next: Option<Block>, touching: &mut Vec<[u32; 3]>, found: &Found) {
+        let Block {
             owners,
             first,
             loads,

@@ -54,11 +54,14 @@ impl Simulation {
             out.count += 1;
             out.mass += g.mass;
         }
-        match &self.domain {
+        match &self.share {
             None => self.drop_stored(&mine),
             Some(_) => {
                 let ids = gone.iter().flat_map(|g| g.first..g.first + g.ids);
-                self.redistribute(&ids.collect(), crate::parallel::domain::Placement::Now);
+                self.redistribute(
+                    &ids.collect(),
+                    crate::parallel::decomposition::Placement::Now,
+                );
             }
         }
     }
@@ -69,7 +72,7 @@ impl Simulation {
     /// gone (a sphere, or a body by its first sphere).
     fn leaving(&self, fate: impl Fn(DVec3) -> Option<u32> + Sync) -> (Vec<u32>, Vec<Gone>) {
         let p = &self.particles;
-        let own = |i: usize| self.domain.as_ref().is_none_or(|d| d.owned[i]);
+        let own = |i: usize| self.share.as_ref().is_none_or(|d| d.owned[i]);
         let centre = |i: usize| match p.body[i] {
             Some(b) => p.bodies.list[p.bodies.index_of(b).expect("a listed body")].x,
             None => p.x[i],
@@ -105,7 +108,7 @@ impl Simulation {
                 ids,
             });
         }
-        if let Some(d) = &self.domain {
+        if let Some(d) = &self.share {
             gone = split::all_gone(d, &gone);
         }
         gone.sort_unstable_by_key(|g| g.first);
@@ -130,7 +133,7 @@ impl Simulation {
     /// Whether frames carry a tag column: the scenario tags particles, or they came tagged.
     pub fn has_tags(&self) -> bool {
         let tagged = self.particles.tagged();
-        let tagged = self.domain.as_ref().map_or(tagged, |d| d.comm.any(tagged));
+        let tagged = self.share.as_ref().map_or(tagged, |d| d.comm.any(tagged));
         !self.scenario.tags.is_empty() || tagged
     }
 }

@@ -18,7 +18,7 @@ impl Simulation {
     pub(crate) fn contact_network_to(&self, reach: Reach) -> Vec<ContactRecord> {
         // Each contact from the process that owns its particle (of a pair, the lower id).
         let network = self.own_contact_network();
-        match &self.domain {
+        match &self.share {
             Some(d) => super::split::gather_contacts((&*d.comm, reach), network),
             None => network,
         }
@@ -175,7 +175,7 @@ impl Simulation {
             let (t, r) = b.kinetic_energy();
             (b.id.first(), t, r)
         }));
-        if let Some(d) = &self.domain {
+        if let Some(d) = &self.share {
             // Over all processes, still in id order.
             use crate::parallel::comm::{Reader, Writer};
             let mut w = Writer::default();
@@ -232,7 +232,7 @@ impl Simulation {
             };
             thermo.max_overlap = thermo.max_overlap.max(c.overlap / smaller);
         }
-        if let Some(d) = &self.domain {
+        if let Some(d) = &self.share {
             let counts = d
                 .comm
                 .sum_i64(&[thermo.pair_contacts as i64, thermo.wall_contacts as i64]);
@@ -246,9 +246,9 @@ impl Simulation {
 /// Each open contact of `list`: owner, partner, springs and slot.
 fn open_contacts(list: &ContactList) -> Vec<(usize, usize, Springs, usize)> {
     let mut v = Vec::new();
-    for piece in 0..list.pieces.len().saturating_sub(1) {
-        let store = &list.stores[piece];
-        for i in list.pieces[piece] as usize..list.pieces[piece + 1] as usize {
+    for block in 0..list.blocks.len().saturating_sub(1) {
+        let store = &list.stores[block];
+        for i in list.blocks[block] as usize..list.blocks[block + 1] as usize {
             for k in list.run(i) {
                 if list.contact[k] != NONE {
                     let springs = store.state.springs[list.contact[k] as usize];

@@ -453,7 +453,7 @@ impl Simulation {
                 domain: Outflow::default(),
             },
             face_grid_radius: max_radius,
-            domain: None,
+            share: None,
             scenario,
             particles,
         };

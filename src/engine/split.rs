@@ -1,4 +1,4 @@
-//! The split run's side of the simulation (`parallel/domain.rs` holds the decomposition
+//! The split run's side of the simulation (`parallel/decomposition.rs` holds the decomposition
 //! itself): splitting a simulation over processes, its collectives (`any`, `agree`), the
 //! redistribution of particles and their contact history at rebuilds, ghosts, spawning and
 //! removal over all processes, and the gathers of particles, contacts and snapshots.
@@ -8,8 +8,8 @@ use crate::engine::regions::Gone;
 use crate::model::bodies::Body as RigidBody;
 use crate::neighbours::{Entries, Periodic};
 use crate::parallel::comm::{Comm, Reach, Reader, Writer};
-use crate::parallel::domain::{
-    Domain, Placement, REBALANCE, Tree, agree, gather_by_id, get_body, get_entry, get_particle,
+use crate::parallel::decomposition::{
+    Placement, REBALANCE, Share, Tree, agree, gather_by_id, get_body, get_entry, get_particle,
     put_body, put_entry, put_particle,
 };
 use rustc_hash::{FxHashMap, FxHashSet};
@@ -80,12 +80,12 @@ pub(crate) fn gather_contacts(
 impl Simulation {
     /// Whether this process writes the output: the first of a split run.
     pub fn is_writer(&self) -> bool {
-        self.domain.as_ref().is_none_or(|d| d.comm.rank() == 0)
+        self.share.as_ref().is_none_or(|d| d.comm.rank() == 0)
     }
 
     /// Whether each of `flags` is set on any process (one collective in a split run).
     pub fn any_each<const N: usize>(&self, flags: [bool; N]) -> [bool; N] {
-        match &self.domain {
+        match &self.share {
             Some(d) => {
                 let counts = d.comm.sum_i64(&flags.map(|f| f as i64));
                 std::array::from_fn(|k| counts[k] > 0)
@@ -96,12 +96,12 @@ impl Simulation {
 
     /// This process's place among the processes of a split run: (rank, count).
     pub fn process(&self) -> Option<(usize, usize)> {
-        self.domain.as_ref().map(|d| d.rank())
+        self.share.as_ref().map(|d| d.rank())
     }
 
     /// [`agree`] over the processes of a split run; `r` in one process.
     pub fn agree<T>(&self, r: Result<T>) -> Result<T> {
-        match &self.domain {
+        match &self.share {
             Some(d) => agree(&*d.comm, r),
             None => r,
         }
@@ -109,12 +109,12 @@ impl Simulation {
 
     /// Whether `flag` is set on any process (collective in a split run).
     pub fn any(&self, flag: bool) -> bool {
-        self.domain.as_ref().map_or(flag, |d| d.comm.any(flag))
+        self.share.as_ref().map_or(flag, |d| d.comm.any(flag))
     }
 
     /// The number of particles (of all processes: collective in a split run).
     pub fn particle_count(&self) -> usize {
-        match &self.domain {
+        match &self.share {
             Some(d) => d.comm.sum_i64(&[d.own_count() as i64])[0] as usize,
             None => self.particles.len(),
         }
@@ -124,7 +124,7 @@ impl Simulation {
     /// (`checkpoint::join`) as the parts of a stop checkpoint are, so that both give the
     /// same checkpoint. An error if some process's state is not one a checkpoint may hold.
     pub(crate) fn snapshot_split(&self) -> Result<Snapshot> {
-        let d = self.domain.as_ref().expect("a split run");
+        let d = self.share.as_ref().expect("a split run");
         let mine = super::records::encode(&self.snapshot_piece(), 0);
         join_pieces(&d.comm.all_gather(mine))
     }
@@ -132,7 +132,7 @@ impl Simulation {
     /// The snapshot of the run on the writer, `None` on the other processes of a split run
     /// (collective), which never hold more than their own piece.
     pub fn snapshot_for_writer(&self) -> Result<Option<Snapshot>> {
-        let Some(d) = &self.domain else {
+        let Some(d) = &self.share else {
             return self.snapshot().map(Some);
         };
         let mine = super::records::encode(&self.snapshot_piece(), 0);
@@ -145,7 +145,7 @@ impl Simulation {
     /// anchors of the last rebuild), the springs of every contact one of them is in, and the
     /// state all processes share. `checkpoint::join` makes the snapshot of the pieces.
     pub fn snapshot_piece(&self) -> Snapshot {
-        let d = self.domain.as_ref().expect("a split run");
+        let d = self.share.as_ref().expect("a split run");
         let p = &self.particles;
         let (mut pairs, mut faces) = self.neighbours.entries_by_id(&p.id);
         let (anchors, _) = self.neighbours.anchors();
@@ -215,7 +215,7 @@ impl Simulation {
         owned: Vec<bool>,
         pending: Entries,
     ) -> Result<Simulation> {
-        self.domain = Some(Domain {
+        self.share = Some(Share {
             comm,
             tree: None,
             owned,
@@ -228,8 +228,8 @@ impl Simulation {
     }
 
     /// This process's share of a split run, if it is one.
-    pub fn domain(&self) -> Option<&Domain> {
-        self.domain.as_ref()
+    pub fn share(&self) -> Option<&Share> {
+        self.share.as_ref()
     }
 
     /// Whether the particle of id `id` is this process's own (of a split run; in one
@@ -241,7 +241,7 @@ impl Simulation {
 
     /// The ids of this process's own particles, in a split run.
     pub(crate) fn own_ids(&self) -> Option<FxHashSet<Id>> {
-        let d = self.domain.as_ref()?;
+        let d = self.share.as_ref()?;
         let p = &self.particles;
         Some(
             (0..p.len())
@@ -254,7 +254,7 @@ impl Simulation {
     /// Whether the particle stored at `i` is this process's own (always, in one process).
     #[inline]
     pub(crate) fn own(&self, i: usize) -> bool {
-        self.domain.as_ref().is_none_or(|d| d.owned[i])
+        self.share.as_ref().is_none_or(|d| d.owned[i])
     }
 
     /// Rebuilds the lists of every process of a split run (collective): the own particles
@@ -291,7 +291,7 @@ impl Simulation {
                 (*x, *v) = periodic.wrap_state(*x, *v);
             }
         }
-        let mut d = self.domain.take().expect("a split run");
+        let mut d = self.share.take().expect("a split run");
         // The old lists and particles go as soon as what they hold is out; the loads too.
         self.loads = Vec::new();
         let mut springs = self.neighbours.entries_by_id(&self.particles.id);
@@ -346,7 +346,7 @@ impl Simulation {
         d.send = ghosts_to.into_iter().map(by_id).collect();
         d.recv = ghosts_from.into_iter().map(by_id).collect();
         d.owned = owned;
-        self.domain = Some(d);
+        self.share = Some(d);
         self.built();
         if let Some(now) = now {
             self.wind_on(now);
@@ -362,7 +362,7 @@ impl Simulation {
         if !self.spawner.active(s, p.next_id, self.time) {
             return;
         }
-        let d = self.domain.as_ref().expect("a split run");
+        let d = self.share.as_ref().expect("a split run");
         let mut largest = s.geometry.radius_max;
         // How far a clump's spheres reach beyond its centre, which is in the region.
         let mut beyond: f64 = 0.0;
@@ -427,7 +427,7 @@ impl Simulation {
     /// The particles of ids from `first` in `around` (spawned on every process) that are in
     /// this process's box: a rigid body whole, by its centre.
     fn keep_spawned(&mut self, around: &Particles, first: Id) {
-        let d = self.domain.as_mut().expect("a split run");
+        let d = self.share.as_mut().expect("a split run");
         let tree = d.tree.as_ref().expect("cut");
         let me = d.comm.rank();
         let periodic = self.neighbours.periodic;
@@ -448,7 +448,7 @@ impl Simulation {
 
     /// The wall loads of this step over all processes (collective): exact sums, merged.
     pub(crate) fn reduce_walls(&self, step: &mut [Sum6]) {
-        let Some(d) = &self.domain else { return };
+        let Some(d) = &self.share else { return };
         let words: Vec<i64> = step.iter().flat_map(|s| s.words()).collect();
         let total = d.comm.sum_i64(&words);
         for (s, w) in step.iter_mut().zip(total.chunks(12)) {
@@ -467,7 +467,7 @@ impl Simulation {
     /// others get none.
     pub(crate) fn gather_particles_to(&self, reach: Reach) -> Particles {
         let p = &self.particles;
-        match &self.domain {
+        match &self.share {
             Some(d) => gather_by_id((&*d.comm, reach), p, |i| d.owned[i]),
             None => gather_by_id((&crate::parallel::comm::Solo, reach), p, |_| true),
         }
@@ -482,7 +482,7 @@ impl Simulation {
 
 /// Stage 5c of a split run (collective): sends the new states of own particles of `p` to
 /// the processes of `d` that hold them as ghosts, and takes theirs.
-pub(super) fn refresh_ghosts(d: &Domain, p: &mut Particles) {
+pub(super) fn refresh_ghosts(d: &Share, p: &mut Particles) {
     let messages: Vec<(usize, Vec<u8>)> = d
         .send
         .iter()
@@ -509,7 +509,7 @@ pub(super) fn refresh_ghosts(d: &Domain, p: &mut Particles) {
 }
 
 /// The grains `gone` of every process (collective), in the order of the ranks.
-pub(super) fn all_gone(d: &Domain, gone: &[Gone]) -> Vec<Gone> {
+pub(super) fn all_gone(d: &Share, gone: &[Gone]) -> Vec<Gone> {
     let mut w = Writer::default();
     for g in gone {
         w.u64(g.first);

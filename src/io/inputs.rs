@@ -15,7 +15,7 @@ use crate::io::{csv, files};
 use crate::model::particles::{Id, Particle, Particles};
 use crate::neighbours::Entries;
 use crate::parallel::comm::{Comm, Reader};
-use crate::parallel::domain::agree;
+use crate::parallel::decomposition::agree;
 use crate::scenario::{ClumpTemplate, MeshInput, MeshSource, Scenario};
 
 impl Scenario {

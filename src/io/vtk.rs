@@ -482,3 +482,33 @@ pub fn write_collection(path: &Path, entries: &[(f64, String)]) -> Result<()> {
     text.push_str("  </Collection>\n</VTKFile>\n");
     atomic_write(path, &[text.as_bytes()])
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::particles::Particle;
+
+    /// An optional field the particles hold is an array of their file and of the listing of
+    /// a split run's pieces.
+    #[test]
+    fn an_optional_field_is_an_array() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut p: Particles = [Particle {
+            radius: 0.01,
+            ..Default::default()
+        }]
+        .into_iter()
+        .collect();
+        let (file, list) = (dir.path().join("p.vtu"), dir.path().join("p.pvtu"));
+        write_particles(&file, &p, None).unwrap();
+        let array = "Name=\"probe\" NumberOfComponents=\"1\"";
+        let text =
+            |path: &Path| String::from_utf8_lossy(&std::fs::read(path).unwrap()).into_owned();
+        assert!(!text(&file).contains(array));
+        p.activate("probe");
+        write_particles(&file, &p, None).unwrap();
+        assert!(text(&file).contains(array));
+        write_particle_list(&list, &["p.vtu".into()], (false, false), p.active).unwrap();
+        assert!(text(&list).contains(array));
+    }
+}

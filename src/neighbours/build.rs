@@ -90,7 +90,7 @@ impl Neighbours {
     /// are, or at the positions `at` (one per particle: the anchors of an earlier rebuild,
     /// which become the anchors again), with the springs of `pairs` and `faces`,
     /// entries by id ((lower id, higher id) and (id, face); those naming a particle that
-    /// `particles` lacks are left out). For a process of a split run (`domain.rs`), which
+    /// `particles` lacks are left out). For a process of a split run (`parallel/decomposition.rs`), which
     /// gathers its history from other processes: it finds no lonely particles, whose
     /// clearances would need the particles it does not hold. Returns the permutation
     /// applied (`Particles::permute`).
@@ -207,8 +207,8 @@ impl Neighbours {
         }
         drop(grid);
         let (start, partner) = face_pairs(x, radius, skin, faces, face_grid);
-        let pieces = pieces_of(&start, FACE_PIECE);
-        self.faces = ContactList::with_springs(start, partner, pieces, &history.faces, self.state);
+        let blocks = blocks_of(&start, FACE_BLOCK);
+        self.faces = ContactList::with_springs(start, partner, blocks, &history.faces, self.state);
     }
 
     /// The pairs across periodic sides: each image x_j + s of a particle near a side
@@ -276,9 +276,9 @@ impl Neighbours {
         self.shift = found.iter().map(|f| f.2).collect();
         self.crossings = found.iter().map(|f| f.3).collect();
         self.offset_at_build = periodic.shear.map_or(0.0, |sh| sh.offset);
-        let pieces = pieces_of(&start, FACE_PIECE);
+        let blocks = blocks_of(&start, FACE_BLOCK);
         self.wrapped =
-            ContactList::with_springs(start, partner, pieces, &history.pairs, self.state);
+            ContactList::with_springs(start, partner, blocks, &history.pairs, self.state);
     }
 }
 

@@ -1,4 +1,4 @@
-//! The contact lists in compressed form, cut into pieces, each with a store of the springs
+//! The contact lists in compressed form, cut into blocks, each with a store of the springs
 //! of its touching contacts.
 
 use rayon::prelude::*;
@@ -8,9 +8,9 @@ use super::*;
 /// A slot without a contact.
 pub const NONE: u32 = u32::MAX;
 
-/// The states of the touching contacts of one piece of a list (`ContactState`: the
+/// The states of the touching contacts of one block of a list (`ContactState`: the
 /// friction springs, and what other parts of the law keep), and its free entries. A
-/// contact stage runs a piece in one task, which opens and closes entries in the piece's
+/// contact stage runs a block in one task, which opens and closes entries in the block's
 /// own store.
 #[derive(Clone, Debug, Default)]
 pub struct Store {
@@ -55,8 +55,8 @@ impl Store {
 }
 
 /// A compressed list: for each owner `i` (a storage index), a run of partners; each slot
-/// whose pair touches holds its contact, an entry of the store of the slot's piece (the
-/// pieces are runs of owners). States are kept only for touching pairs, those of a
+/// whose pair touches holds its contact, an entry of the store of the slot's block (the
+/// blocks are runs of owners). States are kept only for touching pairs, those of a
 /// particle pair as seen from the particle of the lower id (body i of the contact law),
 /// whatever the storage order.
 #[derive(Clone, Debug, Default)]
@@ -65,12 +65,12 @@ pub struct ContactList {
     pub start: Vec<u32>,
     /// Partner of each slot: a particle `j > i` (storage index), or a face index.
     pub partner: Vec<u32>,
-    /// The contact of each slot: its entry in its piece's store, or [`NONE`]. A pair that
+    /// The contact of each slot: its entry in its block's store, or [`NONE`]. A pair that
     /// parts closes its contact and is not looked at again while it stays apart.
     pub contact: Vec<u32>,
-    /// Owner bounds of the pieces: piece `p` is owners `pieces[p]..pieces[p+1]`.
-    pub pieces: Vec<u32>,
-    /// One store per piece.
+    /// Owner bounds of the blocks: block `p` is owners `blocks[p]..blocks[p+1]`.
+    pub blocks: Vec<u32>,
+    /// One store per block.
     pub stores: Vec<Store>,
 }
 
@@ -98,9 +98,9 @@ impl ContactList {
     /// Calls `f` with owner, slot and state of every slot whose contact has a state to
     /// keep (not that of a first touch), in slot order.
     pub(crate) fn for_each_live(&self, mut f: impl FnMut(usize, usize, ContactState)) {
-        for p in 0..self.pieces.len().saturating_sub(1) {
+        for p in 0..self.blocks.len().saturating_sub(1) {
             let store = &self.stores[p];
-            for i in self.pieces[p] as usize..self.pieces[p + 1] as usize {
+            for i in self.blocks[p] as usize..self.blocks[p + 1] as usize {
                 for k in self.run(i) {
                     let c = self.contact[k];
                     if c != NONE {
@@ -143,19 +143,19 @@ impl ContactList {
         })
     }
 
-    /// A list from runs in compressed form cut into pieces at `pieces` (owner bounds), each
+    /// A list from runs in compressed form cut into blocks at `blocks` (owner bounds), each
     /// slot with the springs `history` holds for (owner, partner), found by merging each
     /// run with the owner's history run (both ascending).
     pub(crate) fn with_springs(
         start: Vec<u32>,
         partner: Vec<u32>,
-        pieces: Vec<u32>,
+        blocks: Vec<u32>,
         history: &History,
         active: ActiveState,
     ) -> ContactList {
         let mut contact = vec![NONE; partner.len()];
-        let slots: Vec<usize> = pieces.iter().map(|&o| start[o as usize] as usize).collect();
-        let stores: Vec<Store> = (0..pieces.len().saturating_sub(1))
+        let slots: Vec<usize> = blocks.iter().map(|&o| start[o as usize] as usize).collect();
+        let stores: Vec<Store> = (0..blocks.len().saturating_sub(1))
             .zip(cut(&mut contact, &slots))
             .collect::<Vec<_>>()
             .into_par_iter()
@@ -165,7 +165,7 @@ impl ContactList {
                     state: States::new(active),
                     ..Store::default()
                 };
-                for i in pieces[p] as usize..pieces[p + 1] as usize {
+                for i in blocks[p] as usize..blocks[p + 1] as usize {
                     let run = start[i] as usize..start[i + 1] as usize;
                     let (other, carried) = history.run(i);
                     let mut h = 0;
@@ -188,15 +188,15 @@ impl ContactList {
             start,
             partner,
             contact,
-            pieces,
+            blocks,
             stores,
         }
     }
 }
 
-/// Owner bounds of pieces of at least `size` slots of a list with run starts `start` (the
-/// last piece may be shorter).
-pub(crate) fn pieces_of(start: &[u32], size: usize) -> Vec<u32> {
+/// Owner bounds of blocks of at least `size` slots of a list with run starts `start` (the
+/// last block may be shorter).
+pub(crate) fn blocks_of(start: &[u32], size: usize) -> Vec<u32> {
     let mut bounds = vec![0u32];
     let owners = start.len().saturating_sub(1);
     for i in 1..owners {
@@ -210,17 +210,17 @@ pub(crate) fn pieces_of(start: &[u32], size: usize) -> Vec<u32> {
     bounds
 }
 
-/// Slots per piece of the particle-face list (a task of the mesh stage).
-pub const FACE_PIECE: usize = 256;
+/// Slots per block of the particle-face list (a task of the mesh stage).
+pub const FACE_BLOCK: usize = 256;
 
 /// `slice` cut at `bounds` (ascending, from 0 to its length).
 pub(crate) fn cut<'a, T>(mut slice: &'a mut [T], bounds: &[usize]) -> Vec<&'a mut [T]> {
     bounds
         .windows(2)
         .map(|w| {
-            let (piece, rest) = std::mem::take(&mut slice).split_at_mut(w[1] - w[0]);
+            let (block, rest) = std::mem::take(&mut slice).split_at_mut(w[1] - w[0]);
             slice = rest;
-            piece
+            block
         })
         .collect()
 }

@@ -122,7 +122,7 @@ pub struct Neighbours {
 /// The fewest owners in a slab (a task of the pair stage).
 const MIN_SLAB: usize = 64;
 
-/// The pieces of the pair list, slabs: owner bounds such that the partners of slab `s` lie
+/// The blocks of the pair list, slabs: owner bounds such that the partners of slab `s` lie
 /// in slabs `s` and `s + 1` (slab `s + 2` starts beyond the last partner of slab `s`). So
 /// the pair stage can run the even slabs at the same time, each adding forces to its own
 /// particles and the next slab's, then the odd ones.
@@ -479,7 +479,7 @@ mod tests {
     fn listed(nb: &Neighbours, p: &Particles) -> Vec<(Id, Id)> {
         let list = &nb.pairs;
         let mut pairs = Vec::new();
-        let slabs = &nb.pairs.pieces;
+        let slabs = &nb.pairs.blocks;
         for s in 0..slabs.len() - 1 {
             let limit = slabs.get(s + 2).copied().unwrap_or(slabs[slabs.len() - 1]);
             for i in slabs[s] as usize..slabs[s + 1] as usize {
@@ -555,7 +555,7 @@ mod tests {
         for k in 0..p.len() {
             assert_eq!(p.x[k], x[p.id[k] as usize]);
         }
-        assert!(nb.pairs.pieces.len() > 3, "{:?}", nb.pairs.pieces);
+        assert!(nb.pairs.blocks.len() > 3, "{:?}", nb.pairs.blocks);
     }
 
     /// A checkpoint's springs naming a particle it lacks are refused with the id; a split
@@ -633,11 +633,11 @@ mod tests {
         // Give each pair springs that name it, then move the pairs past each other.
         let list = &mut nb.pairs;
         for i in 0..p.len() {
-            let piece = list.pieces.partition_point(|&b| b as usize <= i) - 1;
+            let block = list.blocks.partition_point(|&b| b as usize <= i) - 1;
             for k in list.start[i] as usize..list.start[i + 1] as usize {
                 let id = p.id[i].min(p.id[list.partner[k] as usize]);
-                let e = list.stores[piece].open();
-                list.stores[piece].state.springs[e as usize].u_t = id as f64 + 1.0;
+                let e = list.stores[block].open();
+                list.stores[block].state.springs[e as usize].u_t = id as f64 + 1.0;
                 list.contact[k] = e;
             }
         }

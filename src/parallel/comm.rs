@@ -1,4 +1,4 @@
-//! Messages between the processes of a run split over several (`domain.rs`): the few
+//! Messages between the processes of a run split over several (`decomposition.rs`): the few
 //! collective operations it needs, over bytes, and the encoding of numbers into them.
 //!
 //! [`Comm`] is implemented by [`Solo`] (one process), by [`Threads`] (several simulations in

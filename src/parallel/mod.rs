@@ -1,4 +1,4 @@
 //! A run split over processes: the communicator and the decomposition of space.
 
 pub mod comm;
-pub mod domain;
+pub mod decomposition;

@@ -261,7 +261,7 @@ pub fn measure(
         (p + f) as i64,
     ];
     let thermo = sim.thermo();
-    let [peak, before, slots] = match sim.domain() {
+    let [peak, before, slots] = match sim.share() {
         Some(d) => d.comm.sum_i64(&mine).try_into().expect("three sums"),
         None => mine,
     };

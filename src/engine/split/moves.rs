@@ -8,7 +8,7 @@ use crate::model::contact_state::ActiveState;
 
 /// The boxes cut anew (collective) when the counts of own particles, at `own`, are out of
 /// balance (or never cut).
-fn recut(d: &mut Domain, own: &[DVec3]) {
+fn recut(d: &mut Share, own: &[DVec3]) {
     let k = d.comm.size();
     let counts: Vec<u64> = d
         .comm
@@ -31,7 +31,7 @@ fn recut(d: &mut Domain, own: &[DVec3]) {
 /// partners, each sent by its partner's old owner (both have the same springs), and are
 /// kept once. A rigid body goes whole, with its record, to the owner of its centre.
 pub(super) fn migrate(
-    d: &mut Domain,
+    d: &mut Share,
     (p, periodic): (Particles, Option<Periodic>),
     anchors: Option<Vec<DVec3>>,
     gone: &FxHashSet<Id>,
@@ -148,7 +148,7 @@ impl Destinations {
     /// the particle, its contacts with faces, and its contacts with particles of higher id
     /// (to the owners of both partners); a rigid body's record to the owner of its spheres.
     fn of(
-        d: &Domain,
+        d: &Share,
         p: &Particles,
         place: &[DVec3],
         gone: &FxHashSet<Id>,
@@ -263,7 +263,7 @@ fn receive(
 /// goes whole, with its record, to every process one of its spheres is within reach of.
 /// Returns the ids sent to and received from each process.
 pub(super) fn exchange_ghosts(
-    d: &Domain,
+    d: &Share,
     held: &mut Particles,
     held_at: &mut Option<Vec<DVec3>>,
     reach: (f64, f64, Option<Periodic>),
@@ -319,7 +319,7 @@ pub(super) fn exchange_ghosts(
 /// or whose images are, and more by the spread of the bodies ([`body_spread`], the
 /// largest of all processes): an own sphere may lie that far outside the box.
 fn ghost_destinations(
-    d: &Domain,
+    d: &Share,
     held: &Particles,
     held_at: Option<&[DVec3]>,
     (r_max, skin, periodic): (f64, f64, Option<Periodic>),

@@ -178,3 +178,47 @@ fn bad_lines_are_named() {
     assert!(err("x,y,z,x\n").contains("appears twice"));
     assert!(err("").contains("empty file"));
 }
+
+/// The optional field the tests have (`probe`) is a column of the frames: written after the
+/// others, read back with the same bits; a frame without it has no such column.
+#[test]
+fn an_optional_field_is_a_column_read_back_exactly() {
+    let mut p: Particles = (0..3)
+        .map(|k| Particle {
+            x: DVec3::new(k as f64, 0.0, 0.0),
+            radius: 0.004,
+            ..Default::default()
+        })
+        .collect();
+    let mut plain = Vec::new();
+    write_particles(&mut plain, &p, Extra::default()).unwrap();
+    assert!(!String::from_utf8_lossy(&plain).contains("probe"));
+    assert!(p.activate("probe"));
+    p.probe = vec![1.0 / 3.0, -1e-300, 7.0];
+    let mut text = Vec::new();
+    write_particles(&mut text, &p, Extra::default()).unwrap();
+    let header = String::from_utf8_lossy(&text)
+        .lines()
+        .next()
+        .unwrap()
+        .to_string();
+    assert!(header.ends_with(",probe"), "{header}");
+    let back = read_particles(&text[..], "frame.csv").unwrap();
+    assert!(back.active.probe);
+    let bits = |v: &[f64]| v.iter().map(|s| s.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&back.probe), bits(&p.probe));
+}
+
+#[test]
+fn a_frame_missing_part_of_a_field_or_with_a_bad_value_is_refused() {
+    let header = "x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz,probe\n";
+    let ok = format!("{header}0,0,0,1,0,0,0,1,0,0,0,0,0,0,2.5\n");
+    let p = read_particles(ok.as_bytes(), "f.csv").unwrap();
+    assert_eq!(p.probe, vec![2.5]);
+    let bad = format!("{header}0,0,0,1,0,0,0,1,0,0,0,0,0,0,nan\n");
+    let e = read_particles(bad.as_bytes(), "f.csv").unwrap_err();
+    assert!(format!("{e:#}").contains("f.csv:2: probe"), "{e:#}");
+    let twice = "x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz,probe,probe\n";
+    let e = read_particles(twice.as_bytes(), "f.csv").unwrap_err();
+    assert!(format!("{e:#}").contains("'probe' appears twice"), "{e:#}");
+}

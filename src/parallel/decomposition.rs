@@ -285,7 +285,7 @@ pub(crate) enum Placement {
 }
 
 /// The share of one process in a split run.
-pub struct Domain {
+pub struct Share {
     pub(crate) comm: Box<dyn Comm>,
     pub(crate) tree: Option<Tree>,
     /// Whether each particle held (storage order) is this process's own; the others are
@@ -299,7 +299,7 @@ pub struct Domain {
     pub cuts: u64,
 }
 
-impl Domain {
+impl Share {
     /// This process and the number of processes.
     pub fn rank(&self) -> (usize, usize) {
         (self.comm.rank(), self.comm.size())
