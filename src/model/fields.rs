@@ -94,6 +94,58 @@ impl Optional {
     }
 }
 
+/// The bytes of a record (a particle, a contact's state) in the messages of a split run:
+/// every core member, then the optional ones that the processes hold (`active`).
+macro_rules! message_record {
+    (
+        $record:ident,
+        $active:ident,
+        [$($name:ident: $ty:ty),*],
+        [$($(#[cfg($cfg:meta)])? $oname:ident: $oty:ty),*]
+    ) => {
+        impl $record {
+            /// The bytes of a record in a message between processes that hold the
+            /// optional members `active`.
+            pub fn size(active: &$active) -> usize {
+                #[allow(unused_mut)]
+                let mut n = 0 $(+ <$ty as Value>::SIZE)*;
+                $($(#[cfg($cfg)])?
+                if active.$oname {
+                    n += <$oty as Value>::SIZE;
+                })*
+                let _ = active;
+                n
+            }
+
+            /// Appends the record's bytes in a message: every core member, and the
+            /// optional ones `active`.
+            pub fn put(&self, active: &$active, out: &mut Vec<u8>) {
+                $(self.$name.put(out);)*
+                $($(#[cfg($cfg)])?
+                if active.$oname {
+                    self.$oname.put(out);
+                })*
+                let _ = active;
+            }
+
+            /// The record whose bytes (in a message between processes that hold the
+            /// optional members `active`) `bytes` begin with.
+            pub fn take(active: &$active, bytes: &mut &[u8]) -> $record {
+                let mut r = $record::default();
+                $(r.$name = Value::take(bytes);)*
+                $($(#[cfg($cfg)])?
+                if active.$oname {
+                    r.$oname = Value::take(bytes);
+                })*
+                let _ = active;
+                r
+            }
+        }
+    };
+}
+
+pub(crate) use message_record;
+
 /// Makes the particles' storage and records from the table of fields (see the module's
 /// text).
 macro_rules! particle_fields {
@@ -294,44 +346,14 @@ macro_rules! particle_fields {
             }
         }
 
+        $crate::model::fields::message_record!(
+            Particle,
+            Active,
+            [$($name: $ty),*],
+            [$($(#[cfg($cfg)])? $oname: $oty),*]
+        );
+
         impl Particle {
-            /// The bytes of a particle's record in a message between processes that hold
-            /// the optional fields `active`.
-            pub fn size(active: &Active) -> usize {
-                #[allow(unused_mut)]
-                let mut n = 0 $(+ <$ty as Value>::SIZE)*;
-                $($(#[cfg($cfg)])?
-                if active.$oname {
-                    n += <$oty as Value>::SIZE;
-                })*
-                let _ = active;
-                n
-            }
-
-            /// Appends the particle's record in a message: every field (of the optional
-            /// ones, those `active`).
-            pub fn put(&self, active: &Active, out: &mut Vec<u8>) {
-                $(self.$name.put(out);)*
-                $($(#[cfg($cfg)])?
-                if active.$oname {
-                    self.$oname.put(out);
-                })*
-                let _ = active;
-            }
-
-            /// The particle whose record (in a message between processes that hold the
-            /// optional fields `active`) `bytes` begin with.
-            pub fn take(active: &Active, bytes: &mut &[u8]) -> Particle {
-                let mut p = Particle::default();
-                $(p.$name = Value::take(bytes);)*
-                $($(#[cfg($cfg)])?
-                if active.$oname {
-                    p.$oname = Value::take(bytes);
-                })*
-                let _ = active;
-                p
-            }
-
             /// The bytes of a particle's record in a checkpoint of format `version`.
             pub fn checkpoint_size(version: u32) -> usize {
                 0 $(+ match $since { Some(since) if version >= since => <$ty as Value>::SIZE, _ => 0 })*
@@ -509,43 +531,14 @@ macro_rules! contact_fields {
             }
         }
 
+        $crate::model::fields::message_record!(
+            ContactState,
+            ActiveState,
+            [$($name: $ty),*],
+            [$($(#[cfg($cfg)])? $oname: $oty),*]
+        );
+
         impl ContactState {
-            /// The bytes of a contact's state in a message between processes that hold the
-            /// optional members `active`.
-            pub fn size(active: &ActiveState) -> usize {
-                #[allow(unused_mut)]
-                let mut n = 0 $(+ <$ty as Value>::SIZE)*;
-                $($(#[cfg($cfg)])?
-                if active.$oname {
-                    n += <$oty as Value>::SIZE;
-                })*
-                let _ = active;
-                n
-            }
-
-            /// Appends the state's bytes in a message (of the optional members, those
-            /// `active`).
-            pub fn put(&self, active: &ActiveState, out: &mut Vec<u8>) {
-                $(self.$name.put(out);)*
-                $($(#[cfg($cfg)])?
-                if active.$oname {
-                    self.$oname.put(out);
-                })*
-                let _ = active;
-            }
-
-            /// The state whose bytes (in a message) `bytes` begin with.
-            pub fn take(active: &ActiveState, bytes: &mut &[u8]) -> ContactState {
-                let mut s = ContactState::default();
-                $(s.$name = Value::take(bytes);)*
-                $($(#[cfg($cfg)])?
-                if active.$oname {
-                    s.$oname = Value::take(bytes);
-                })*
-                let _ = active;
-                s
-            }
-
             /// The bytes of the core members in an entry of a checkpoint.
             pub const CHECKPOINT_SIZE: usize = 0 $(+ <$ty as Value>::SIZE)*;
 

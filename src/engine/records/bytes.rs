@@ -186,14 +186,19 @@ fn encode_as(out: &mut Vec<u8>, snapshot: &Snapshot, fingerprint: u64, version: 
     out.extend_from_slice(&crc.to_le_bytes());
 }
 
+/// A field's name: its length (u8) and bytes.
+fn put_name(out: &mut Vec<u8>, name: &str) {
+    out.push(name.len() as u8);
+    out.extend_from_slice(name.as_bytes());
+}
+
 /// The optional fields the particles hold: their count (u32), and per field its name
 /// (length u8, bytes) and its values in storage order.
 fn put_optional(out: &mut Vec<u8>, p: &Particles) {
     let fields = p.active.fields();
     out.extend_from_slice(&(fields.len() as u32).to_le_bytes());
     for f in fields {
-        out.push(f.name.len() as u8);
-        out.extend_from_slice(f.name.as_bytes());
+        put_name(out, f.name);
         p.put_field(f.name, out);
     }
 }
@@ -204,8 +209,7 @@ fn put_optional_state(out: &mut Vec<u8>, s: &Snapshot) {
     let members = s.contact_state.fields();
     out.extend_from_slice(&(members.len() as u32).to_le_bytes());
     for m in members {
-        out.push(m.name.len() as u8);
-        out.extend_from_slice(m.name.as_bytes());
+        put_name(out, m.name);
         for e in s.pair_history.iter().chain(&s.face_history) {
             e.2.put_member(m.name, out);
         }
@@ -299,6 +303,11 @@ impl Cursor<'_> {
     }
     fn vec3(&mut self) -> Result<DVec3> {
         Ok(DVec3::new(self.f64()?, self.f64()?, self.f64()?))
+    }
+    /// A field's name ([`put_name`]).
+    fn name(&mut self) -> Result<String> {
+        let length = self.u8()? as usize;
+        Ok(String::from_utf8_lossy(self.take(length)?).into_owned())
     }
     /// A count of records of `size` bytes each, checked against the bytes left.
     fn count(&mut self, size: usize) -> Result<usize> {
@@ -506,8 +515,7 @@ impl Cursor<'_> {
     fn optional(&mut self, particles: &mut Particles) -> Result<()> {
         let r = self;
         for _ in 0..r.u32()? {
-            let length = r.u8()? as usize;
-            let name = String::from_utf8_lossy(r.take(length)?).into_owned();
+            let name = r.name()?;
             let Some(field) = OPTIONAL.iter().find(|f| f.name == name) else {
                 bail!(
                     "the checkpoint holds the particle field '{name}', which this tinydem does not know"
@@ -531,8 +539,7 @@ impl Cursor<'_> {
         let r = self;
         let mut active = ActiveState::default();
         for _ in 0..r.u32()? {
-            let length = r.u8()? as usize;
-            let name = String::from_utf8_lossy(r.take(length)?).into_owned();
+            let name = r.name()?;
             let Some(member) = OPTIONAL_STATE.iter().find(|f| f.name == name) else {
                 bail!(
                     "the checkpoint holds the contact state '{name}', which this tinydem does not know"
