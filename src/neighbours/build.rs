@@ -201,14 +201,14 @@ impl Neighbours {
             pairs_by_larger(&grid, x, radius, (skin, layout), &close)
         };
         let slabs = slabs_of(&start, &partner);
-        self.pairs = ContactList::with_springs(start, partner, slabs, &history.pairs, self.state);
+        self.pairs = ContactList::with_states(start, partner, slabs, &history.pairs, self.state);
         if let Some(periodic) = self.periodic {
             self.build_wrapped(periodic, x, particles, (&grid, layout), history);
         }
         drop(grid);
         let (start, partner) = face_pairs(x, radius, skin, faces, face_grid);
         let blocks = blocks_of(&start, FACE_BLOCK);
-        self.faces = ContactList::with_springs(start, partner, blocks, &history.faces, self.state);
+        self.faces = ContactList::with_states(start, partner, blocks, &history.faces, self.state);
     }
 
     /// The pairs across periodic sides: each image x_j + s of a particle near a side
@@ -277,8 +277,7 @@ impl Neighbours {
         self.crossings = found.iter().map(|f| f.3).collect();
         self.offset_at_build = periodic.shear.map_or(0.0, |sh| sh.offset);
         let blocks = blocks_of(&start, FACE_BLOCK);
-        self.wrapped =
-            ContactList::with_springs(start, partner, blocks, &history.pairs, self.state);
+        self.wrapped = ContactList::with_states(start, partner, blocks, &history.pairs, self.state);
     }
 }
 

@@ -1,11 +1,11 @@
-//! Contact history: the springs of touching contacts keyed by particle (id or storage
+//! Contact history: the states of touching contacts keyed by particle (id or storage
 //! index) and partner, to carry them across rebuilds and into checkpoints.
 
 use super::*;
 
-/// A contact history: the springs of particle pairs keyed by (lower, higher) and of
+/// A contact history: the states of particle pairs keyed by (lower, higher) and of
 /// particle-face contacts by (particle, face), where particles are named by id (in
-/// checkpoints) or by their storage index after a rebuild's re-sort (to carry the springs
+/// checkpoints) or by their storage index after a rebuild's re-sort (to carry the states
 /// into the new lists). Compressed by the first key, each run ordered by the second.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct History {
@@ -16,7 +16,7 @@ pub struct History {
 }
 
 impl History {
-    /// The history of `(a, other, springs)` entries, `a` below `keys`: a counting sort by
+    /// The history of `(a, other, state)` entries, `a` below `keys`: a counting sort by
     /// `a`, then each run by `other`. `visit` hands every entry to its argument, the same
     /// entries in the same order each time it is called (twice: to count, then to place).
     pub(crate) fn from_visits(
@@ -57,7 +57,7 @@ impl History {
         }
     }
 
-    /// The history of saved `(id, other, springs)` entries (a checkpoint's) for `particles`
+    /// The history of saved `(id, other, state)` entries (a checkpoint's) for `particles`
     /// (in storage order): keyed by storage index, `pairs` or not. An entry naming a
     /// particle that `particles` lacks is an error.
     pub fn in_storage(
@@ -133,7 +133,7 @@ impl History {
         self.other.is_empty()
     }
 
-    /// The entries of `a`: the other keys (ascending) and their springs.
+    /// The entries of `a`: the other keys (ascending) and their states.
     #[inline]
     pub(crate) fn run(&self, a: usize) -> (&[u32], &[ContactState]) {
         if a + 1 >= self.start.len() {

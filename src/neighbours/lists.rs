@@ -1,4 +1,4 @@
-//! The contact lists in compressed form, cut into blocks, each with a store of the springs
+//! The contact lists in compressed form, cut into blocks, each with a store of the states
 //! of its touching contacts.
 
 use rayon::prelude::*;
@@ -38,7 +38,7 @@ impl Store {
         }
     }
 
-    /// Frees entry `k` (its springs are forgotten).
+    /// Frees entry `k` (its state is forgotten).
     #[inline]
     pub fn close(&mut self, k: u32) {
         self.free.push(k);
@@ -114,9 +114,9 @@ impl ContactList {
         }
     }
 
-    /// The contact history of the list: for each slot with springs, the key that
+    /// The contact history of the list: for each slot with a state to keep, the key that
     /// `key(owner, partner)` gives it (first keys below `keys`; none: the contact is
-    /// dropped) and its springs.
+    /// dropped) and its state.
     pub(crate) fn history(
         &self,
         keys: usize,
@@ -144,9 +144,9 @@ impl ContactList {
     }
 
     /// A list from runs in compressed form cut into blocks at `blocks` (owner bounds), each
-    /// slot with the springs `history` holds for (owner, partner), found by merging each
+    /// slot with the state `history` holds for (owner, partner), found by merging each
     /// run with the owner's history run (both ascending).
-    pub(crate) fn with_springs(
+    pub(crate) fn with_states(
         start: Vec<u32>,
         partner: Vec<u32>,
         blocks: Vec<u32>,
