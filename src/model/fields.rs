@@ -94,6 +94,50 @@ impl Optional {
     }
 }
 
+/// A set of flags, one per optional member of a table (`held` of `$described`, each
+/// described in `$table`): which members are held, listed and set by name.
+macro_rules! held_set {
+    (
+        $(#[doc = $doc:literal])*
+        $set:ident,
+        $described:ty,
+        $table:ident,
+        [$($(#[cfg($cfg:meta)])? $oname:ident),*]
+    ) => {
+        $(#[doc = $doc])*
+        #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+        pub struct $set {
+            $($(#[cfg($cfg)])? pub $oname: bool,)*
+        }
+
+        impl $set {
+            /// The members held, as `$table` describes them.
+            pub fn fields(&self) -> Vec<&'static $described> {
+                #[allow(unused_mut)]
+                let mut held = Vec::new();
+                $($(#[cfg($cfg)])?
+                if self.$oname {
+                    held.extend($table.iter().find(|f| f.name == stringify!($oname)));
+                })*
+                held
+            }
+
+            /// Holds the member `name` from now on; false if there is none.
+            pub fn activate(&mut self, name: &str) -> bool {
+                $($(#[cfg($cfg)])?
+                if name == stringify!($oname) {
+                    self.$oname = true;
+                    return true;
+                })*
+                let _ = name;
+                false
+            }
+        }
+    };
+}
+
+pub(crate) use held_set;
+
 /// The bytes of a record (a particle, a contact's state) in the messages of a split run:
 /// every core member, then the optional ones that the processes hold (`active`).
 macro_rules! message_record {
@@ -175,11 +219,13 @@ macro_rules! particle_fields {
             pub bodies: Bodies,
         }
 
-        /// Which optional fields the particles hold.
-        #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-        pub struct Active {
-            $($(#[cfg($cfg)])? pub $oname: bool,)*
-        }
+        $crate::model::fields::held_set!(
+            /// Which optional fields the particles hold.
+            Active,
+            $crate::model::fields::Optional,
+            OPTIONAL,
+            [$($(#[cfg($cfg)])? $oname),*]
+        );
 
         /// One particle's state: a row of [`Particles`] (optional fields not held at their
         /// defaults).
@@ -200,19 +246,6 @@ macro_rules! particle_fields {
                 ghost: $oghost,
             },
         )*];
-
-        impl Active {
-            /// The optional fields held.
-            pub fn fields(&self) -> Vec<&'static $crate::model::fields::Optional> {
-                #[allow(unused_mut)]
-                let mut held = Vec::new();
-                $($(#[cfg($cfg)])?
-                if self.$oname {
-                    held.extend(OPTIONAL.iter().find(|f| f.name == stringify!($oname)));
-                })*
-                held
-            }
-        }
 
         impl Particles {
             /// Adds a particle that has its id already (one made elsewhere: by another
@@ -415,11 +448,13 @@ macro_rules! contact_fields {
             $($(#[cfg($cfg)])? $(#[doc = $odoc])* pub $oname: $oty,)*
         }
 
-        /// Which optional members of a contact's state are held.
-        #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-        pub struct ActiveState {
-            $($(#[cfg($cfg)])? pub $oname: bool,)*
-        }
+        $crate::model::fields::held_set!(
+            /// Which optional members of a contact's state are held.
+            ActiveState,
+            $crate::model::fields::OptionalState,
+            OPTIONAL_STATE,
+            [$($(#[cfg($cfg)])? $oname),*]
+        );
 
         /// The optional members of a contact's state.
         pub const OPTIONAL_STATE: &[$crate::model::fields::OptionalState] = &[$(
@@ -429,30 +464,6 @@ macro_rules! contact_fields {
                 size: <$oty as Value>::SIZE,
             },
         )*];
-
-        impl ActiveState {
-            /// The optional members held.
-            pub fn fields(&self) -> Vec<&'static $crate::model::fields::OptionalState> {
-                #[allow(unused_mut)]
-                let mut held = Vec::new();
-                $($(#[cfg($cfg)])?
-                if self.$oname {
-                    held.extend(OPTIONAL_STATE.iter().find(|f| f.name == stringify!($oname)));
-                })*
-                held
-            }
-
-            /// Holds the optional member `name` from now on; false if there is none.
-            pub fn activate(&mut self, name: &str) -> bool {
-                $($(#[cfg($cfg)])?
-                if name == stringify!($oname) {
-                    self.$oname = true;
-                    return true;
-                })*
-                let _ = name;
-                false
-            }
-        }
 
         /// The states of the entries of a store: a vector per member (the optional ones
         /// empty unless held).
