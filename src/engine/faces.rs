@@ -57,8 +57,20 @@ struct FaceStage<'a> {
 /// every face is a surface of its own), hands the springs of the others to the contact
 /// that absorbs them, then evaluates the law for `WIDTH` contacts at a time in SIMD
 /// lanes (bit for bit as alone).
-#[inline(never)] // a stage of its own in profiles
 pub(super) fn run(
+    model: &Model,
+    p: &Particles,
+    walls: &Walls,
+    owned: Option<&[bool]>,
+    list: &mut ContactList,
+    loads: &mut [Load],
+) -> (Findings, Vec<Sum6>) {
+    with_models!(model.law.choice(), M => run_with::<M>(model, p, walls, owned, list, loads))
+}
+
+/// [`run`] with the sub-models `M`.
+#[inline(never)] // a stage of its own in profiles
+fn run_with<M: Models>(
     model: &Model,
     p: &Particles,
     walls: &Walls,
@@ -95,7 +107,7 @@ pub(super) fn run(
     let blocks: Vec<(Vec<Sum6>, bool)> = all
         .into_par_iter()
         .with_min_len(MIN_PARALLEL_LEN.div_ceil(FACE_BLOCK))
-        .map(|block| SCRATCH.with_borrow_mut(|scratch| stage.block(block, scratch, &found)))
+        .map(|block| SCRATCH.with_borrow_mut(|scratch| stage.block::<M>(block, scratch, &found)))
         .collect();
     let mut found = found.into_inner();
     // The blocks' sums of the loads on the mesh files, in order.
@@ -128,7 +140,12 @@ impl FaceStage<'_> {
     /// One block of the particle-face list: its contacts' loads added to its particles',
     /// and the block's sum of the reactions on each mesh file (and whether it was in range).
     #[inline]
-    fn block(&self, block: Block, scratch: &mut MeshScratch, found: &Found) -> (Vec<Sum6>, bool) {
+    fn block<M: Models>(
+        &self,
+        block: Block,
+        scratch: &mut MeshScratch,
+        found: &Found,
+    ) -> (Vec<Sum6>, bool) {
         let Block {
             owners,
             first,
@@ -159,7 +176,7 @@ impl FaceStage<'_> {
         for group in contacts.chunks(WIDTH) {
             let loads = (&mut *loads, owners.start);
             let slots = (&mut *contact, &mut *store);
-            wall_fine &= self.law_of((group, near), first, slots, loads, &mut wall, found);
+            wall_fine &= self.law_of::<M>((group, near), first, slots, loads, &mut wall, found);
         }
         (wall, wall_fine)
     }
@@ -297,7 +314,7 @@ impl FaceStage<'_> {
     /// their particles (`loads` from owner `loads.1`) and their reactions to `wall`; whether
     /// the wall sums stayed in range.
     #[inline]
-    fn law_of(
+    fn law_of<M: Models>(
         &self,
         (group, near): (&[u32], &[Near]),
         first: usize,
@@ -342,7 +359,7 @@ impl FaceStage<'_> {
         let mut lanes = gather_springs(store, e);
         let force = self
             .law
-            .evaluate(&coef, radius, mass, Other::Wall, &kin, &mut lanes);
+            .compose::<M, _>(&coef, radius, mass, Other::Wall, &kin, &mut lanes);
         scatter_springs(lanes, store, &e[..group.len()]);
         let (f, tau) = (Group::scatter_vec(force.f), Group::scatter_vec(force.tau_i));
         let mut fine = true;

@@ -15,7 +15,9 @@ use rayon::prelude::*;
 
 pub use crate::engine::records::{ContactRecord, Outflow, Partner, Removed, Snapshot, Wrench};
 use crate::geometry::mesh::{Contacts, Face, Mesh};
-use crate::model::contact::{Body, Coefficients, ContactLaw, Kinematics, Other};
+use crate::model::contact::{
+    Body, Coefficients, ContactLaw, Kinematics, Models, Other, with_models,
+};
 use crate::model::exact::{Scale, Scales8, Sum6, pack};
 use crate::model::integrate::{Density, Inertia, Response, State, advance};
 use crate::model::lanes::{Gather, Lanes};

@@ -49,8 +49,18 @@ type SlabLoads<'s, 'l> = (
 /// parted forgets its springs), then evaluates them `WIDTH` at a time in SIMD lanes; a
 /// lane gives the bits the pair would give alone. Body i of a pair is the particle of
 /// the lower id, so a pair's force and springs do not depend on the storage order.
-#[inline(never)] // a stage of its own in profiles
 pub(super) fn run(
+    model: &Model,
+    p: &Particles,
+    lists: &mut Neighbours,
+    loads: &mut [Load],
+) -> Findings {
+    with_models!(model.law.choice(), M => run_with::<M>(model, p, lists, loads))
+}
+
+/// [`run`] with the sub-models `M`.
+#[inline(never)] // a stage of its own in profiles
+fn run_with<M: Models>(
     model: &Model,
     p: &Particles,
     lists: &mut Neighbours,
@@ -93,18 +103,18 @@ pub(super) fn run(
             })
             .collect();
         tasks.into_par_iter().for_each(|(slab, next)| {
-            TOUCHING.with_borrow_mut(|touching| stage.slab(slab, next, touching, &found));
+            TOUCHING.with_borrow_mut(|touching| stage.slab::<M>(slab, next, touching, &found));
         });
     }
     let mut found = found.into_inner();
-    wrapped(model, p, lists, loads, &mut found);
+    wrapped::<M>(model, p, lists, loads, &mut found);
     found
 }
 
 /// Stage 3, across periodic sides: the pairs of `Neighbours::wrapped`, partner j seen at
 /// its image x_j + shift, one by one in slot order (they are few: those at the sides),
 /// after the slabs; the law as for any pair, body i the lower id.
-fn wrapped(
+fn wrapped<M: Models>(
     model: &Model,
     p: &Particles,
     nb: &mut Neighbours,
@@ -154,7 +164,8 @@ fn wrapped(
                     m: model.mass(p, j),
                 };
                 let coef = law.pair(p.material[i], p.material[j]);
-                let force = law.evaluate(coef, p.radius[i], model.mass(p, i), other, &kin, springs);
+                let (r_i, m_i) = (p.radius[i], model.mass(p, i));
+                let force = law.compose::<M, _>(coef, r_i, m_i, other, &kin, springs);
                 let lanes = &model.scales.lanes;
                 let (load_i, load_j) = pair_mut(loads, i, j);
                 let fine = load_i.add(pack(force.f, force.tau_i), lanes)
@@ -199,7 +210,13 @@ impl PairStage<'_> {
     /// One slab of the pair list: its touching pairs, then the law for `WIDTH` of them at a
     /// time, added to the loads of the slab's particles and of the `next` slab's.
     #[inline]
-    fn slab(&self, slab: Block, next: Option<Block>, touching: &mut Vec<[u32; 3]>, found: &Found) {
+    fn slab<M: Models>(
+        &self,
+        slab: Block,
+        next: Option<Block>,
+        touching: &mut Vec<[u32; 3]>,
+        found: &Found,
+    ) {
         let Block {
             owners,
             first,
@@ -211,7 +228,7 @@ impl PairStage<'_> {
         self.touching(owners.clone(), first, contact, store, touching);
         let at = (owners.start, owners.end);
         for group in touching.chunks(WIDTH) {
-            self.group(group, store, (at, &mut *loads, &mut next_loads), found);
+            self.group::<M>(group, store, (at, &mut *loads, &mut next_loads), found);
         }
     }
 
@@ -263,7 +280,7 @@ impl PairStage<'_> {
     /// The law for one group of touching pairs, added to both particles' loads; deep
     /// overlaps and loads out of range to `found`.
     #[inline]
-    fn group(
+    fn group<M: Models>(
         &self,
         group: &[[u32; 3]],
         store: &mut Store,
@@ -300,7 +317,7 @@ impl PairStage<'_> {
         };
         let force = self
             .law
-            .evaluate(&coef, body_i.radius, m_i, other, &kin, &mut lanes);
+            .compose::<M, _>(&coef, body_i.radius, m_i, other, &kin, &mut lanes);
         scatter_springs(lanes, store, &c[..group.len()]);
         let (f, tau_i, tau_j) = (
             Group::scatter_vec(force.f),

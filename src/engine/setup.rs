@@ -493,7 +493,7 @@ pub(super) fn servo_control(
     };
     let law = contact_law(s);
     let e_star = (0..s.materials.len() as u16)
-        .map(|a| law.with_wall(a, wall).e_star)
+        .map(|a| law.with_wall(a, wall).normal.e_star)
         .fold(0.0, f64::max);
     let (r, dt) = (s.geometry.radius_min, s.simulation.timestep);
     let gain = servo

@@ -3,7 +3,7 @@
 //! (`f64x4`, `f64x8` from `wide`, with [`V3`] and [`Q4`] of them: no vector crate has
 //! 3-vectors of 8 double lanes).
 //!
-//! The law (`contact.rs`) and SPIRAL (`integrate.rs`) are generic over [`Lanes`], so both
+//! The law (`contact/`) and SPIRAL (`integrate.rs`) are generic over [`Lanes`], so both
 //! read the same and do the same IEEE operations in the same order: a lane gives the bits
 //! of the contact or particle alone (property tests in both files). Where the scalar code
 //! branches, the lanes take both sides and blend them, unless all lanes agree

@@ -2,6 +2,8 @@
 //! is made from (the scenario's `[[materials]]`, `[[interactions]]` and `[simulation]
 //! friction_springs` become these).
 
+pub use crate::model::registry::ContactModels;
+
 /// The properties of a material (Table 2 of the paper).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
@@ -22,10 +24,12 @@ pub struct Material {
     /// k_c [M/LT²] = [J/m³]: the simplified JKR cohesion, a pull k_c A over the contact
     /// area A.
     pub cohesion: f64,
+    /// The contact law's sub-models for this material's contacts.
+    pub models: ContactModels,
 }
 
 /// When a friction spring is advanced by Δt v relative to the force taken from it
-/// (`[simulation] friction_springs`; the derivation is at `coulomb_spring` in `contact.rs`).
+/// (`[simulation] friction_springs`; the derivation is at `coulomb_spring` in `contact/friction.rs`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum FrictionSprings {
     /// Advance the spring, then take its force: symplectic, creates no energy (the default).
@@ -54,6 +58,7 @@ pub struct PairCoefficients {
     pub friction_rolling: f64,
     pub friction_twisting: f64,
     pub cohesion: f64,
+    pub models: ContactModels,
     /// Whether `[[interactions]]` set any of them (otherwise the means).
     pub given: bool,
 }

@@ -12,6 +12,7 @@ pub mod lanes;
 pub mod materials;
 pub mod motion;
 pub mod particles;
+pub mod registry;
 pub mod rigid;
 pub mod servo;
 pub mod springs;

@@ -227,6 +227,10 @@ pub(super) struct RawGeometry {
 #[serde(deny_unknown_fields)]
 pub(super) struct RawMaterial {
     pub(super) cohesion: Option<f64>,
+    pub(super) normal_model: Option<String>,
+    pub(super) adhesion_model: Option<String>,
+    pub(super) rolling_model: Option<String>,
+    pub(super) tangential_coulomb: Option<String>,
     pub(super) density: Option<f64>,
     pub(super) youngs_modulus: Option<f64>,
     pub(super) poisson_ratio: Option<f64>,
@@ -248,6 +252,10 @@ impl RawMaterial {
             || self.friction_rolling.is_some()
             || self.friction_twisting.is_some()
             || self.cohesion.is_some()
+            || self.normal_model.is_some()
+            || self.adhesion_model.is_some()
+            || self.rolling_model.is_some()
+            || self.tangential_coulomb.is_some()
     }
 }
 
@@ -256,6 +264,10 @@ impl RawMaterial {
 pub(super) struct RawNamedMaterial {
     pub(super) name: String,
     pub(super) cohesion: Option<f64>,
+    pub(super) normal_model: Option<String>,
+    pub(super) adhesion_model: Option<String>,
+    pub(super) rolling_model: Option<String>,
+    pub(super) tangential_coulomb: Option<String>,
     pub(super) density: Option<f64>,
     pub(super) youngs_modulus: Option<f64>,
     pub(super) poisson_ratio: Option<f64>,
@@ -277,6 +289,10 @@ impl From<RawNamedMaterial> for RawMaterial {
             friction_twisting: m.friction_twisting,
             viscosity: None,
             cohesion: m.cohesion,
+            normal_model: m.normal_model,
+            adhesion_model: m.adhesion_model,
+            rolling_model: m.rolling_model,
+            tangential_coulomb: m.tangential_coulomb,
         }
     }
 }
@@ -286,6 +302,10 @@ impl From<RawNamedMaterial> for RawMaterial {
 pub(super) struct RawInteraction {
     pub(super) materials: [String; 2],
     pub(super) cohesion: Option<f64>,
+    pub(super) normal_model: Option<String>,
+    pub(super) adhesion_model: Option<String>,
+    pub(super) rolling_model: Option<String>,
+    pub(super) tangential_coulomb: Option<String>,
     pub(super) restitution: Option<f64>,
     pub(super) friction_sliding: Option<f64>,
     pub(super) friction_rolling: Option<f64>,

@@ -6,6 +6,7 @@ use std::fmt::Write;
 
 use glam::DVec3;
 
+use super::models;
 use super::*;
 use crate::geometry::shapes::{BOX_SIDES, CYLINDER_ENDS};
 
@@ -70,6 +71,9 @@ impl Scenario {
             ] {
                 let _ = writeln!(o, "{key} = {}", num(x));
             }
+            for (key, name) in models::beyond_defaults(m.models, m.cohesion).named() {
+                let _ = writeln!(o, "{key} = {}", text(name));
+            }
         };
         if self.uses_materials() {
             for m in &self.materials {
@@ -88,6 +92,9 @@ impl Scenario {
                     if let Some(x) = x {
                         let _ = writeln!(o, "{key} = {}", num(x));
                     }
+                }
+                for (key, name) in i.models.named() {
+                    let _ = writeln!(o, "{key} = {}", text(name));
                 }
             }
             *o += "\n[material]\n";

@@ -10,6 +10,7 @@ use super::meshes::meshes;
 use super::raw::*;
 use super::spawn::spawn;
 use super::*;
+use crate::model::registry::AdhesionModel;
 
 /// A range check of Table 2's "Requirements" column.
 #[derive(Clone, Copy)]
@@ -81,8 +82,19 @@ pub(super) fn region(key: &str, b: RawBox, strict: bool) -> Result<Region> {
 }
 
 /// Validates the properties of one material (`key` names it in messages).
-fn material(key: &str, m: RawMaterial, viscosity: f64) -> Result<Material> {
-    let key = |name: &str| format!("{key} {name}");
+fn material(table: &str, m: RawMaterial, viscosity: f64) -> Result<Material> {
+    let key = |name: &str| format!("{table} {name}");
+    let cohesion = check(
+        &key("cohesion"),
+        m.cohesion.unwrap_or(0.0),
+        Range::NonNegative,
+    )?;
+    let names = [
+        m.normal_model,
+        m.adhesion_model,
+        m.rolling_model,
+        m.tangential_coulomb,
+    ];
     let friction_sliding = check(
         &key("friction_sliding"),
         m.friction_sliding.unwrap_or(0.3),
@@ -118,11 +130,8 @@ fn material(key: &str, m: RawMaterial, viscosity: f64) -> Result<Material> {
             Range::NonNegative,
         )?,
         viscosity,
-        cohesion: check(
-            &key("cohesion"),
-            m.cohesion.unwrap_or(0.0),
-            Range::NonNegative,
-        )?,
+        cohesion,
+        models: GivenModels::read(table, names)?.of_material(table, cohesion)?,
     })
 }
 
@@ -418,13 +427,30 @@ fn interactions(
         let opt = |name: &str, x: Option<f64>, r: Range| -> Result<Option<f64>> {
             x.map(|x| check(&key(name), x, r)).transpose()
         };
+        let cohesion = opt("cohesion", i.cohesion, Range::NonNegative)?;
+        let models = GivenModels::read(
+            &format!("[[interactions]] #{}", k + 1),
+            [
+                i.normal_model,
+                i.adhesion_model,
+                i.rolling_model,
+                i.tangential_coulomb,
+            ],
+        )?;
+        if models.adhesion == Some(AdhesionModel::None) && cohesion.is_some_and(|k_c| k_c > 0.0) {
+            bail!(
+                "{} = \"none\" contradicts cohesion: drop one of them",
+                key("adhesion_model")
+            );
+        }
         interactions.push(Interaction {
             materials: pair,
             restitution: opt("restitution", i.restitution, Range::Closed(0.0, 1.0))?,
             friction_sliding: opt("friction_sliding", i.friction_sliding, Range::NonNegative)?,
             friction_rolling: opt("friction_rolling", i.friction_rolling, Range::NonNegative)?,
             friction_twisting: opt("friction_twisting", i.friction_twisting, Range::NonNegative)?,
-            cohesion: opt("cohesion", i.cohesion, Range::NonNegative)?,
+            cohesion,
+            models,
         });
     }
     Ok(interactions)

@@ -1,6 +1,10 @@
 //! The contact law against Section 2.2: its limits, its symmetries and its friction springs.
 
+use super::friction::{coulomb_spring, project_onto_tangent_plane};
 use super::*;
+use crate::model::motion::RigidVelocity;
+use crate::model::registry::AdhesionModel;
+use glam::DVec3;
 
 #[test]
 fn beta_limits() {
@@ -114,7 +118,17 @@ mod lanes {
             )
     }
 
-    fn law(e_n: f64) -> ContactLaw {
+    /// The law of one material with restitution `e_n` and cohesion `k_c`, its springs in
+    /// the paper's order or advanced first: each of the four compositions.
+    fn law(e_n: f64, k_c: f64, paper: bool) -> ContactLaw {
+        let models = crate::model::registry::ContactModels {
+            adhesion: if k_c > 0.0 {
+                AdhesionModel::Sjkr
+            } else {
+                AdhesionModel::None
+            },
+            ..Default::default()
+        };
         let material = Material {
             density: 2500.0,
             youngs_modulus: 1e7,
@@ -124,9 +138,19 @@ mod lanes {
             friction_rolling: 0.05,
             friction_twisting: 0.02,
             viscosity: 1e-5,
-            cohesion: 0.0,
+            cohesion: k_c,
+            models,
         };
-        ContactLaw::new(&material, 1e-5, FrictionSprings::AdvanceFirst)
+        let springs = if paper {
+            FrictionSprings::Paper
+        } else {
+            FrictionSprings::AdvanceFirst
+        };
+        ContactLaw::new(&material, 1e-5, springs)
+    }
+
+    fn cohesion() -> impl Strategy<Value = f64> {
+        prop_oneof![Just(0.0), 1.0..1e5f64]
     }
 
     fn mass(r: f64) -> f64 {
@@ -293,8 +317,10 @@ mod lanes {
         fn wall_contacts_in_eight_lanes_give_their_single_bits(
             contacts in proptest::array::uniform8(wall_contact()),
             e_n in 0.1..0.9f64,
+            k_c in cohesion(),
+            paper: bool,
         ) {
-            walls_in_lanes_match_single_contacts::<f64x8, 8>(contacts, law(e_n))?;
+            walls_in_lanes_match_single_contacts::<f64x8, 8>(contacts, law(e_n, k_c, paper))?;
         }
 
         /// The particle-pair stage evaluates several contacts at once; each lane must
@@ -303,16 +329,76 @@ mod lanes {
         fn four_lanes_give_the_bits_of_four_single_contacts(
             contacts in proptest::array::uniform4(contact()),
             e_n in 0.1..0.9f64,
+            k_c in cohesion(),
+            paper: bool,
         ) {
-            lanes_match_single_contacts::<f64x4, 4>(contacts, law(e_n))?;
+            lanes_match_single_contacts::<f64x4, 4>(contacts, law(e_n, k_c, paper))?;
         }
 
         #[test]
         fn eight_lanes_give_the_bits_of_eight_single_contacts(
             contacts in proptest::array::uniform8(contact()),
             e_n in 0.1..0.9f64,
+            k_c in cohesion(),
+            paper: bool,
         ) {
-            lanes_match_single_contacts::<f64x8, 8>(contacts, law(e_n))?;
+            lanes_match_single_contacts::<f64x8, 8>(contacts, law(e_n, k_c, paper))?;
         }
     }
+}
+
+/// A run where some pair adheres composes every contact with SJKR; a pair with k_c = 0
+/// must then give the bits it has without adhesion, in either spring order.
+#[test]
+fn sjkr_without_cohesion_gives_the_bits_of_no_adhesion() {
+    use adhesion::{NoAdhesion, Sjkr};
+    use composition::Composition;
+    use friction::{AdvanceFirst, PaperOrder};
+    let material = Material {
+        density: 2500.0,
+        youngs_modulus: 1e7,
+        poisson_ratio: 0.25,
+        restitution: 0.5,
+        friction_sliding: 0.4,
+        friction_rolling: 0.05,
+        friction_twisting: 0.02,
+        viscosity: 1e-5,
+        cohesion: 0.0,
+        models: Default::default(),
+    };
+    let law = ContactLaw::new(&material, 1e-5, FrictionSprings::AdvanceFirst);
+    let i = Body {
+        x: DVec3::new(0.0, 0.0, 0.0),
+        radius: 1e-3,
+        v: DVec3::new(0.1, -0.2, 0.3),
+        w: DVec3::new(5.0, 1.0, -2.0),
+    };
+    let j = Body {
+        x: DVec3::new(1.9e-3, 1e-4, -2e-4),
+        radius: 1.1e-3,
+        v: DVec3::new(-0.3, 0.0, 0.1),
+        w: DVec3::new(0.0, 7.0, 3.0),
+    };
+    let kin = Kinematics::between_particles(&i, &j).expect("overlapping");
+    let other = Other::Particle { r: 1.1e-3, m: 1e-5 };
+    let springs = Springs {
+        u_s: DVec3::new(1e-6, 2e-6, 0.0),
+        u_r: DVec3::new(0.0, 1e-6, 1e-6),
+        u_t: 1e-6,
+    };
+    let coef = law.pair(0, 0);
+    let run = |compose: &dyn Fn(&mut Springs) -> ContactForce| {
+        let mut s = springs;
+        (compose(&mut s), s)
+    };
+    type Dry<O> = Composition<NoAdhesion, O>;
+    type Wet<O> = Composition<Sjkr, O>;
+    assert_eq!(
+        run(&|s| law.compose::<Dry<AdvanceFirst>, f64>(coef, 1e-3, 1e-5, other, &kin, s)),
+        run(&|s| law.compose::<Wet<AdvanceFirst>, f64>(coef, 1e-3, 1e-5, other, &kin, s)),
+    );
+    assert_eq!(
+        run(&|s| law.compose::<Dry<PaperOrder>, f64>(coef, 1e-3, 1e-5, other, &kin, s)),
+        run(&|s| law.compose::<Wet<PaperOrder>, f64>(coef, 1e-3, 1e-5, other, &kin, s)),
+    );
 }
