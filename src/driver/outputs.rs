@@ -5,12 +5,24 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 
+use crate::engine::records::{ContactRecord, contact_loads};
 use crate::engine::{Simulation, Thermo};
-use crate::io::csv::{Extra, write_frame, write_frame_as};
+use crate::io::csv::{Extra, write_frame_as};
 use crate::io::output::{FRAMES, LOG, LOG_HEADER, OUTLETS, RUN_TOML, WALLS};
 use crate::io::vtk;
+use crate::model::particles::Particles;
 use crate::parallel::comm::Reach;
 use crate::scenario::{Formats, Gather, Met, Scenario};
+
+/// The rows of a frame's files: the particles `own` (all, or a process's own), among those
+/// it `held` (for the partners of their contacts), with the columns `extra` and the `body`
+/// array if `bodies`.
+struct Rows<'p> {
+    own: &'p Particles,
+    held: &'p Particles,
+    bodies: bool,
+    extra: Extra<'static>,
+}
 
 /// Writes frames in the scenario's formats, and the ParaView collection.
 pub(super) struct Frames<'a> {
@@ -69,33 +81,20 @@ impl<'a> Frames<'a> {
         if !sim.is_writer() {
             return Ok(());
         }
-        // The contact force and torque of each row (clumps whole) and of each sphere.
-        let loads = |whole: bool| {
-            let network = contacts.as_deref().filter(|_| s.forces)?;
-            Some(crate::engine::records::contact_loads(
-                &particles, network, whole,
-            ))
+        let network = contacts.as_deref().filter(|_| s.forces);
+        let contacts = contacts.as_deref().filter(|_| s.contact_network);
+        let whole = |stem: &str, ext: &str| format!("{stem}{k:06}.{ext}");
+        let rows = Rows {
+            own: &particles,
+            held: &particles,
+            bodies: !particles.bodies.is_empty(),
+            extra: self.extra,
         };
-        let (rows, spheres) = (loads(true), loads(false));
-        let contacts = contacts.filter(|_| s.contact_network);
-        if self.formats.csv {
-            let extra = Extra {
-                loads: rows.as_ref(),
-                ..self.extra
-            };
-            write_frame(self.dir, k, &particles, extra)?;
-        }
-        if let Some(contacts) = contacts {
-            crate::io::csv::write_contacts(self.dir, &format!("contacts{k:06}.csv"), &contacts)?;
-            if self.formats.vtk {
-                let name = format!("contacts{k:06}.vtp");
-                vtk::write_contacts(&self.dir.join(&name), &particles, &contacts)?;
+        self.files(whole, rows, network, contacts)?;
+        if self.formats.vtk {
+            if contacts.is_some() {
                 self.collection("contacts", k, "vtp")?;
             }
-        }
-        if self.formats.vtk {
-            let name = format!("particles{k:06}.vtu");
-            vtk::write_particles(&self.dir.join(&name), &particles, spheres.as_ref())?;
             self.collection("particles", k, "vtu")?;
             self.moving_mesh(k, sim)?;
         }
@@ -107,44 +106,23 @@ impl<'a> Frames<'a> {
     /// first writes the `.pvtu` and `.pvtp` files that list the VTK pieces.
     fn write_pieces(&self, k: u64, sim: &Simulation) -> Result<()> {
         let (rank, size) = sim.process().expect("a split run");
-        let piece = |stem: &str, ext: &str| format!("{stem}{k:06}_{rank}.{ext}");
         let (own, held) = sim.own_particles_in_domain();
-        let contacts = sim
-            .scenario
-            .contact_network
-            .then(|| sim.own_contact_network());
+        let contacts = (sim.scenario.contact_network).then(|| sim.own_contact_network());
         // Every contact of an own particle is among those this process holds (its ghosts are
         // within reach): the loads of its own rows from them.
-        let loads = |whole: bool| {
-            let network = sim.scenario.forces.then(|| sim.held_contacts())?;
-            Some(crate::engine::records::contact_loads(
-                &held, &network, whole,
-            ))
-        };
-        let (rows, spheres) = (loads(true), loads(false));
+        let network = sim.scenario.forces.then(|| sim.held_contacts());
+        let piece = |stem: &str, ext: &str| format!("{stem}{k:06}_{rank}.{ext}");
         let bodies = self.extra.clump;
-        let written = (|| -> Result<()> {
-            if self.formats.csv {
-                let extra = Extra {
-                    ids: true,
-                    loads: rows.as_ref(),
-                    ..self.extra
-                };
-                write_frame_as(self.dir, &piece("particles", "csv"), &own, extra)?;
-            }
-            if let Some(contacts) = &contacts {
-                crate::io::csv::write_contacts(self.dir, &piece("contacts", "csv"), contacts)?;
-                if self.formats.vtk {
-                    let path = self.dir.join(piece("contacts", "vtp"));
-                    vtk::write_contacts(&path, &held, contacts)?;
-                }
-            }
-            if self.formats.vtk {
-                let path = self.dir.join(piece("particles", "vtu"));
-                vtk::write_particle_piece(&path, &own, bodies, spheres.as_ref())?;
-            }
-            Ok(())
-        })();
+        let rows = Rows {
+            own: &own,
+            held: &held,
+            bodies,
+            extra: Extra {
+                ids: true,
+                ..self.extra
+            },
+        };
+        let written = self.files(piece, rows, network.as_deref(), contacts.as_deref());
         // Every piece on disk before a list names it.
         sim.agree(written)?;
         if !sim.is_writer() || !self.formats.vtk {
@@ -166,6 +144,40 @@ impl<'a> Frames<'a> {
             self.collection("contacts", k, "pvtp")?;
         }
         self.moving_mesh(k, sim)
+    }
+
+    /// The files of one frame or of this process's piece of it, named by `name(stem,
+    /// ext)`: the particles of `rows` in each format, with their contact loads from
+    /// `network` (`[output] forces`), and the contacts `contacts` (`[output] contacts`).
+    fn files(
+        &self,
+        name: impl Fn(&str, &str) -> String,
+        rows: Rows,
+        network: Option<&[ContactRecord]>,
+        contacts: Option<&[ContactRecord]>,
+    ) -> Result<()> {
+        // The contact force and torque of each row (clumps whole) and of each sphere.
+        let loads = |whole: bool| network.map(|n| contact_loads(rows.held, n, whole));
+        let (whole, spheres) = (loads(true), loads(false));
+        if self.formats.csv {
+            let extra = Extra {
+                loads: whole.as_ref(),
+                ..rows.extra
+            };
+            write_frame_as(self.dir, &name("particles", "csv"), rows.own, extra)?;
+        }
+        if let Some(contacts) = contacts {
+            crate::io::csv::write_contacts(self.dir, &name("contacts", "csv"), contacts)?;
+            if self.formats.vtk {
+                let path = self.dir.join(name("contacts", "vtp"));
+                vtk::write_contacts(&path, rows.held, contacts)?;
+            }
+        }
+        if self.formats.vtk {
+            let path = self.dir.join(name("particles", "vtu"));
+            vtk::write_particle_piece(&path, rows.own, rows.bodies, spheres.as_ref())?;
+        }
+        Ok(())
     }
 
     /// The mesh of frame `k`, if it moves, and its collection.

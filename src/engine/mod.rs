@@ -44,6 +44,7 @@ pub mod records;
 mod regions;
 mod report;
 pub mod setup;
+mod snapshot;
 pub mod spawn;
 mod split;
 mod walls;
@@ -486,36 +487,6 @@ pub struct Simulation {
 }
 
 impl Simulation {
-    /// The complete state of the run (collective in a split run, where it fails if the
-    /// state of some process is not one a checkpoint may hold).
-    pub fn snapshot(&self) -> Result<Snapshot> {
-        if self.share.is_some() {
-            return self.snapshot_split();
-        }
-        let p = &self.particles;
-        // The springs by id, each once, in (id, partner) order.
-        let (mut pairs, mut faces) = self.neighbours.entries_by_id(&p.id);
-        pairs.sort_unstable_by_key(|e| (e.0, e.1));
-        faces.sort_unstable_by_key(|e| (e.0, e.1));
-        let (anchors, lonely) = self.neighbours.anchors();
-        Ok(Snapshot {
-            contact_state: self.neighbours.state,
-            steps: self.steps,
-            built_at: self.built_at,
-            particles: p.clone(),
-            spawner: self.spawner.state(),
-            anchors: anchors.to_vec(),
-            lonely: lonely.to_vec(),
-            pair_history: pairs,
-            face_history: faces,
-            removed: self.removed.clone(),
-            wall_sums: self.walls.sums.clone(),
-            scenario: self.scenario.to_toml(),
-            mesh_files: self.walls.signatures(),
-            servos: self.walls.servos(),
-        })
-    }
-
     /// Number of neighbour-list rebuilds so far.
     pub fn rebuilds(&self) -> u64 {
         self.neighbours.rebuilds

@@ -17,15 +17,6 @@ use rustc_hash::{FxHashMap, FxHashSet};
 mod moves;
 use moves::{centre_in_box, exchange_ghosts, migrate, owner_places};
 
-/// The snapshot of the encoded pieces of every process.
-fn join_pieces(pieces: &[Vec<u8>]) -> Result<Snapshot> {
-    let pieces = pieces
-        .iter()
-        .map(|bytes| super::records::decode(bytes, Some(0)))
-        .collect::<Result<Vec<_>>>()?;
-    super::records::join(pieces)
-}
-
 /// Every process's contacts (collective), in the order of `Simulation::contact_network`.
 /// on the processes `reach` names (the others get none).
 pub(crate) fn gather_contacts(
@@ -117,66 +108,6 @@ impl Simulation {
         match &self.share {
             Some(d) => d.comm.sum_i64(&[d.own_count() as i64])[0] as usize,
             None => self.particles.len(),
-        }
-    }
-
-    /// The snapshot of a split run (collective): the pieces of all processes, joined
-    /// (`checkpoint::join`) as the parts of a stop checkpoint are, so that both give the
-    /// same checkpoint. An error if some process's state is not one a checkpoint may hold.
-    pub(crate) fn snapshot_split(&self) -> Result<Snapshot> {
-        let d = self.share.as_ref().expect("a split run");
-        let mine = super::records::encode(&self.snapshot_piece(), 0);
-        join_pieces(&d.comm.all_gather(mine))
-    }
-
-    /// The snapshot of the run on the writer, `None` on the other processes of a split run
-    /// (collective), which never hold more than their own piece.
-    pub fn snapshot_for_writer(&self) -> Result<Option<Snapshot>> {
-        let Some(d) = &self.share else {
-            return self.snapshot().map(Some);
-        };
-        let mine = super::records::encode(&self.snapshot_piece(), 0);
-        let pieces = d.comm.gather(mine);
-        let joined = (!pieces.is_empty()).then(|| join_pieces(&pieces));
-        agree(&*d.comm, joined.transpose())
-    }
-
-    /// This process's piece of the state of a split run: its own particles (with their
-    /// anchors of the last rebuild), the springs of every contact one of them is in, and the
-    /// state all processes share. `checkpoint::join` makes the snapshot of the pieces.
-    pub fn snapshot_piece(&self) -> Snapshot {
-        let d = self.share.as_ref().expect("a split run");
-        let p = &self.particles;
-        let (mut pairs, mut faces) = self.neighbours.entries_by_id(&p.id);
-        let (anchors, _) = self.neighbours.anchors();
-        let own_ids = self.own_ids().expect("a split run");
-        let mut own = p.empty_like();
-        let mut own_anchors = Vec::with_capacity(own_ids.len());
-        for k in (0..p.len()).filter(|&k| d.owned[k]) {
-            own.insert(p.id[k], p.get(k));
-            own_anchors.push(anchors.get(k).copied().unwrap_or(p.x[k]));
-        }
-        for b in p.bodies_where(|k| d.owned[k]) {
-            own.bodies.insert(p.bodies.list[b].clone());
-        }
-        own.locate_bodies();
-        pairs.retain(|e| own_ids.contains(&e.0) || own_ids.contains(&e.1));
-        faces.retain(|e| own_ids.contains(&e.0));
-        Snapshot {
-            contact_state: self.neighbours.state,
-            steps: self.steps,
-            built_at: self.built_at,
-            particles: own,
-            spawner: self.spawner.state(),
-            anchors: own_anchors,
-            lonely: Vec::new(),
-            pair_history: pairs,
-            face_history: faces,
-            removed: self.removed.clone(),
-            wall_sums: self.walls.sums.clone(),
-            scenario: self.scenario.to_toml(),
-            mesh_files: self.walls.signatures(),
-            servos: self.walls.servos(),
         }
     }
 

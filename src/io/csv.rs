@@ -145,13 +145,8 @@ pub fn write_particles(out: &mut impl Write, p: &Particles, extra: Extra) -> std
     Ok(())
 }
 
-/// Writes a frame file atomically: to a temporary name first, then renamed, so a crash
-/// never leaves a half-written frame behind.
-pub fn write_frame(dir: &Path, k: u64, p: &Particles, extra: Extra) -> Result<PathBuf> {
-    write_frame_as(dir, &frame_name(k), p, extra)
-}
-
-/// Writes particles atomically to `dir/name`.
+/// Writes particles atomically to `dir/name` (a frame, or a piece of one): to a temporary
+/// name first, then renamed, so a crash never leaves a half-written frame behind.
 pub fn write_frame_as(dir: &Path, name: &str, p: &Particles, extra: Extra) -> Result<PathBuf> {
     let path = dir.join(name);
     crate::io::files::write_atomically(&path, |w| write_particles(w, p, extra))

@@ -60,7 +60,7 @@ mod text;
 mod until;
 mod validate;
 pub use clumps::{ClumpTemplate, MassSource};
-pub use models::GivenModels;
+pub use models::{GivenModels, beyond_defaults};
 pub use output::{Formats, Gather};
 pub use resolved::changes;
 pub use text::MOST_SCENARIO_BYTES;

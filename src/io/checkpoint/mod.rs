@@ -8,7 +8,7 @@ use std::path::Path;
 use crate::engine::records::Snapshot;
 pub use crate::engine::records::{decode, encode, encode_into, hash, join, shared_part};
 use crate::geometry::mesh::Mesh;
-use crate::scenario::{FrictionSprings, Scenario};
+use crate::scenario::{FrictionSprings, GivenModels, Scenario, beyond_defaults};
 use anyhow::{Context, Result};
 
 pub mod parts;
@@ -63,14 +63,69 @@ pub fn fingerprint(s: &Scenario, mesh: &Mesh) -> u64 {
     };
     // Named materials (absent from older checkpoints, which stay valid without them).
     let text = if s.uses_materials() {
-        format!(
-            "{text}|{:?}|{:?}|{}",
-            s.materials, s.interactions, s.geometry.mesh_material
-        )
+        format!("{text}|{}|{}", materials_text(s), s.geometry.mesh_material)
     } else {
         text
     };
     hash(&text)
+}
+
+/// The named materials and interactions of `s` as the fingerprint holds them: in the text
+/// earlier checkpoints hashed (the `Debug` text their structs had, written out here so that
+/// a member added to the structs changes no fingerprint), then the contact sub-models each
+/// names beyond the defaults, if any.
+fn materials_text(s: &Scenario) -> String {
+    let materials: Vec<String> = (s.materials.iter())
+        .map(|m| {
+            let p = &m.properties;
+            format!(
+                "MaterialSpec {{ name: {:?}, properties: Material {{ density: {:?}, youngs_modulus: {:?}, poisson_ratio: {:?}, restitution: {:?}, friction_sliding: {:?}, friction_rolling: {:?}, friction_twisting: {:?}, viscosity: {:?}, cohesion: {:?} }} }}",
+                m.name,
+                p.density,
+                p.youngs_modulus,
+                p.poisson_ratio,
+                p.restitution,
+                p.friction_sliding,
+                p.friction_rolling,
+                p.friction_twisting,
+                p.viscosity,
+                p.cohesion
+            )
+        })
+        .collect();
+    let interactions: Vec<String> = (s.interactions.iter())
+        .map(|i| {
+            format!(
+                "Interaction {{ materials: {:?}, restitution: {:?}, friction_sliding: {:?}, friction_rolling: {:?}, friction_twisting: {:?}, cohesion: {:?} }}",
+                i.materials,
+                i.restitution,
+                i.friction_sliding,
+                i.friction_rolling,
+                i.friction_twisting,
+                i.cohesion
+            )
+        })
+        .collect();
+    let mut text = format!("[{}]|[{}]", materials.join(", "), interactions.join(", "));
+    let named = |given: GivenModels| -> String {
+        (given.named().iter())
+            .map(|(key, name)| format!(" {key}={name}"))
+            .collect()
+    };
+    for (k, m) in s.materials.iter().enumerate() {
+        let p = &m.properties;
+        let beyond = named(beyond_defaults(p.models, p.cohesion));
+        if !beyond.is_empty() {
+            text += &format!("|models of material {k}:{beyond}");
+        }
+    }
+    for i in &s.interactions {
+        let given = named(i.models);
+        if !given.is_empty() {
+            text += &format!("|models of {:?}:{given}", i.materials);
+        }
+    }
+    text
 }
 
 /// Writes a checkpoint atomically (temporary file, then rename), and then removes the parts
@@ -234,6 +289,45 @@ mod tests {
         assert_eq!(fingerprint(&s, &mesh), FORMAT_2_DEFAULT);
         let default = Scenario::default();
         assert_ne!(fingerprint(&default, &mesh), FORMAT_2_DEFAULT);
+    }
+
+    /// The fingerprint of a scenario of named materials in the checkpoints of commit
+    /// 26f0eb7 (format 8, before the contact sub-models had keys).
+    const FORMAT_8_MATERIALS: u64 = 15390153614767865885;
+
+    #[test]
+    fn the_fingerprint_of_named_materials_is_that_of_format_8() {
+        let text = "[[materials]]\nname = \"glass\"\ncohesion = 200.0\n\
+            [[materials]]\nname = \"steel\"\ndensity = 7800.0\n\
+            [[interactions]]\nmaterials = [\"steel\", \"glass\"]\nfriction_sliding = 0.2\n\
+            [geometry]\nmesh_material = \"steel\"\n";
+        let of = |text: &str| {
+            let s = Scenario::parse(text, Path::new("s.toml")).unwrap();
+            let mesh = crate::geometry::mesh::Mesh::parse_off(
+                crate::scenario::HOURGLASS_OFF,
+                "hourglass",
+                &s.geometry.mesh_radii,
+            )
+            .unwrap()
+            .with_contacts(s.geometry.mesh_contacts);
+            fingerprint(&s, &mesh)
+        };
+        assert_eq!(of(text), FORMAT_8_MATERIALS);
+        // The defaults named change nothing; a model beyond them is another scenario.
+        let named = text.replace(
+            "cohesion = 200.0",
+            "cohesion = 200.0\nadhesion_model = \"sjkr\"",
+        );
+        assert_eq!(of(&named), FORMAT_8_MATERIALS);
+        let dry_pair = format!(
+            "{text}[[interactions]]\nmaterials = [\"glass\", \"glass\"]\nadhesion_model = \"none\"\n"
+        );
+        assert_ne!(of(&dry_pair), FORMAT_8_MATERIALS);
+        let sticky_steel = text.replace(
+            "density = 7800.0",
+            "density = 7800.0\nadhesion_model = \"sjkr\"",
+        );
+        assert_ne!(of(&sticky_steel), FORMAT_8_MATERIALS);
     }
 
     #[test]
