@@ -46,6 +46,7 @@ mod report;
 pub mod setup;
 mod snapshot;
 pub mod spawn;
+mod spawning;
 mod split;
 mod walls;
 use crate::engine::spawn::{Spawner, SpawnerState};
@@ -599,19 +600,6 @@ impl Simulation {
         Ok(())
     }
 
-    /// Particles inserted by each `[[spawn]]` region so far.
-    pub fn spawned(&self) -> Vec<u64> {
-        let mut n = self.spawner.inserted();
-        n.resize(self.scenario.spawn.len(), 0);
-        n
-    }
-
-    /// The `[[spawn]]` regions that have made fewer particles than they were asked for so
-    /// far, each said with its likely cause (see [`Spawner::shortfalls`]).
-    pub fn spawn_shortfalls(&self) -> Vec<String> {
-        (self.spawner).shortfalls(&self.scenario, self.particles.next_id, self.time)
-    }
-
     /// The state `[simulation] until` is checked on at a frame (collective in a split run).
     pub fn frame_state(&self, th: &Thermo) -> crate::scenario::FrameState {
         let p = &self.particles;
@@ -624,25 +612,6 @@ impl Simulation {
             servos: (self.walls.servo_controls().iter())
                 .map(|&(k, c, s)| (k, s.load, c.force))
                 .collect(),
-        }
-    }
-
-    /// Stage 1 (Section 3.1): new particles in the spawn box or the `[[spawn]]` regions.
-    #[inline(never)] // a stage of its own in profiles
-    fn spawn(&mut self) {
-        if self.share.is_some() {
-            return self.spawn_split();
-        }
-        let s = &self.scenario;
-        if self.particles.next_id < s.simulation.max_particles {
-            self.spawner.spawn(
-                s,
-                &mut self.particles,
-                &self.walls.mesh.faces,
-                &self.face_grid,
-                self.time,
-                0.0,
-            );
         }
     }
 

@@ -94,7 +94,7 @@ pub(super) fn migrate(
 /// Where each particle of `p` (at `place`) is placed to find its owner: its place, or for
 /// a sphere of a rigid body its body's centre of mass ([`centre_in_box`]), so that a body
 /// goes whole to the process of its centre.
-pub(super) fn owner_places<'a>(
+pub(in crate::engine) fn owner_places<'a>(
     p: &Particles,
     place: &'a [DVec3],
     periodic: Option<Periodic>,
@@ -112,7 +112,7 @@ pub(super) fn owner_places<'a>(
 
 /// The centre of mass of `body`, put back into a periodic box (a body's centre is never
 /// wrapped in the step, as its spheres are at rebuilds): the place that decides its owner.
-pub(super) fn centre_in_box(body: &RigidBody, periodic: Option<Periodic>) -> DVec3 {
+pub(in crate::engine) fn centre_in_box(body: &RigidBody, periodic: Option<Periodic>) -> DVec3 {
     periodic.map_or(body.x, |periodic| periodic.wrap(body.x))
 }
 
