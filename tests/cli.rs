@@ -263,6 +263,31 @@ fn check_prints_derived_quantities() {
     }
 }
 
+/// The pair table says where each pair's coefficients and sub-models come from, for a pair
+/// of one material too.
+#[test]
+fn check_says_where_each_pairs_coefficients_come_from() {
+    let t = tempfile::tempdir().unwrap();
+    write(
+        t.path(),
+        "s.toml",
+        "[[materials]]\nname = \"a\"\ncohesion = 200.0\n[[materials]]\nname = \"b\"\ncohesion = 100.0\n\
+         [[interactions]]\nmaterials = [\"b\", \"a\"]\nfriction_sliding = 0.5\nadhesion_model = \"none\"\n\
+         [[interactions]]\nmaterials = [\"b\", \"b\"]\nrestitution = 0.9\n\
+         [simulation]\nframes = 1\n",
+    );
+    let o = tinydem(&["check", "s.toml"], t.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    for line in [
+        "a - a: e_n 0.5, mu_s 0.3, mu_r 0.3, mu_t 0.2, k_c 200 (its own)",
+        "a - b: e_n 0.5, mu_s 0.5, mu_r 0.3, mu_t 0.2, k_c 0 (mu_s, adhesion_model from [[interactions]], the rest means)",
+        "b - b: e_n 0.9, mu_s 0.3, mu_r 0.3, mu_t 0.2, k_c 100 (e_n from [[interactions]], the rest its own)",
+    ] {
+        assert!(out.contains(line), "missing {line} in\n{out}");
+    }
+}
+
 #[test]
 fn check_says_the_order_of_the_friction_springs() {
     let t = tempfile::tempdir().unwrap();

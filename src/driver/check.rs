@@ -333,7 +333,6 @@ fn radius_words(r: &crate::scenario::RadiusDistribution) -> String {
     }
 }
 
-/// The materials and the coefficients of each pair of them (where named).
 /// Each clump template: its spheres, mass, principal moments and how they were found.
 fn clump_lines(s: &Scenario) -> String {
     let mut lines = String::new();
@@ -360,6 +359,7 @@ fn clump_lines(s: &Scenario) -> String {
     lines
 }
 
+/// The materials and the coefficients of each pair of them (where named).
 fn material_lines(s: &Scenario) -> String {
     let mut materials = String::new();
     if s.materials.len() > 1 || s.materials[0].name != "default" {
@@ -407,27 +407,30 @@ fn material_lines(s: &Scenario) -> String {
     materials
 }
 
-/// Where the coefficients of the pair of materials `a`, `b` come from.
+/// Where the coefficients of the pair of materials `a`, `b` come from: its own material's,
+/// the means of the two, or (some of them, and the sub-models it names) `[[interactions]]`.
 fn pair_origin(s: &Scenario, a: u16, b: u16) -> String {
-    if a == b {
-        "its own".to_string()
-    } else {
-        let given: Vec<&str> = s
-            .interactions
-            .iter()
-            .find(|i| i.materials == (a, b))
-            .map_or_else(Vec::new, |i| {
-                i.coefficients()
-                    .iter()
-                    .filter(|c| c.2.is_some())
-                    .map(|c| c.1)
-                    .collect()
-            });
-        match given.len() {
-            0 => "means of the two".to_string(),
-            5 => "[[interactions]]".to_string(),
-            _ => format!("{} from [[interactions]], the rest means", given.join(", ")),
+    let interaction = (s.interactions.iter()).find(|i| i.materials == (a.min(b), a.max(b)));
+    let Some(i) = interaction else {
+        return if a == b {
+            "its own"
+        } else {
+            "means of the two"
         }
+        .to_string();
+    };
+    let coefficients = i.coefficients();
+    let given: Vec<&str> = (coefficients.iter().filter(|c| c.2.is_some()).map(|c| c.1))
+        .chain(i.models.named().into_iter().map(|(key, _)| key))
+        .collect();
+    if coefficients.iter().all(|c| c.2.is_some()) {
+        "[[interactions]]".to_string()
+    } else {
+        let rest = if a == b { "its own" } else { "means" };
+        format!(
+            "{} from [[interactions]], the rest {rest}",
+            given.join(", ")
+        )
     }
 }
 
