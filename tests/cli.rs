@@ -288,6 +288,32 @@ fn check_says_where_each_pairs_coefficients_come_from() {
     }
 }
 
+/// `verify` runs its cases, prints the table, writes the report, and refuses an unknown
+/// case naming the known ones.
+#[test]
+fn verify_runs_the_analytic_cases_and_writes_its_report() {
+    let t = tempfile::tempdir().unwrap();
+    let o = tinydem(&["verify", "--quick", "--report", "report"], t.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    for case in [
+        "hertz_impact",
+        "restitution",
+        "slip_to_rolling",
+        "stacked_spheres",
+    ] {
+        assert!(out.contains(case), "missing {case} in\n{out}");
+    }
+    assert!(out.contains("checks pass") && !out.contains(" NO"), "{out}");
+    let report = std::fs::read_to_string(t.path().join("report/verify.md")).unwrap();
+    assert!(
+        report.contains("| `hertz_impact` | contact time [s] |"),
+        "{report}"
+    );
+    let o = tinydem(&["verify", "--only", "hertz_impact,nope"], t.path());
+    fails_with(&o, &["no case \"nope\"", "stacked_spheres"]);
+}
+
 #[test]
 fn check_says_the_order_of_the_friction_springs() {
     let t = tempfile::tempdir().unwrap();

@@ -1,4 +1,4 @@
-//! Tools on a run's output: render, plot, text, analyze, bench.
+//! Tools on a run's output: render, plot, text, analyze, bench; and verify, the analytic cases.
 
 pub mod analyze;
 pub mod bench;
@@ -7,4 +7,5 @@ pub mod frames;
 pub mod plot;
 pub mod render;
 pub mod text;
+pub mod verify;
 pub mod walls;

@@ -6,6 +6,7 @@ mod bench;
 mod plot;
 mod render;
 mod run;
+mod verify;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -58,6 +59,10 @@ enum Command {
     /// The dense-packing benchmark of the paper's Section 5: timed steps in settled
     /// packings; each size and thread count runs in its own process.
     Bench(bench::BenchArgs),
+    /// Run the analytic verification cases (Hertz impact, restitution, slip to rolling,
+    /// static overlaps) with this build: a table of each quantity against its reference;
+    /// fails if any is beyond its tolerance.
+    Verify(verify::VerifyArgs),
 }
 
 impl Command {
@@ -71,6 +76,7 @@ impl Command {
             Command::Plot(_) => "plot",
             Command::Checkpoint(_) => "checkpoint",
             Command::Bench(_) => "bench",
+            Command::Verify(_) => "verify",
         }
     }
 }
@@ -249,6 +255,7 @@ fn execute(
         Some(Command::Plot(args)) => args.execute(),
         Some(Command::Check(args)) => args.execute(),
         Some(Command::Checkpoint(c)) => c.execute(),
+        Some(Command::Verify(args)) => args.execute(),
     }
 }
 

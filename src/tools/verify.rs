@@ -1,0 +1,423 @@
+//! `tinydem verify`: single-contact cases with analytic references, run with the program
+//! itself, so that a user sees on their own build whether it reproduces the known answers.
+//! Each case runs a small simulation and measures what the theory predicts; a check passes
+//! when the relative error is within its tolerance.
+//!
+//! The cases so far (the analytic limits; the published test series of Chung & Ooi 2011 and
+//! of MFIX-DEM are to join them):
+//! - `hertz_impact`: an elastic head-on impact of two equal spheres: peak overlap, peak force
+//!   (from the change of momentum per step) and contact time against Hertz's solution.
+//! - `restitution`: the same impact damped, at two speeds: the coefficient of restitution
+//!   against the `restitution` asked for (Eqs. 18, 21).
+//! - `slip_to_rolling`: a sphere launched sliding on a floor ends rolling at 5/7 of its speed.
+//! - `stacked_spheres`: two spheres at rest on a floor under gravity: the overlaps with the
+//!   floor (load 2 m g) and between them (m g) against Hertz's static overlap.
+
+use anyhow::{Result, bail};
+use glam::{DQuat, DVec3};
+
+use crate::engine::Simulation;
+use crate::geometry::mesh::Mesh;
+use crate::model::integrate::Inertia;
+use crate::model::particles::{Particle, Particles};
+use crate::scenario::Scenario;
+
+/// One quantity of a case: what tinydem measured, the reference, and the tolerance on the
+/// relative error.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Check {
+    pub case: &'static str,
+    pub quantity: String,
+    pub unit: &'static str,
+    pub tinydem: f64,
+    pub reference: f64,
+    /// The largest relative error that passes.
+    pub tolerance: f64,
+}
+
+impl Check {
+    /// |tinydem - reference| / |reference|.
+    pub fn error(&self) -> f64 {
+        (self.tinydem - self.reference).abs() / self.reference.abs()
+    }
+
+    pub fn passes(&self) -> bool {
+        self.error() <= self.tolerance
+    }
+}
+
+/// A case: its name, what it checks and against what, and how to run it.
+pub struct Case {
+    pub name: &'static str,
+    pub what: &'static str,
+    /// Whether `--quick` runs it.
+    pub quick: bool,
+    run: fn() -> Result<Vec<Check>>,
+}
+
+/// Every case, in the order of the table.
+pub const CASES: &[Case] = &[
+    Case {
+        name: "hertz_impact",
+        what: "elastic head-on impact of two equal spheres against Hertz's solution",
+        quick: true,
+        run: hertz_impact,
+    },
+    Case {
+        name: "restitution",
+        what: "damped head-on impacts: the restitution asked for (Eqs. 18, 21)",
+        quick: true,
+        run: restitution,
+    },
+    Case {
+        name: "slip_to_rolling",
+        what: "a sphere sliding on a floor ends rolling at 5/7 of its speed",
+        quick: true,
+        run: slip_to_rolling,
+    },
+    Case {
+        name: "stacked_spheres",
+        what: "two spheres at rest on a floor: Hertz's static overlaps",
+        quick: true,
+        run: stacked_spheres,
+    },
+];
+
+/// The checks of the cases `only` names (all without), or of the quick ones if `quick`.
+pub fn run(only: &[String], quick: bool) -> Result<Vec<Check>> {
+    for name in only {
+        if !CASES.iter().any(|c| c.name == name) {
+            let known: Vec<&str> = CASES.iter().map(|c| c.name).collect();
+            bail!("no case \"{name}\": the cases are {}", known.join(", "));
+        }
+    }
+    let mut checks = Vec::new();
+    for case in CASES {
+        let chosen = if only.is_empty() {
+            case.quick || !quick
+        } else {
+            only.iter().any(|n| n == case.name)
+        };
+        if chosen {
+            checks.extend((case.run)()?);
+        }
+    }
+    Ok(checks)
+}
+
+/// The table of `checks`, one line each.
+pub fn table(checks: &[Check]) -> String {
+    let mut out = format!(
+        "{:<18}{:<34}{:>14}{:>14}{:>11}{:>11}  pass\n",
+        "case", "quantity", "tinydem", "reference", "error", "tolerance"
+    );
+    for c in checks {
+        out += &format!(
+            "{:<18}{:<34}{:>14.6e}{:>14.6e}{:>11.2e}{:>11.1e}  {}\n",
+            c.case,
+            format!("{} [{}]", c.quantity, c.unit),
+            c.tinydem,
+            c.reference,
+            c.error(),
+            c.tolerance,
+            if c.passes() { "yes" } else { "NO" }
+        );
+    }
+    out
+}
+
+/// The report of `checks` as Markdown: what each case is, and the table.
+pub fn report(checks: &[Check]) -> String {
+    let mut out = String::from("# tinydem verify\n\n| case | what |\n|---|---|\n");
+    for case in CASES
+        .iter()
+        .filter(|c| checks.iter().any(|k| k.case == c.name))
+    {
+        out += &format!("| `{}` | {} |\n", case.name, case.what);
+    }
+    out += "\n| case | quantity | tinydem | reference | error | tolerance | pass |\n";
+    out += "|---|---|---|---|---|---|---|\n";
+    for c in checks {
+        out += &format!(
+            "| `{}` | {} [{}] | {:.6e} | {:.6e} | {:.2e} | {:.1e} | {} |\n",
+            c.case,
+            c.quantity,
+            c.unit,
+            c.tinydem,
+            c.reference,
+            c.error(),
+            c.tolerance,
+            if c.passes() { "yes" } else { "**no**" }
+        );
+    }
+    out
+}
+
+/// The spheres of the single-contact cases: radius, density, Young's modulus, Poisson's
+/// ratio (a soft glass-like grain, Table 2's scale).
+const R: f64 = 0.005;
+const RHO: f64 = 1000.0;
+const E: f64 = 1e6;
+const NU: f64 = 0.3;
+
+/// A floor at z = 0.
+const FLOOR: &str = "OFF\n4 1 0\n-1 -1 0\n1 -1 0\n1 1 0\n-1 1 0\n4 0 1 2 3\n";
+
+fn sphere(x: DVec3, v: DVec3) -> Particle {
+    Particle {
+        x,
+        radius: R,
+        v,
+        q: DQuat::IDENTITY,
+        ..Particle::default()
+    }
+}
+
+/// A simulation of `particles` with the material keys `material` (TOML lines), gravity
+/// `g`, time step `dt` (Eq. 50's without) and the floor if `floor`.
+fn simulation(
+    material: &str,
+    g: f64,
+    dt: Option<f64>,
+    floor: bool,
+    particles: Vec<Particle>,
+) -> Result<Simulation> {
+    let dt = dt.map_or(String::new(), |dt| format!("timestep = {dt:e}\n"));
+    let text = format!(
+        "[geometry]\nradius_min = {R}\nradius_max = {R}\nmesh_radii = [0.0]\n\
+         [material]\ndensity = {RHO}\nyoungs_modulus = {E}\npoisson_ratio = {NU}\n{material}\n\
+         [kinetics]\ngravity = [0.0, 0.0, {g}]\n\
+         [simulation]\nmax_particles = 0\nspawn_attempts = 0\n{dt}"
+    );
+    let s = Scenario::parse(&text, std::path::Path::new("verify.toml"))?;
+    let mesh = if floor {
+        Mesh::parse_off(FLOOR, "floor", &s.geometry.mesh_radii)?
+    } else {
+        Mesh::default()
+    };
+    Simulation::from_parts(s, mesh, particles.into_iter().collect::<Particles>())
+}
+
+/// What a head-on impact of two spheres at relative speed `v0` shows: restitution, contact
+/// time, peak overlap and peak force (from sphere 1's change of momentum per step).
+struct Impact {
+    restitution: f64,
+    contact_time: f64,
+    peak_overlap: f64,
+    peak_force: f64,
+}
+
+fn impact(e_n: f64, v0: f64) -> Result<Impact> {
+    let gap = 1e-5;
+    let mut s = simulation(
+        &format!("restitution = {e_n}\nfriction_sliding = 0.3"),
+        0.0,
+        Some(1e-7),
+        false,
+        vec![
+            sphere(DVec3::new(-R - gap, 0.0, 0.0), DVec3::X * v0 / 2.0),
+            sphere(DVec3::new(R + gap, 0.0, 0.0), -DVec3::X * v0 / 2.0),
+        ],
+    )?;
+    let dt = s.scenario.simulation.timestep;
+    let m = Inertia::mass(R, RHO);
+    let overlap = |s: &Simulation| 2.0 * R - (s.particles.x[1] - s.particles.x[0]).length();
+    let (mut steps_in_contact, mut peak_overlap, mut peak_force) = (0u64, 0.0f64, 0.0f64);
+    let mut touched = false;
+    for _ in 0..10_000_000 {
+        let v_before = s.particles.v[1].x;
+        s.step()?;
+        let delta = overlap(&s);
+        if delta > 0.0 {
+            touched = true;
+            steps_in_contact += 1;
+            peak_overlap = peak_overlap.max(delta);
+            peak_force = peak_force.max(m * (s.particles.v[1].x - v_before) / dt);
+        } else if touched {
+            break;
+        }
+    }
+    Ok(Impact {
+        restitution: (s.particles.v[1].x - s.particles.v[0].x) / v0,
+        contact_time: steps_in_contact as f64 * dt,
+        peak_overlap,
+        peak_force,
+    })
+}
+
+/// Hertz's elastic impact: with F = 4/3 E* sqrt(R*) δ^(3/2), the peak overlap
+/// δ_m = (15 m* v0² / (16 E* sqrt(R*)))^(2/5) and the contact time
+/// t_c = 2 δ_m / v0 ∫₀¹ dx / sqrt(1 - x^(5/2)) = 2.94328 δ_m / v0 (Johnson 1985, Sec. 11.4).
+fn hertz_impact() -> Result<Vec<Check>> {
+    let v0 = 0.5;
+    let got = impact(1.0, v0)?;
+    let m_star = Inertia::mass(R, RHO) / 2.0;
+    let (r_star, e_star) = (R / 2.0, E / (2.0 * (1.0 - NU * NU)));
+    let delta_m = (15.0 * m_star * v0 * v0 / (16.0 * e_star * r_star.sqrt())).powf(0.4);
+    let check = |quantity: &str, unit, tinydem, reference, tolerance| Check {
+        case: "hertz_impact",
+        quantity: quantity.into(),
+        unit,
+        tinydem,
+        reference,
+        tolerance,
+    };
+    Ok(vec![
+        check("peak overlap", "m", got.peak_overlap, delta_m, 1e-4),
+        check(
+            "peak force",
+            "N",
+            got.peak_force,
+            4.0 / 3.0 * e_star * r_star.sqrt() * delta_m.powf(1.5),
+            1e-4,
+        ),
+        check(
+            "contact time",
+            "s",
+            got.contact_time,
+            2.0 * 1.471_637_6 * delta_m / v0,
+            5e-4, // the time step is 5e-5 of it
+        ),
+        check("restitution (elastic)", "-", got.restitution, 1.0, 1e-4),
+    ])
+}
+
+/// The damping of Eq. (18) with β of Eq. (21) gives e_n independent of the impact speed
+/// (the damped Hertz oscillator's restitution depends on β alone).
+fn restitution() -> Result<Vec<Check>> {
+    let mut checks = Vec::new();
+    for e_n in [0.2, 0.5, 0.8] {
+        for v0 in [0.1, 1.0] {
+            checks.push(Check {
+                case: "restitution",
+                quantity: format!("e at e_n = {e_n}, v0 = {v0} m/s"),
+                unit: "-",
+                tinydem: impact(e_n, v0)?.restitution,
+                reference: e_n,
+                tolerance: 1e-3,
+            });
+        }
+    }
+    Ok(checks)
+}
+
+/// A sphere launched sliding without spin on a floor: Coulomb friction slows it and spins it
+/// up until v = ω R, at v = 5/7 v0 for a solid sphere (I = 2/5 m R²), whatever μ.
+fn slip_to_rolling() -> Result<Vec<Check>> {
+    let v0 = 0.5;
+    let mut s = simulation(
+        "restitution = 0.5\nfriction_sliding = 0.3\nfriction_rolling = 0.0\nfriction_twisting = 0.0",
+        -9.81,
+        None,
+        true,
+        vec![sphere(DVec3::new(0.0, 0.0, R * 0.9995), DVec3::X * v0)],
+    )?;
+    for _ in 0..40_000 {
+        s.step()?;
+    }
+    let (v, w) = (s.particles.v[0], s.particles.w[0]);
+    let check = |quantity: &str, tinydem, reference| Check {
+        case: "slip_to_rolling",
+        quantity: quantity.into(),
+        unit: "m/s",
+        tinydem,
+        reference,
+        tolerance: 2e-3, // the sphere bounces a little at the start
+    };
+    Ok(vec![
+        check("final speed", v.x, 5.0 / 7.0 * v0),
+        check("final spin times R", w.y * R, 5.0 / 7.0 * v0),
+    ])
+}
+
+/// Two spheres stacked on a floor, settled under gravity: the floor carries 2 m g at
+/// overlap (3 F / (4 E*_w sqrt(R)))^(2/3) with E*_w = E / (1 - ν²) (a rigid wall); the
+/// spheres' contact m g with E* = E / (2 (1 - ν²)), R* = R / 2.
+fn stacked_spheres() -> Result<Vec<Check>> {
+    let g = 9.81;
+    let mut s = simulation(
+        "restitution = 0.1\nfriction_sliding = 0.3",
+        -g,
+        None,
+        true,
+        vec![
+            sphere(DVec3::new(0.0, 0.0, R), DVec3::ZERO),
+            sphere(DVec3::new(0.0, 0.0, 3.0 * R), DVec3::ZERO),
+        ],
+    )?;
+    let dt = s.scenario.simulation.timestep;
+    // Settled: many periods of the contact's oscillation, damped.
+    let steps = (0.5 / dt) as usize;
+    for _ in 0..steps {
+        s.step()?;
+    }
+    let p = &s.particles;
+    let (low, high) = if p.x[0].z < p.x[1].z { (0, 1) } else { (1, 0) };
+    let m = Inertia::mass(R, RHO);
+    let static_overlap = |f: f64, e_star: f64, r_star: f64| {
+        (3.0 * f / (4.0 * e_star * r_star.sqrt())).powf(2.0 / 3.0)
+    };
+    let e_wall = E / (1.0 - NU * NU);
+    let e_pair = E / (2.0 * (1.0 - NU * NU));
+    let check = |quantity: &str, tinydem, reference| Check {
+        case: "stacked_spheres",
+        quantity: quantity.into(),
+        unit: "m",
+        tinydem,
+        reference,
+        tolerance: 1e-6,
+    };
+    Ok(vec![
+        check(
+            "overlap with the floor",
+            R - p.x[low].z,
+            static_overlap(2.0 * m * g, e_wall, R),
+        ),
+        check(
+            "overlap between the spheres",
+            2.0 * R - (p.x[high] - p.x[low]).length(),
+            static_overlap(m * g, e_pair, R / 2.0),
+        ),
+    ])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_unknown_case_is_refused_with_the_known_ones() {
+        let e = run(&["nope".into()], false).unwrap_err().to_string();
+        assert!(e.contains("hertz_impact") && e.contains("nope"), "{e}");
+    }
+
+    #[test]
+    fn a_check_fails_beyond_its_tolerance() {
+        let c = Check {
+            case: "x",
+            quantity: "q".into(),
+            unit: "-",
+            tinydem: 1.02,
+            reference: 1.0,
+            tolerance: 0.01,
+        };
+        assert!(!c.passes());
+        assert!(table(std::slice::from_ref(&c)).contains("NO"));
+        assert!(report(&[c]).contains("**no**"));
+    }
+
+    /// Johnson's constant of the contact time: ∫₀¹ dx / sqrt(1 - x^(5/2)) = sqrt(π) Γ(7/5) / Γ(9/10).
+    #[test]
+    fn the_contact_time_constant_is_the_integral() {
+        // x = 1 - u²: the integrand's singularity at 1 becomes smooth.
+        let n = 200_000;
+        let integral: f64 = (0..n)
+            .map(|k| {
+                let u = (k as f64 + 0.5) / n as f64;
+                let x: f64 = 1.0 - u * u;
+                2.0 * u / (1.0 - x.powf(2.5)).sqrt() / n as f64
+            })
+            .sum();
+        assert!((integral - 1.471_637_6).abs() < 1e-5, "{integral}");
+    }
+}
