@@ -1,6 +1,7 @@
 //! The scenario reference of the user guide (`docs/book/src/scenario/`) and the README stay
-//! true: every TOML snippet on their pages is a valid scenario, every page has one, and the snippets that
-//! show a table's defaults show the defaults the parser gives.
+//! true: every TOML snippet on their pages is a valid scenario, every page has one, and the
+//! snippets that show a table's defaults show the defaults the parser gives; the verification
+//! page shows this build's report.
 
 use std::path::{Path, PathBuf};
 
@@ -124,4 +125,19 @@ fn the_snippets_that_show_defaults_show_the_parsers_defaults() {
     let mut same = s.clone();
     same.timestep = dt;
     assert_eq!(same, default.simulation);
+}
+
+/// The guide's verification page shows the report this build writes (`tinydem verify
+/// --report`): regenerate the page's tables when a case or its numbers change.
+#[test]
+fn the_verification_page_is_the_report_of_this_build() {
+    let checks = tinydem::tools::verify::run(&[], false).unwrap();
+    let report = tinydem::tools::verify::report(&checks);
+    let tables = &report[report.find("| case | what |").unwrap()..];
+    let page = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/book/src/verification.md");
+    let text = std::fs::read_to_string(page).unwrap();
+    assert!(
+        text.ends_with(tables),
+        "the page's tables are not this build's report:\n{tables}"
+    );
 }

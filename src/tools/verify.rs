@@ -33,6 +33,8 @@ pub struct Check {
     pub reference: f64,
     /// The largest relative error that passes.
     pub tolerance: f64,
+    /// Whether the case gave the same bits on 1 and on 2 threads (it passes only then).
+    pub same_bits: bool,
 }
 
 impl Check {
@@ -42,7 +44,7 @@ impl Check {
     }
 
     pub fn passes(&self) -> bool {
-        self.error() <= self.tolerance
+        self.error() <= self.tolerance && self.same_bits
     }
 }
 
@@ -52,7 +54,20 @@ pub struct Case {
     pub what: &'static str,
     /// Whether `--quick` runs it.
     pub quick: bool,
-    run: fn() -> Result<Vec<Check>>,
+    run: fn(Setup) -> Result<Vec<Check>>,
+}
+
+/// How a case makes its simulations: `tamper` changes each after its setup (a test makes
+/// the model wrong with it, to see the suite fail).
+#[derive(Clone, Copy)]
+pub struct Setup {
+    tamper: fn(&mut Simulation),
+}
+
+impl Default for Setup {
+    fn default() -> Setup {
+        Setup { tamper: |_| {} }
+    }
 }
 
 /// Every case, in the order of the table.
@@ -85,6 +100,12 @@ pub const CASES: &[Case] = &[
 
 /// The checks of the cases `only` names (all without), or of the quick ones if `quick`.
 pub fn run(only: &[String], quick: bool) -> Result<Vec<Check>> {
+    run_with(only, quick, Setup::default())
+}
+
+/// [`run`] with the simulations made by `setup`: each case on 1 and on 2 threads, its
+/// checks those of 1 thread, marked with whether 2 gave the same bits.
+fn run_with(only: &[String], quick: bool, setup: Setup) -> Result<Vec<Check>> {
     for name in only {
         if !CASES.iter().any(|c| c.name == name) {
             let known: Vec<&str> = CASES.iter().map(|c| c.name).collect();
@@ -99,7 +120,17 @@ pub fn run(only: &[String], quick: bool) -> Result<Vec<Check>> {
             only.iter().any(|n| n == case.name)
         };
         if chosen {
-            checks.extend((case.run)()?);
+            let on = |threads: usize| -> Result<Vec<Check>> {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()?;
+                pool.install(|| (case.run)(setup))
+            };
+            let (one, two) = (on(1)?, on(2)?);
+            for (mut check, other) in one.into_iter().zip(two) {
+                check.same_bits &= check.tinydem.to_bits() == other.tinydem.to_bits();
+                checks.push(check);
+            }
         }
     }
     Ok(checks)
@@ -108,18 +139,19 @@ pub fn run(only: &[String], quick: bool) -> Result<Vec<Check>> {
 /// The table of `checks`, one line each.
 pub fn table(checks: &[Check]) -> String {
     let mut out = format!(
-        "{:<18}{:<34}{:>14}{:>14}{:>11}{:>11}  pass\n",
+        "{:<18}{:<34}{:>14}{:>14}{:>11}{:>11}  1=2 threads  pass\n",
         "case", "quantity", "tinydem", "reference", "error", "tolerance"
     );
     for c in checks {
         out += &format!(
-            "{:<18}{:<34}{:>14.6e}{:>14.6e}{:>11.2e}{:>11.1e}  {}\n",
+            "{:<18}{:<34}{:>14.6e}{:>14.6e}{:>11.2e}{:>11.1e}  {:<11}  {}\n",
             c.case,
             format!("{} [{}]", c.quantity, c.unit),
             c.tinydem,
             c.reference,
             c.error(),
             c.tolerance,
+            if c.same_bits { "same bits" } else { "DIFFER" },
             if c.passes() { "yes" } else { "NO" }
         );
     }
@@ -135,11 +167,12 @@ pub fn report(checks: &[Check]) -> String {
     {
         out += &format!("| `{}` | {} |\n", case.name, case.what);
     }
-    out += "\n| case | quantity | tinydem | reference | error | tolerance | pass |\n";
-    out += "|---|---|---|---|---|---|---|\n";
+    out +=
+        "\n| case | quantity | tinydem | reference | error | tolerance | 1 = 2 threads | pass |\n";
+    out += "|---|---|---|---|---|---|---|---|\n";
     for c in checks {
         out += &format!(
-            "| `{}` | {} [{}] | {:.6e} | {:.6e} | {:.2e} | {:.1e} | {} |\n",
+            "| `{}` | {} [{}] | {:.6e} | {:.6e} | {:.2e} | {:.1e} | {} | {} |\n",
             c.case,
             c.quantity,
             c.unit,
@@ -147,6 +180,11 @@ pub fn report(checks: &[Check]) -> String {
             c.reference,
             c.error(),
             c.tolerance,
+            if c.same_bits {
+                "same bits"
+            } else {
+                "**differ**"
+            },
             if c.passes() { "yes" } else { "**no**" }
         );
     }
@@ -176,6 +214,7 @@ fn sphere(x: DVec3, v: DVec3) -> Particle {
 /// A simulation of `particles` with the material keys `material` (TOML lines), gravity
 /// `g`, time step `dt` (Eq. 50's without) and the floor if `floor`.
 fn simulation(
+    setup: Setup,
     material: &str,
     g: f64,
     dt: Option<f64>,
@@ -195,7 +234,9 @@ fn simulation(
     } else {
         Mesh::default()
     };
-    Simulation::from_parts(s, mesh, particles.into_iter().collect::<Particles>())
+    let mut sim = Simulation::from_parts(s, mesh, particles.into_iter().collect::<Particles>())?;
+    (setup.tamper)(&mut sim);
+    Ok(sim)
 }
 
 /// What a head-on impact of two spheres at relative speed `v0` shows: restitution, contact
@@ -207,9 +248,10 @@ struct Impact {
     peak_force: f64,
 }
 
-fn impact(e_n: f64, v0: f64) -> Result<Impact> {
+fn impact(setup: Setup, e_n: f64, v0: f64) -> Result<Impact> {
     let gap = 1e-5;
     let mut s = simulation(
+        setup,
         &format!("restitution = {e_n}\nfriction_sliding = 0.3"),
         0.0,
         Some(1e-7),
@@ -248,9 +290,9 @@ fn impact(e_n: f64, v0: f64) -> Result<Impact> {
 /// Hertz's elastic impact: with F = 4/3 E* sqrt(R*) δ^(3/2), the peak overlap
 /// δ_m = (15 m* v0² / (16 E* sqrt(R*)))^(2/5) and the contact time
 /// t_c = 2 δ_m / v0 ∫₀¹ dx / sqrt(1 - x^(5/2)) = 2.94328 δ_m / v0 (Johnson 1985, Sec. 11.4).
-fn hertz_impact() -> Result<Vec<Check>> {
+fn hertz_impact(setup: Setup) -> Result<Vec<Check>> {
     let v0 = 0.5;
-    let got = impact(1.0, v0)?;
+    let got = impact(setup, 1.0, v0)?;
     let m_star = Inertia::mass(R, RHO) / 2.0;
     let (r_star, e_star) = (R / 2.0, E / (2.0 * (1.0 - NU * NU)));
     let delta_m = (15.0 * m_star * v0 * v0 / (16.0 * e_star * r_star.sqrt())).powf(0.4);
@@ -261,6 +303,7 @@ fn hertz_impact() -> Result<Vec<Check>> {
         tinydem,
         reference,
         tolerance,
+        same_bits: true,
     };
     Ok(vec![
         check("peak overlap", "m", got.peak_overlap, delta_m, 1e-4),
@@ -284,7 +327,7 @@ fn hertz_impact() -> Result<Vec<Check>> {
 
 /// The damping of Eq. (18) with β of Eq. (21) gives e_n independent of the impact speed
 /// (the damped Hertz oscillator's restitution depends on β alone).
-fn restitution() -> Result<Vec<Check>> {
+fn restitution(setup: Setup) -> Result<Vec<Check>> {
     let mut checks = Vec::new();
     for e_n in [0.2, 0.5, 0.8] {
         for v0 in [0.1, 1.0] {
@@ -292,9 +335,10 @@ fn restitution() -> Result<Vec<Check>> {
                 case: "restitution",
                 quantity: format!("e at e_n = {e_n}, v0 = {v0} m/s"),
                 unit: "-",
-                tinydem: impact(e_n, v0)?.restitution,
+                tinydem: impact(setup, e_n, v0)?.restitution,
                 reference: e_n,
                 tolerance: 1e-3,
+                same_bits: true,
             });
         }
     }
@@ -303,9 +347,10 @@ fn restitution() -> Result<Vec<Check>> {
 
 /// A sphere launched sliding without spin on a floor: Coulomb friction slows it and spins it
 /// up until v = ω R, at v = 5/7 v0 for a solid sphere (I = 2/5 m R²), whatever μ.
-fn slip_to_rolling() -> Result<Vec<Check>> {
+fn slip_to_rolling(setup: Setup) -> Result<Vec<Check>> {
     let v0 = 0.5;
     let mut s = simulation(
+        setup,
         "restitution = 0.5\nfriction_sliding = 0.3\nfriction_rolling = 0.0\nfriction_twisting = 0.0",
         -9.81,
         None,
@@ -323,6 +368,7 @@ fn slip_to_rolling() -> Result<Vec<Check>> {
         tinydem,
         reference,
         tolerance: 2e-3, // the sphere bounces a little at the start
+        same_bits: true,
     };
     Ok(vec![
         check("final speed", v.x, 5.0 / 7.0 * v0),
@@ -333,9 +379,10 @@ fn slip_to_rolling() -> Result<Vec<Check>> {
 /// Two spheres stacked on a floor, settled under gravity: the floor carries 2 m g at
 /// overlap (3 F / (4 E*_w sqrt(R)))^(2/3) with E*_w = E / (1 - ν²) (a rigid wall); the
 /// spheres' contact m g with E* = E / (2 (1 - ν²)), R* = R / 2.
-fn stacked_spheres() -> Result<Vec<Check>> {
+fn stacked_spheres(setup: Setup) -> Result<Vec<Check>> {
     let g = 9.81;
     let mut s = simulation(
+        setup,
         "restitution = 0.1\nfriction_sliding = 0.3",
         -g,
         None,
@@ -366,6 +413,7 @@ fn stacked_spheres() -> Result<Vec<Check>> {
         tinydem,
         reference,
         tolerance: 1e-6,
+        same_bits: true,
     };
     Ok(vec![
         check(
@@ -391,6 +439,31 @@ mod tests {
         assert!(e.contains("hertz_impact") && e.contains("nope"), "{e}");
     }
 
+    /// The suite can fail: with the normal stiffness doubled (a wrong model), the Hertz
+    /// cases do.
+    #[test]
+    fn a_wrong_model_fails_the_hertz_cases() {
+        let stiffer = Setup {
+            tamper: |sim| sim.model.law.stiffer(2.0),
+        };
+        let only = ["hertz_impact".to_string(), "stacked_spheres".to_string()];
+        let checks = run_with(&only, false, stiffer).unwrap();
+        let failed: Vec<&str> = (checks.iter().filter(|c| !c.passes()))
+            .map(|c| c.quantity.as_str())
+            .collect();
+        assert_eq!(
+            failed,
+            [
+                "peak overlap",
+                "peak force",
+                "contact time",
+                "overlap with the floor",
+                "overlap between the spheres"
+            ]
+        );
+        assert!(run(&only, false).unwrap().iter().all(Check::passes));
+    }
+
     #[test]
     fn a_check_fails_beyond_its_tolerance() {
         let c = Check {
@@ -400,6 +473,7 @@ mod tests {
             tinydem: 1.02,
             reference: 1.0,
             tolerance: 0.01,
+            same_bits: true,
         };
         assert!(!c.passes());
         assert!(table(std::slice::from_ref(&c)).contains("NO"));

@@ -287,6 +287,14 @@ impl ContactLaw {
         &self.walls[a as usize * self.materials + w as usize]
     }
 
+    /// The law with every E* times `factor`: a wrong model, for the tests that must see it fail.
+    #[cfg(test)]
+    pub(crate) fn stiffer(&mut self, factor: f64) {
+        for c in self.pairs.iter_mut().chain(&mut self.walls) {
+            c.normal.e_star *= factor;
+        }
+    }
+
     /// Normal stiffness k_n at overlap `delta` between two particles of radii `r_i`, `r_j`
     /// (Eqs. 12, 14, 17); used for reporting derived quantities.
     pub fn normal_stiffness(&self, r_i: f64, r_j: f64, delta: f64) -> f64 {
