@@ -59,9 +59,9 @@ enum Command {
     /// The dense-packing benchmark of the paper's Section 5: timed steps in settled
     /// packings; each size and thread count runs in its own process.
     Bench(bench::BenchArgs),
-    /// Run the analytic verification cases (Hertz impact, restitution, slip to rolling,
-    /// static overlaps) with this build: a table of each quantity against its reference;
-    /// fails if any is beyond its tolerance.
+    /// Run the analytic verification cases (Hertz impacts, restitution, oblique sliding,
+    /// slip to rolling, static overlaps) with this build: a table of each quantity against
+    /// its reference; fails if any is beyond its tolerance.
     Verify(verify::VerifyArgs),
 }
 
