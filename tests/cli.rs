@@ -299,6 +299,7 @@ fn verify_runs_the_analytic_cases_and_writes_its_report() {
     for case in [
         "hertz_impact",
         "restitution",
+        "free_fall",
         "wall_impact",
         "slip_to_rolling",
         "stacked_spheres",
