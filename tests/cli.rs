@@ -301,6 +301,7 @@ fn verify_runs_the_analytic_cases_and_writes_its_report() {
         "restitution",
         "free_fall",
         "wall_impact",
+        "chung_ooi_2",
         "slip_to_rolling",
         "stacked_spheres",
     ] {

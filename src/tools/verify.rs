@@ -12,6 +12,8 @@
 //! - `free_fall`: a sphere dropped onto a floor: fall time, impact speed, rebound height.
 //! - `wall_impact`: an elastic impact on a rigid floor against Hertz, and an oblique one in
 //!   gross sliding: the tangential speed and spin after it.
+//! - `chung_ooi_2`: Chung & Ooi's (2011) test 2, an elastic normal impact on a rigid plane
+//!   (two alloys): peak overlap, peak force, contact time against Hertz.
 //! - `slip_to_rolling`: a sphere launched sliding on a floor ends rolling at 5/7 of its speed.
 //! - `stacked_spheres`: two spheres at rest on a floor under gravity: the overlaps with the
 //!   floor (load 2 m g) and between them (m g) against Hertz's static overlap.
@@ -98,6 +100,12 @@ pub const CASES: &[Case] = &[
         what: "elastic and oblique impacts on a rigid floor: Hertz, and the gross-sliding limit",
         quick: true,
         run: wall_impact,
+    },
+    Case {
+        name: "chung_ooi_2",
+        what: "Chung & Ooi (2011) test 2: elastic normal impact of a sphere on a rigid plane",
+        quick: true,
+        run: chung_ooi_2,
     },
     Case {
         name: "slip_to_rolling",
@@ -217,18 +225,23 @@ const NU: f64 = 0.3;
 const FLOOR: &str = "OFF\n4 1 0\n-1 -1 0\n1 -1 0\n1 1 0\n-1 1 0\n4 0 1 2 3\n";
 
 fn sphere(x: DVec3, v: DVec3) -> Particle {
+    sphere_of(R, x, v)
+}
+
+fn sphere_of(radius: f64, x: DVec3, v: DVec3) -> Particle {
     Particle {
         x,
-        radius: R,
+        radius,
         v,
         q: DQuat::IDENTITY,
         ..Particle::default()
     }
 }
 
-/// A simulation of `particles` with the material keys `material` (TOML lines), gravity
-/// `g`, time step `dt` (Eq. 50's without) and the floor if `floor`; Young's modulus `E`
-/// unless `material` gives one.
+/// A simulation of `particles` (their radius the first one's) with the material keys
+/// `material` (TOML lines; density, Young's modulus and Poisson's ratio `RHO`, `E`, `NU`
+/// unless it gives them), gravity `g`, time step `dt` (Eq. 50's without) and the floor if
+/// `floor`.
 fn simulation(
     setup: Setup,
     material: &str,
@@ -238,14 +251,20 @@ fn simulation(
     particles: Vec<Particle>,
 ) -> Result<Simulation> {
     let dt = dt.map_or(String::new(), |dt| format!("timestep = {dt:e}\n"));
-    let stiffness = if material.contains("youngs_modulus") {
-        String::new()
-    } else {
-        format!("youngs_modulus = {E}\n")
-    };
+    let mut keys = String::new();
+    for (key, value) in [
+        ("density", RHO),
+        ("youngs_modulus", E),
+        ("poisson_ratio", NU),
+    ] {
+        if !material.contains(key) {
+            keys += &format!("{key} = {value:e}\n");
+        }
+    }
+    let r = particles.first().map_or(R, |p| p.radius);
     let text = format!(
-        "[geometry]\nradius_min = {R}\nradius_max = {R}\nmesh_radii = [0.0]\n\
-         [material]\ndensity = {RHO}\npoisson_ratio = {NU}\n{stiffness}{material}\n\
+        "[geometry]\nradius_min = {r:e}\nradius_max = {r:e}\nmesh_radii = [0.0]\n\
+         [material]\n{keys}{material}\n\
          [kinetics]\ngravity = [0.0, 0.0, {g}]\n\
          [simulation]\nmax_particles = 0\nspawn_attempts = 0\n{dt}"
     );
@@ -490,6 +509,73 @@ fn wall_impact(setup: Setup) -> Result<Vec<Check>> {
             2e-3,
         ),
     ])
+}
+
+/// Chung & Ooi (2011), test 2: a sphere of radius 0.1 m meets a rigid plane at 0.2 m/s,
+/// elastic and frictionless, of aluminium alloy (E = 70 GPa, ν = 0.30, ρ = 2699 kg/m³) and
+/// of magnesium alloy (40 GPa, 0.35, 1800 kg/m³). Their figure is the force-overlap curve of
+/// Hertz's solution; checked here: its peak overlap and force (force as m dv/dt) and the
+/// contact time, with m* = m, R* = R, E* = E / (1 - ν²).
+fn chung_ooi_2(setup: Setup) -> Result<Vec<Check>> {
+    let (r, v0, dt) = (0.1, 0.2, 1e-7);
+    let mut checks = Vec::new();
+    for (name, e, nu, rho) in [
+        ("aluminium alloy", 7.0e10, 0.30, 2699.0),
+        ("magnesium alloy", 4.0e10, 0.35, 1800.0),
+    ] {
+        let material = format!(
+            "density = {rho:e}\nyoungs_modulus = {e:e}\npoisson_ratio = {nu}\n\
+             restitution = 1.0\nfriction_sliding = 0.0\nfriction_rolling = 0.0"
+        );
+        let at = DVec3::new(0.0, 0.0, r + 1e-7);
+        let ball = sphere_of(r, at, -DVec3::Z * v0);
+        let mut s = simulation(setup, &material, 0.0, Some(dt), true, vec![ball])?;
+        let m = Inertia::mass(r, rho);
+        let (mut steps, mut peak_overlap, mut peak_force, mut touched) =
+            (0u64, 0.0f64, 0.0f64, false);
+        for _ in 0..10_000_000 {
+            let v_before = s.particles.v[0].z;
+            s.step()?;
+            let delta = r - s.particles.x[0].z;
+            if delta > 0.0 {
+                touched = true;
+                steps += 1;
+                peak_overlap = peak_overlap.max(delta);
+                peak_force = peak_force.max(m * (s.particles.v[0].z - v_before) / dt);
+            } else if touched {
+                break;
+            }
+        }
+        let e_star = e / (1.0 - nu * nu);
+        let delta_m = (15.0 * m * v0 * v0 / (16.0 * e_star * r.sqrt())).powf(0.4);
+        let check = |quantity: &str, unit, tinydem, reference, tolerance| Check {
+            case: "chung_ooi_2",
+            quantity: format!("{name}: {quantity}"),
+            unit,
+            tinydem,
+            reference,
+            tolerance,
+            same_bits: true,
+        };
+        checks.extend([
+            check("peak overlap", "m", peak_overlap, delta_m, 1e-4),
+            check(
+                "peak force",
+                "N",
+                peak_force,
+                4.0 / 3.0 * e_star * r.sqrt() * delta_m.powf(1.5),
+                1e-4,
+            ),
+            check(
+                "contact time",
+                "s",
+                steps as f64 * dt,
+                2.0 * 1.471_637_6 * delta_m / v0,
+                5e-4,
+            ),
+        ]);
+    }
+    Ok(checks)
 }
 
 /// A sphere launched sliding without spin on a floor: Coulomb friction slows it and spins it

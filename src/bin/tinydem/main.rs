@@ -59,8 +59,8 @@ enum Command {
     /// The dense-packing benchmark of the paper's Section 5: timed steps in settled
     /// packings; each size and thread count runs in its own process.
     Bench(bench::BenchArgs),
-    /// Run the analytic verification cases (Hertz impacts, restitution, oblique sliding,
-    /// slip to rolling, static overlaps) with this build: a table of each quantity against
+    /// Run the analytic verification cases (Hertz impacts, Chung & Ooi's test 2,
+    /// restitution, oblique sliding, slip to rolling, static overlaps) with this build: a table of each quantity against
     /// its reference; fails if any is beyond its tolerance.
     Verify(verify::VerifyArgs),
 }
