@@ -43,6 +43,25 @@ pub struct Check {
 }
 
 impl Check {
+    /// A check of `case`: `quantity` [`unit`] measured as `tinydem`, expected as `reference`
+    /// within the relative `tolerance`.
+    fn of(
+        case: &'static str,
+        quantity: impl Into<String>,
+        unit: &'static str,
+        (tinydem, reference, tolerance): (f64, f64, f64),
+    ) -> Check {
+        Check {
+            case,
+            quantity: quantity.into(),
+            unit,
+            tinydem,
+            reference,
+            tolerance,
+            same_bits: true,
+        }
+    }
+
     /// |tinydem - reference| / |reference|.
     pub fn error(&self) -> f64 {
         (self.tinydem - self.reference).abs() / self.reference.abs()
@@ -336,14 +355,13 @@ fn hertz_impact(setup: Setup) -> Result<Vec<Check>> {
     let m_star = Inertia::mass(R, RHO) / 2.0;
     let (r_star, e_star) = (R / 2.0, E / (2.0 * (1.0 - NU * NU)));
     let delta_m = (15.0 * m_star * v0 * v0 / (16.0 * e_star * r_star.sqrt())).powf(0.4);
-    let check = |quantity: &str, unit, tinydem, reference, tolerance| Check {
-        case: "hertz_impact",
-        quantity: quantity.into(),
-        unit,
-        tinydem,
-        reference,
-        tolerance,
-        same_bits: true,
+    let check = |quantity: &str, unit, tinydem, reference, tolerance| {
+        Check::of(
+            "hertz_impact",
+            quantity,
+            unit,
+            (tinydem, reference, tolerance),
+        )
     };
     Ok(vec![
         check("peak overlap", "m", got.peak_overlap, delta_m, 1e-4),
@@ -371,15 +389,9 @@ fn restitution(setup: Setup) -> Result<Vec<Check>> {
     let mut checks = Vec::new();
     for e_n in [0.2, 0.5, 0.8] {
         for v0 in [0.1, 1.0] {
-            checks.push(Check {
-                case: "restitution",
-                quantity: format!("e at e_n = {e_n}, v0 = {v0} m/s"),
-                unit: "-",
-                tinydem: impact(setup, e_n, v0)?.restitution,
-                reference: e_n,
-                tolerance: 1e-3,
-                same_bits: true,
-            });
+            let e = impact(setup, e_n, v0)?.restitution;
+            let quantity = format!("e at e_n = {e_n}, v0 = {v0} m/s");
+            checks.push(Check::of("restitution", quantity, "-", (e, e_n, 1e-3)));
         }
     }
     Ok(checks)
@@ -416,14 +428,8 @@ fn free_fall(setup: Setup) -> Result<Vec<Check>> {
         s.step()?;
         apex = apex.max(s.particles.x[0].z);
     }
-    let check = |quantity: &str, unit, tinydem, reference, tolerance| Check {
-        case: "free_fall",
-        quantity: quantity.into(),
-        unit,
-        tinydem,
-        reference,
-        tolerance,
-        same_bits: true,
+    let check = |quantity: &str, unit, tinydem, reference, tolerance| {
+        Check::of("free_fall", quantity, unit, (tinydem, reference, tolerance))
     };
     Ok(vec![
         check("time to touch", "s", touch, (2.0 * h / g).sqrt(), 1e-4),
@@ -469,14 +475,13 @@ fn wall_impact(setup: Setup) -> Result<Vec<Check>> {
         1000.0 * E
     );
     let (oblique, _) = bounce(&material, DVec3::new(v_t, 0.0, -v_n))?;
-    let check = |quantity: &str, unit, tinydem, reference, tolerance| Check {
-        case: "wall_impact",
-        quantity: quantity.into(),
-        unit,
-        tinydem,
-        reference,
-        tolerance,
-        same_bits: true,
+    let check = |quantity: &str, unit, tinydem, reference, tolerance| {
+        Check::of(
+            "wall_impact",
+            quantity,
+            unit,
+            (tinydem, reference, tolerance),
+        )
     };
     let impulse = 2.0 * mu * v_n;
     Ok(vec![
@@ -548,14 +553,14 @@ fn chung_ooi_2(setup: Setup) -> Result<Vec<Check>> {
         }
         let e_star = e / (1.0 - nu * nu);
         let delta_m = (15.0 * m * v0 * v0 / (16.0 * e_star * r.sqrt())).powf(0.4);
-        let check = |quantity: &str, unit, tinydem, reference, tolerance| Check {
-            case: "chung_ooi_2",
-            quantity: format!("{name}: {quantity}"),
-            unit,
-            tinydem,
-            reference,
-            tolerance,
-            same_bits: true,
+        let check = |quantity: &str, unit, tinydem, reference, tolerance| {
+            let quantity = format!("{name}: {quantity}");
+            Check::of(
+                "chung_ooi_2",
+                quantity,
+                unit,
+                (tinydem, reference, tolerance),
+            )
         };
         checks.extend([
             check("peak overlap", "m", peak_overlap, delta_m, 1e-4),
@@ -594,14 +599,14 @@ fn slip_to_rolling(setup: Setup) -> Result<Vec<Check>> {
         s.step()?;
     }
     let (v, w) = (s.particles.v[0], s.particles.w[0]);
-    let check = |quantity: &str, tinydem, reference| Check {
-        case: "slip_to_rolling",
-        quantity: quantity.into(),
-        unit: "m/s",
-        tinydem,
-        reference,
-        tolerance: 2e-3, // the sphere bounces a little at the start
-        same_bits: true,
+    // The tolerance: the sphere bounces a little at the start.
+    let check = |quantity: &str, tinydem, reference| {
+        Check::of(
+            "slip_to_rolling",
+            quantity,
+            "m/s",
+            (tinydem, reference, 2e-3),
+        )
     };
     Ok(vec![
         check("final speed", v.x, 5.0 / 7.0 * v0),
@@ -639,14 +644,8 @@ fn stacked_spheres(setup: Setup) -> Result<Vec<Check>> {
     };
     let e_wall = E / (1.0 - NU * NU);
     let e_pair = E / (2.0 * (1.0 - NU * NU));
-    let check = |quantity: &str, tinydem, reference| Check {
-        case: "stacked_spheres",
-        quantity: quantity.into(),
-        unit: "m",
-        tinydem,
-        reference,
-        tolerance: 1e-6,
-        same_bits: true,
+    let check = |quantity: &str, tinydem, reference| {
+        Check::of("stacked_spheres", quantity, "m", (tinydem, reference, 1e-6))
     };
     Ok(vec![
         check(

@@ -268,6 +268,17 @@ mod tests {
         }
     }
 
+    /// The built-in hourglass as scenario `s` makes it.
+    fn hourglass(s: &Scenario) -> crate::geometry::mesh::Mesh {
+        crate::geometry::mesh::Mesh::parse_off(
+            crate::scenario::HOURGLASS_OFF,
+            "hourglass",
+            &s.geometry.mesh_radii,
+        )
+        .unwrap()
+        .with_contacts(s.geometry.mesh_contacts)
+    }
+
     /// The fingerprint of the default scenario in the checkpoints of the build of
     /// 2026-12-02 (format 2, commit 40d4a3a).
     const FORMAT_2_DEFAULT: u64 = 3511474096700281170;
@@ -279,13 +290,7 @@ mod tests {
         // they are another scenario.
         let mut s = Scenario::default();
         s.simulation.friction_springs = crate::scenario::FrictionSprings::Paper;
-        let mesh = crate::geometry::mesh::Mesh::parse_off(
-            crate::scenario::HOURGLASS_OFF,
-            "hourglass",
-            &s.geometry.mesh_radii,
-        )
-        .unwrap()
-        .with_contacts(s.geometry.mesh_contacts);
+        let mesh = hourglass(&s);
         assert_eq!(fingerprint(&s, &mesh), FORMAT_2_DEFAULT);
         let default = Scenario::default();
         assert_ne!(fingerprint(&default, &mesh), FORMAT_2_DEFAULT);
@@ -303,14 +308,7 @@ mod tests {
             [geometry]\nmesh_material = \"steel\"\n";
         let of = |text: &str| {
             let s = Scenario::parse(text, Path::new("s.toml")).unwrap();
-            let mesh = crate::geometry::mesh::Mesh::parse_off(
-                crate::scenario::HOURGLASS_OFF,
-                "hourglass",
-                &s.geometry.mesh_radii,
-            )
-            .unwrap()
-            .with_contacts(s.geometry.mesh_contacts);
-            fingerprint(&s, &mesh)
+            fingerprint(&s, &hourglass(&s))
         };
         assert_eq!(of(text), FORMAT_8_MATERIALS);
         // The defaults named change nothing; a model beyond them is another scenario.
