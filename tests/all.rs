@@ -15,6 +15,7 @@ mod examples;
 mod fields;
 mod fixed;
 mod friction_springs;
+mod heat;
 mod materials;
 mod mesh_contacts;
 mod moving;

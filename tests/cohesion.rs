@@ -28,6 +28,7 @@ fn grain(x: DVec3) -> Particle {
         material: 0,
         fixed: false,
         body: None,
+        ..Particle::default()
     }
 }
 

@@ -26,6 +26,7 @@ fn at_rest(x: DVec3, v: DVec3) -> Particle {
         material: 0,
         fixed: false,
         body: None,
+        ..Particle::default()
     }
 }
 

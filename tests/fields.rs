@@ -122,6 +122,7 @@ fn the_kinetic_stress_of_a_gas_is_its_momentum_flux() {
                 material: 0,
                 fixed: false,
                 body: None,
+                ..Particle::default()
             }
         })
         .collect();

@@ -32,6 +32,7 @@ fn grain(x: DVec3, v: DVec3, material: u16) -> Particle {
         material,
         fixed: false,
         body: None,
+        ..Particle::default()
     }
 }
 

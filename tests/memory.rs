@@ -31,6 +31,7 @@ fn pair(speed: f64) -> Simulation {
         material: 0,
         fixed: false,
         body: None,
+        ..Particle::default()
     };
     // Two pairs of neighbours (listed, so not "lonely": each pair's lists are rebuilt every
     // half skin of travel), 1 mm apart within a pair.

@@ -22,6 +22,7 @@ fn grain(x: DVec3, v: DVec3, w: DVec3) -> Particle {
         material: 0,
         fixed: false,
         body: None,
+        ..Particle::default()
     }
 }
 

@@ -551,6 +551,7 @@ fn a_pair_squeezed_past_the_smaller_radius_goes_on_with_one_warning() {
         material: 0,
         fixed: false,
         body: None,
+        ..Particle::default()
     };
     let particles: Particles = [grain(-0.01201, 0.002, 15.0), grain(0.0, 0.01, 0.0)]
         .into_iter()

@@ -150,7 +150,7 @@ impl Simulation {
     /// The number of components of the optional field `name`, if the particles hold it.
     fn held(&self, name: &str) -> PyResult<usize> {
         let active = self.sim.particles.active;
-        let held = active.fields();
+        let held = active.framed();
         match held.iter().find(|f| f.name == name) {
             Some(f) => Ok(f.suffixes.len()),
             None => Err(PyKeyError::new_err(format!(
@@ -579,7 +579,7 @@ impl Simulation {
     #[getter]
     fn fields(&self) -> Vec<&'static str> {
         let active = self.sim.particles.active;
-        active.fields().into_iter().map(|f| f.name).collect()
+        active.framed().into_iter().map(|f| f.name).collect()
     }
 
     /// The optional per-particle field `name` (see `fields`) in id order: (N,) for a

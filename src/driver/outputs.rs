@@ -342,6 +342,10 @@ pub(super) struct Logs {
     steps_per_frame: u64,
     /// Whether `log.csv` has the column `until` (the scenario has conditions).
     until: bool,
+    /// The mesh files held at a temperature (with heat transfer), whose heat `log.csv` has.
+    heated: Vec<usize>,
+    /// The thermal step [s], to turn the heat of a frame into a mean power.
+    thermal_dt: f64,
 }
 
 impl Logs {
@@ -354,12 +358,9 @@ impl Logs {
         let walls = s
             .wall_forces
             .then(|| {
-                Log::open(
-                    dir,
-                    WALLS,
-                    "frame,time,mesh,x,y,z,fx,fy,fz,tx,ty,tz",
-                    resumed_at,
-                )
+                let heat = if s.heat() { ",heat" } else { "" };
+                let header = format!("frame,time,mesh,x,y,z,fx,fy,fz,tx,ty,tz{heat}");
+                Log::open(dir, WALLS, &header, resumed_at)
             })
             .transpose()?;
         write_run_toml(dir, s)?;
@@ -374,6 +375,20 @@ impl Logs {
         {
             header += &format!(",mesh{}_position,mesh{}_load", k + 1, k + 1);
         }
+        // The temperatures, and the heat into each mesh held at a temperature.
+        let heated: Vec<usize> = match s.heat() {
+            true => (s.meshes.iter().enumerate())
+                .filter(|(_, m)| m.temperature.is_some())
+                .map(|(k, _)| k + 1)
+                .collect(),
+            false => Vec::new(),
+        };
+        if s.heat() {
+            header += ",T_mean,T_min,T_max,heat_content";
+            for k in &heated {
+                header += &format!(",mesh{k}_heat");
+            }
+        }
         if until {
             header += ",until";
         }
@@ -384,6 +399,8 @@ impl Logs {
             walls,
             steps_per_frame: s.simulation.steps_per_frame,
             until,
+            heated,
+            thermal_dt: s.simulation.timestep * s.simulation.thermal_time_scale,
         })
     }
 
@@ -396,10 +413,10 @@ impl Logs {
         frame: u64,
         (th, met): (&Thermo, Option<&Met>),
     ) -> Result<()> {
-        let loads = if frame > 0 {
-            sim.take_wall_loads()
+        let (loads, heat) = if frame > 0 {
+            (sim.take_wall_loads(), sim.take_wall_heat())
         } else {
-            Vec::new()
+            (Vec::new(), Vec::new())
         };
         let Some(logs) = logs else {
             return Ok(());
@@ -434,6 +451,15 @@ impl Logs {
         for (position, load) in &servos {
             row.extend([position as &dyn LogValue, load]);
         }
+        // The mean power into each file since the last frame [W].
+        let seconds = logs.steps_per_frame as f64 * logs.thermal_dt;
+        let watts: Vec<f64> = (0..sim.walls.files.len())
+            .map(|k| heat.get(k).map_or(0.0, |q| q / seconds))
+            .collect();
+        if let Some(t) = &th.heat {
+            row.extend([&t.mean as &dyn LogValue, &t.min, &t.max, &t.content]);
+            row.extend(logs.heated.iter().map(|&k| &watts[k] as &dyn LogValue));
+        }
         if logs.until {
             row.push(&ended);
         }
@@ -449,9 +475,12 @@ impl Logs {
             for (k, w) in loads.iter().enumerate() {
                 let (f, t) = (w.f / steps, w.tau / steps);
                 let x = sim.walls.reference(k);
-                let row: [&dyn LogValue; 12] = [
+                let mut row: Vec<&dyn LogValue> = vec![
                     &frame, &sim.time, &k, &x.x, &x.y, &x.z, &f.x, &f.y, &f.z, &t.x, &t.y, &t.z,
                 ];
+                if th.heat.is_some() {
+                    row.push(&watts[k]);
+                }
                 log.row(&row)?;
             }
         }

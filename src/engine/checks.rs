@@ -46,8 +46,7 @@ impl Simulation {
             beyond_range,
         } = found;
         let p = &self.particles;
-        let non_finite =
-            |k: usize| !(p.x[k].is_finite() && p.v[k].is_finite() && p.w[k].is_finite());
+        let non_finite = |k: usize| self.broken(k);
         // Split over processes: each reports on its own particles (a pair: the one of the
         // lower id), and all stop if one must.
         let bad = match &self.share {
@@ -93,8 +92,7 @@ impl Simulation {
     /// run), then the deepest overlaps past the smaller diameter by pair.
     fn told(&self, mut deep: Vec<Deep>, beyond_range: bool) -> Vec<(u8, u64, u64, String)> {
         let p = &self.particles;
-        let non_finite =
-            |k: usize| !(p.x[k].is_finite() && p.v[k].is_finite() && p.w[k].is_finite());
+        let non_finite = |k: usize| self.broken(k);
         let mut told: Vec<(u8, u64, u64, String)> = Vec::new();
         if beyond_range {
             told.push((0, 0, 0, format!(
@@ -109,15 +107,20 @@ impl Simulation {
             .filter(|&k| self.own(k) && non_finite(k))
             .take(5)
         {
-            told.push((
-                1,
-                p.id[k],
-                0,
-                format!(
+            let what = match self.model.heat.as_ref().filter(|_| self.bad_temperature(k)) {
+                Some((h, _)) => format!(
+                    "particle {} has a temperature of {} K: heat advanced by f dt = {:.3e} s per step overshoots (the grains' thermal time scale is {:.3e} s): lower [simulation] thermal_time_scale",
+                    p.id[k],
+                    p.temperature[k],
+                    h.dt,
+                    h.time_scale(self.scenario.geometry.radius_min, 12.0)
+                ),
+                None => format!(
                     "particle {} has a non-finite state (x = {}, v = {}, w = {})",
                     p.id[k], p.x[k], p.v[k], p.w[k]
                 ),
-            ));
+            };
+            told.push((1, p.id[k], 0, what));
         }
         deep.retain(Deep::through);
         deep.sort_by_key(|d| d.key(&p.id));
@@ -131,6 +134,20 @@ impl Simulation {
             told.push((2, a, b, d.describe(&p.id)));
         }
         told
+    }
+
+    /// Whether particle `k`'s state has blown up: not finite, or (with heat transfer) a
+    /// temperature below 0 K or not finite.
+    fn broken(&self, k: usize) -> bool {
+        let p = &self.particles;
+        !(p.x[k].is_finite() && p.v[k].is_finite() && p.w[k].is_finite()) || self.bad_temperature(k)
+    }
+
+    /// Whether particle `k`'s temperature (with heat transfer) has left the physical
+    /// range: below 0 K, or not finite.
+    fn bad_temperature(&self, k: usize) -> bool {
+        let t = self.particles.temperature.get(k);
+        self.model.heat.is_some() && t.is_some_and(|&t| !(t >= 0.0 && t.is_finite()))
     }
 
     /// Overlaps past the smaller radius so far (each pair once).

@@ -74,17 +74,18 @@ impl LoadScales {
 }
 
 impl Simulation {
-    /// Starts summing the loads on each mesh file (`take_wall_loads`), for `walls.csv` or
+    /// Starts summing the loads (and the heat) on each mesh file (`take_wall_loads`), for `walls.csv` or
     /// for the servos, which follow the load on their file.
     pub(super) fn sum_wall_loads(&mut self) {
-        let servos = self.scenario.meshes.iter().any(|m| m.servo.is_some());
-        if !(self.scenario.wall_forces || servos) {
-            return;
-        }
         let w = &mut self.walls;
         w.face_file = vec![0; w.mesh.faces.len()];
         for (k, file) in w.files.iter().enumerate() {
             w.face_file[file.faces.clone()].fill(k as u32);
+        }
+        w.heat = vec![0; w.files.len()];
+        let servos = self.scenario.meshes.iter().any(|m| m.servo.is_some());
+        if !(self.scenario.wall_forces || servos) {
+            return;
         }
         w.sums = vec![Wrench::default(); w.files.len()];
         // The lever of a torque about a file's point: to its farthest corner, or across the

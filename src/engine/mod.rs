@@ -19,6 +19,7 @@ use crate::model::contact::{
     Body, Coefficients, ContactLaw, Kinematics, Models, Other, with_models,
 };
 use crate::model::exact::{Scale, Scales8, Sum6, pack};
+use crate::model::heat::HeatModel;
 use crate::model::integrate::{Density, Inertia, Response, State, advance};
 use crate::model::lanes::{Gather, Lanes};
 use crate::model::motion::{Motion, Pose, RigidVelocity};
@@ -36,6 +37,7 @@ mod checks;
 mod edit;
 pub use edit::{DEEPEST_ADDED, Overlap};
 mod faces;
+mod heat;
 mod loads;
 #[cfg(test)]
 mod open_core_tests;
@@ -76,6 +78,9 @@ pub(crate) struct Model {
     pub(crate) law: ContactLaw,
     pub(crate) densities: Vec<Density>,
     pub(crate) scales: LoadScales,
+    /// Heat transfer, if the scenario's materials conduct, make or exchange heat; with
+    /// the walls' temperatures and conductivities.
+    pub(crate) heat: Option<(HeatModel, heat::WallHeat)>,
 }
 
 impl Model {
@@ -219,6 +224,7 @@ pub enum Stage {
     Neighbours,
     ParticleContacts,
     MeshContacts,
+    Heat,
     Bodies,
     Integrate,
     Tag,
@@ -228,12 +234,13 @@ pub enum Stage {
 }
 
 impl Stage {
-    pub const ALL: [Stage; 11] = [
+    pub const ALL: [Stage; 12] = [
         Stage::MoveMeshes,
         Stage::Spawn,
         Stage::Neighbours,
         Stage::ParticleContacts,
         Stage::MeshContacts,
+        Stage::Heat,
         Stage::Bodies,
         Stage::Integrate,
         Stage::Tag,
@@ -249,6 +256,7 @@ impl Stage {
             Stage::Neighbours => "neighbour lists",
             Stage::ParticleContacts => "particle contacts",
             Stage::MeshContacts => "mesh contacts",
+            Stage::Heat => "heat",
             Stage::Bodies => "rigid bodies",
             Stage::Integrate => "integrate",
             Stage::Tag => "tag",
@@ -444,6 +452,19 @@ pub struct Thermo {
     pub max_overlap: f64,
     /// Particles removed so far by the outlets and the domain bounds.
     pub removed: u64,
+    /// The temperatures, if heat is transferred.
+    pub heat: Option<Temperatures>,
+}
+
+/// The particles' temperatures in numbers, for `log.csv`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Temperatures {
+    /// Mean, least and greatest temperature [K] (0 without particles).
+    pub mean: f64,
+    pub min: f64,
+    pub max: f64,
+    /// Σ m c T [J].
+    pub content: f64,
 }
 
 impl Thermo {
@@ -566,6 +587,15 @@ impl Simulation {
         found.merge(on_faces);
         self.add_wall_loads(walls);
         let t = self.stage_times.add(Stage::MeshContacts, t);
+        let mut overheated = false;
+        if let Some(model) = &self.model.heat {
+            let owned = self.share.as_ref().map(|d| &d.owned[..]);
+            let (p, lists) = (&mut self.particles, &self.neighbours);
+            let walls;
+            (walls, overheated) = heat::run(&model.0, (&self.walls, &model.1), lists, owned, p);
+            self.add_wall_heat(walls);
+        }
+        let t = self.stage_times.add(Stage::Heat, t);
         let (dt, g) = (
             self.scenario.simulation.timestep,
             self.scenario.kinetics.gravity,
@@ -581,7 +611,8 @@ impl Simulation {
         );
         let t = self.stage_times.add(Stage::Bodies, t);
         let non_finite = advance::run(&self.model, (dt, g), &mut self.particles, &mut self.loads)
-            | bodies_non_finite;
+            | bodies_non_finite
+            | overheated;
         #[cfg(test)]
         open_core_tests::walk(&mut self.particles, dt);
         let t = self.stage_times.add(Stage::Integrate, t);

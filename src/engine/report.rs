@@ -239,6 +239,7 @@ impl Simulation {
             (thermo.pair_contacts, thermo.wall_contacts) = (counts[0] as usize, counts[1] as usize);
             thermo.max_overlap = d.comm.max(thermo.max_overlap);
         }
+        thermo.heat = self.temperatures();
         thermo
     }
 }

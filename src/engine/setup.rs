@@ -70,6 +70,7 @@ impl Simulation {
             w.face_material[file.faces.clone()].fill(file.material);
         }
         sim.sum_wall_loads();
+        sim.start_heat()?;
         for (faces, drive) in moving {
             sim.walls.add_moving(faces, drive);
         }
@@ -104,6 +105,7 @@ impl Simulation {
                 .map_err(misfit)?,
         };
         sim.particles = snapshot.particles;
+        sim.start_heat()?;
         sim.neighbours.state = snapshot.contact_state;
         sim.spawner = Spawner::resume(sim.scenario.simulation.seed, snapshot.spawner);
         sim.removed.domain = snapshot.removed.domain;
@@ -274,6 +276,7 @@ impl Simulation {
         }
         sim.particles = p;
         Self::fix_within(&mut sim.particles, &sim.scenario.fixed);
+        sim.start_heat()?;
         let servos = sim.carried_servos(&snapshot.mesh_files, &snapshot.servos);
         if !servos.is_empty() {
             notes.push(format!("{} servo(s) carried where they were", servos.len()));
@@ -437,6 +440,7 @@ impl Simulation {
                     .map(|m| Density::new(m.properties.density, m.properties.viscosity))
                     .collect(),
                 scales: LoadScales::of(&scenario),
+                heat: None,
             },
             neighbours: Neighbours::with_periodic(skin, scenario.periodicity()),
             face_grid,
@@ -458,6 +462,7 @@ impl Simulation {
             particles,
         };
         sim.sum_wall_loads();
+        sim.start_heat()?;
         Ok(sim)
     }
 }

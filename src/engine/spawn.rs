@@ -122,6 +122,14 @@ pub struct SpawnerState {
     pub box_off: bool,
 }
 
+/// The particles of `particles` from index `from` on at temperature `t`, if particles hold
+/// temperatures (heat transfer).
+fn warm(particles: &mut Particles, from: usize, t: f64) {
+    if particles.active.temperature {
+        particles.temperature[from..].fill(t);
+    }
+}
+
 /// What one insertion draws from and where it puts its particles.
 struct Source<'a> {
     region: Region,
@@ -271,7 +279,14 @@ impl Spawner {
             return 0;
         }
         if s.spawn.is_empty() {
-            return self.spawn_in_box(s, particles, faces, face_grid, present);
+            let from = particles.len();
+            let n = self.spawn_in_box(s, particles, faces, face_grid, present);
+            warm(
+                particles,
+                from,
+                s.materials[0].properties.thermal.initial_temperature,
+            );
+            return n;
         }
         self.regions.resize(s.spawn.len(), RegionState::default());
         let dt = s.simulation.timestep;
@@ -293,6 +308,7 @@ impl Spawner {
                 clump: r.clump,
             };
             let mut pending = state.pending_radius;
+            let from = particles.len();
             let insert = if r.clump.is_some() {
                 Spawner::insert_clumps
             } else {
@@ -308,6 +324,13 @@ impl Spawner {
                 (particles, present),
                 faces,
                 face_grid,
+            );
+            let material = &s.materials[r.material as usize].properties;
+            warm(
+                particles,
+                from,
+                r.temperature
+                    .unwrap_or(material.thermal.initial_temperature),
             );
             self.regions[k] = RegionState {
                 inserted: state.inserted + n,

@@ -92,8 +92,11 @@ pub struct Walls {
     pub(super) face_part: Vec<u32>,
     /// Largest displacement of a moving face since the last neighbour-list rebuild.
     pub(super) drift: f64,
-    /// For each face, its mesh file (an index of `files`), if wall loads are summed.
+    /// For each face, its mesh file (an index of `files`).
     pub(super) face_file: Vec<u32>,
+    /// The heat into each mesh file [quanta of the heat model] since the last
+    /// [`Walls::take_heat`] (over all processes).
+    pub(super) heat: Vec<i128>,
     /// For each face, its material.
     pub(super) face_material: Vec<u16>,
     /// The loads on each mesh file summed over the steps since the last
@@ -125,6 +128,7 @@ impl Walls {
             face_part: vec![STATIC; n],
             drift: 0.0,
             face_file: Vec::new(),
+            heat: Vec::new(),
             face_material: vec![material; n],
             sums: Vec::new(),
             scales: Scales8::new([Scale::for_largest(1.0); 8]),
@@ -317,6 +321,13 @@ impl Walls {
     pub fn take_loads(&mut self) -> Vec<Wrench> {
         let zero = vec![Wrench::default(); self.sums.len()];
         std::mem::replace(&mut self.sums, zero)
+    }
+
+    /// The heat into each mesh file since the last call [quanta], and the sums set back
+    /// to zero.
+    pub fn take_heat(&mut self) -> Vec<i128> {
+        let zero = vec![0; self.heat.len()];
+        std::mem::replace(&mut self.heat, zero)
     }
 
     /// Adds a step's exact sums of the loads on each file (over all processes).

@@ -66,7 +66,7 @@ fn header(p: &Particles, extra: &Extra) -> (String, bool, bool) {
     if clump {
         line.push_str(",clump");
     }
-    for f in p.active.fields() {
+    for f in p.active.framed() {
         line.push_str(&format!(",{}", f.columns().join(",")));
     }
     if extra.loads.is_some() {
@@ -81,7 +81,7 @@ pub fn write_particles(out: &mut impl Write, p: &Particles, extra: Extra) -> std
     let mut line = String::with_capacity(512);
     let (header, fixed, clump) = header(p, &extra);
     out.write_all(header.as_bytes())?;
-    let optional = p.active.fields();
+    let optional = p.active.framed();
     let mut numbers = Vec::new();
     let mut buf = ryu::Buffer::new();
     for i in p.id_order() {

@@ -330,7 +330,7 @@ fn particles_vtu(p: &Particles, bodies: bool, loads: Option<&Loads>) -> Vtu {
         v.vectors(PointData, "force", n, by_id().map(|i| load(i).0));
         v.vectors(PointData, "torque", n, by_id().map(|i| load(i).1));
     }
-    for f in p.active.fields() {
+    for f in p.active.framed() {
         let k = f.suffixes.len();
         let mut numbers = Vec::with_capacity(k * n);
         by_id().for_each(|i| p.numbers(f.name, i, &mut numbers));

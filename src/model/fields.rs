@@ -70,6 +70,16 @@ impl Components for DVec3 {
     }
 }
 
+/// A whole number the engine keeps exactly (a heat content in its quantum): carried by
+/// messages and checkpoints, in no frame (no columns).
+impl Components for i128 {
+    const SUFFIXES: &'static [&'static str] = &[];
+    fn numbers(&self, _: &mut Vec<f64>) {}
+    fn from_numbers(_: &[f64]) -> Option<Self> {
+        None
+    }
+}
+
 /// What the frames, checkpoints and Python know of an optional field.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Optional {
@@ -102,7 +112,7 @@ macro_rules! held_set {
         $set:ident,
         $described:ty,
         $table:ident,
-        [$($(#[cfg($cfg:meta)])? $oname:ident),*]
+        [$($(#[cfg($cfg:meta)])? $oname:ident = $oalias:expr),*]
     ) => {
         $(#[doc = $doc])*
         #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -117,7 +127,7 @@ macro_rules! held_set {
                 let mut held = Vec::new();
                 $($(#[cfg($cfg)])?
                 if self.$oname {
-                    held.extend($table.iter().find(|f| f.name == stringify!($oname)));
+                    held.extend($table.iter().find(|f| f.name == $oalias));
                 })*
                 held
             }
@@ -125,7 +135,7 @@ macro_rules! held_set {
             /// Holds the member `name` from now on; false if there is none.
             pub fn activate(&mut self, name: &str) -> bool {
                 $($(#[cfg($cfg)])?
-                if name == stringify!($oname) {
+                if name == $oalias {
                     self.$oname = true;
                     return true;
                 })*
@@ -137,6 +147,18 @@ macro_rules! held_set {
 }
 
 pub(crate) use held_set;
+
+/// The name of an optional field: the one its row gives (`name: "T"`), or its own.
+macro_rules! field_name {
+    ($name:ident) => {
+        stringify!($name)
+    };
+    ($name:ident, $alias:literal) => {
+        $alias
+    };
+}
+
+pub(crate) use field_name;
 
 /// The bytes of a record (a particle, a contact's state) in the messages of a split run:
 /// every core member, then the optional ones that the processes hold (`active`).
@@ -201,7 +223,8 @@ macro_rules! particle_fields {
         optional {$(
             $(#[cfg($cfg:meta)])?
             $(#[doc = $odoc:literal])*
-            $oname:ident: $oty:ty, ghost: $oghost:literal, unit: $unit:literal;
+            $oname:ident: $oty:ty, ghost: $oghost:literal, unit: $unit:literal
+            $(, name: $oalias:literal)?;
         )*}
     ) => {
         /// The state of every particle: a vector per field of the table, in storage order.
@@ -224,8 +247,18 @@ macro_rules! particle_fields {
             Active,
             $crate::model::fields::Optional,
             OPTIONAL,
-            [$($(#[cfg($cfg)])? $oname),*]
+            [$($(#[cfg($cfg)])? $oname = $crate::model::fields::field_name!($oname $(, $oalias)?)),*]
         );
+
+        impl Active {
+            /// The fields held that frames write (those with columns), as `OPTIONAL`
+            /// describes them.
+            pub fn framed(&self) -> Vec<&'static $crate::model::fields::Optional> {
+                let mut held = self.fields();
+                held.retain(|f| !f.suffixes.is_empty());
+                held
+            }
+        }
 
         /// One particle's state: a row of [`Particles`] (optional fields not held at their
         /// defaults).
@@ -239,7 +272,7 @@ macro_rules! particle_fields {
         pub const OPTIONAL: &[$crate::model::fields::Optional] = &[$(
             $(#[cfg($cfg)])?
             $crate::model::fields::Optional {
-                name: stringify!($oname),
+                name: $crate::model::fields::field_name!($oname $(, $oalias)?),
                 unit: $unit,
                 suffixes: <$oty as $crate::model::fields::Components>::SUFFIXES,
                 size: <$oty as Value>::SIZE,
@@ -278,7 +311,7 @@ macro_rules! particle_fields {
             pub fn activate(&mut self, name: &str) -> bool {
                 let n = self.len();
                 $($(#[cfg($cfg)])?
-                if name == stringify!($oname) {
+                if name == $crate::model::fields::field_name!($oname $(, $oalias)?) {
                     if !self.active.$oname {
                         self.active.$oname = true;
                         self.$oname = vec![Default::default(); n];
@@ -332,7 +365,7 @@ macro_rules! particle_fields {
             /// `i` (as many as its columns), if it is held.
             pub fn numbers(&self, name: &str, i: usize, out: &mut Vec<f64>) {
                 $($(#[cfg($cfg)])?
-                if name == stringify!($oname) && self.active.$oname {
+                if name == $crate::model::fields::field_name!($oname $(, $oalias)?) && self.active.$oname {
                     <$oty as $crate::model::fields::Components>::numbers(&self.$oname[i], out);
                 })*
                 let _ = (name, i, out);
@@ -342,7 +375,7 @@ macro_rules! particle_fields {
             /// value of `numbers`; false if they make none.
             pub fn set_numbers(&mut self, name: &str, i: usize, numbers: &[f64]) -> bool {
                 $($(#[cfg($cfg)])?
-                if name == stringify!($oname) && self.active.$oname {
+                if name == $crate::model::fields::field_name!($oname $(, $oalias)?) && self.active.$oname {
                     return match <$oty as $crate::model::fields::Components>::from_numbers(numbers) {
                         Some(value) => {
                             self.$oname[i] = value;
@@ -358,7 +391,7 @@ macro_rules! particle_fields {
             /// Appends the values of the optional field `name` (held) in storage order.
             pub fn put_field(&self, name: &str, out: &mut Vec<u8>) {
                 $($(#[cfg($cfg)])?
-                if name == stringify!($oname) && self.active.$oname {
+                if name == $crate::model::fields::field_name!($oname $(, $oalias)?) && self.active.$oname {
                     self.$oname.iter().for_each(|v| v.put(out));
                 })*
                 let _ = (name, out);
@@ -371,7 +404,7 @@ macro_rules! particle_fields {
                     return false;
                 }
                 $($(#[cfg($cfg)])?
-                if name == stringify!($oname) {
+                if name == $crate::model::fields::field_name!($oname $(, $oalias)?) {
                     self.$oname.iter_mut().for_each(|v| *v = Value::take(bytes));
                 })*
                 let _ = bytes;
@@ -453,7 +486,7 @@ macro_rules! contact_fields {
             ActiveState,
             $crate::model::fields::OptionalState,
             OPTIONAL_STATE,
-            [$($(#[cfg($cfg)])? $oname),*]
+            [$($(#[cfg($cfg)])? $oname = stringify!($oname)),*]
         );
 
         /// The optional members of a contact's state.

@@ -2,6 +2,7 @@
 //! is made from (the scenario's `[[materials]]`, `[[interactions]]` and `[simulation]
 //! friction_springs` become these).
 
+pub use crate::model::heat::Thermal;
 pub use crate::model::registry::ContactModels;
 
 /// The properties of a material (Table 2 of the paper).
@@ -26,6 +27,8 @@ pub struct Material {
     pub cohesion: f64,
     /// The contact law's sub-models for this material's contacts.
     pub models: ContactModels,
+    /// k, c, T_0, q_V, h: heat transfer (conducts where k > 0).
+    pub thermal: Thermal,
 }
 
 /// When a friction spring is advanced by Δt v relative to the force taken from it

@@ -6,6 +6,7 @@ pub mod contact;
 pub mod contact_state;
 pub mod exact;
 pub mod fields;
+pub mod heat;
 pub mod id;
 pub mod integrate;
 pub mod lanes;

@@ -38,7 +38,7 @@ macro_rules! number {
     )*};
 }
 
-number!(u8, u16, u32, u64, f64);
+number!(u8, u16, u32, u64, i128, f64);
 
 /// One byte, 1 or 0 (read: anything but 0 is true).
 impl Value for bool {
@@ -107,6 +107,7 @@ mod tests {
         round_trip(u32::MAX);
         round_trip(u64::MAX - 3);
         round_trip(-1e-300f64);
+        round_trip(-(1i128 << 100) + 7);
         round_trip(true);
         round_trip(DVec3::new(1.0, -2.0, 3.5));
         round_trip(DQuat::from_rotation_y(0.3));

@@ -99,6 +99,7 @@ fn mesh_spec(k: usize, m: RawMesh, base: &Path) -> Result<MeshSpec> {
         motion,
         servo,
         material: 0,
+        temperature: super::heat::temperature(&key("temperature"), m.temperature)?,
     })
 }
 

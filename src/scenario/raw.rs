@@ -14,6 +14,7 @@ pub(super) struct RawMesh {
     pub(super) contacts: Option<String>,
     pub(super) material: Option<String>,
     pub(super) motion: Option<RawMotion>,
+    pub(super) temperature: Option<f64>,
 }
 
 /// `[[meshes]] shape = { type = ... }`: a built-in shape (`geometry/shapes.rs`).
@@ -105,6 +106,7 @@ pub(super) struct RawSpawn {
     pub(super) radius: Option<RawRadius>,
     pub(super) clump: Option<String>,
     pub(super) scale: Option<RawScale>,
+    pub(super) temperature: Option<f64>,
 }
 
 /// A `[[spawn]]` region's `scale` of its clumps: a factor, or uniform in `min`..`max`.
@@ -239,6 +241,11 @@ pub(super) struct RawMaterial {
     pub(super) friction_rolling: Option<f64>,
     pub(super) friction_twisting: Option<f64>,
     pub(super) viscosity: Option<f64>,
+    pub(super) thermal_conductivity: Option<f64>,
+    pub(super) heat_capacity: Option<f64>,
+    pub(super) initial_temperature: Option<f64>,
+    pub(super) heat_source: Option<f64>,
+    pub(super) surface_heat_transfer: Option<f64>,
 }
 
 impl RawMaterial {
@@ -256,6 +263,16 @@ impl RawMaterial {
             || self.adhesion_model.is_some()
             || self.rolling_model.is_some()
             || self.tangential_coulomb.is_some()
+            || self.has_thermal_keys()
+    }
+
+    /// Whether it sets a thermal property.
+    pub(super) fn has_thermal_keys(&self) -> bool {
+        self.thermal_conductivity.is_some()
+            || self.heat_capacity.is_some()
+            || self.initial_temperature.is_some()
+            || self.heat_source.is_some()
+            || self.surface_heat_transfer.is_some()
     }
 }
 
@@ -275,6 +292,11 @@ pub(super) struct RawNamedMaterial {
     pub(super) friction_sliding: Option<f64>,
     pub(super) friction_rolling: Option<f64>,
     pub(super) friction_twisting: Option<f64>,
+    pub(super) thermal_conductivity: Option<f64>,
+    pub(super) heat_capacity: Option<f64>,
+    pub(super) initial_temperature: Option<f64>,
+    pub(super) heat_source: Option<f64>,
+    pub(super) surface_heat_transfer: Option<f64>,
 }
 
 impl From<RawNamedMaterial> for RawMaterial {
@@ -293,6 +315,11 @@ impl From<RawNamedMaterial> for RawMaterial {
             adhesion_model: m.adhesion_model,
             rolling_model: m.rolling_model,
             tangential_coulomb: m.tangential_coulomb,
+            thermal_conductivity: m.thermal_conductivity,
+            heat_capacity: m.heat_capacity,
+            initial_temperature: m.initial_temperature,
+            heat_source: m.heat_source,
+            surface_heat_transfer: m.surface_heat_transfer,
         }
     }
 }
@@ -318,6 +345,7 @@ pub(super) struct RawKinetics {
     pub(super) initial_velocity: Option<[f64; 3]>,
     pub(super) initial_angular_velocity: Option<[f64; 3]>,
     pub(super) gravity: Option<[f64; 3]>,
+    pub(super) ambient_temperature: Option<f64>,
 }
 
 #[derive(Deserialize, Default)]
@@ -331,6 +359,8 @@ pub(super) struct RawSimulation {
     pub(super) seed: Option<u64>,
     pub(super) skin: Option<f64>,
     pub(super) friction_springs: Option<String>,
+    pub(super) thermal_time_scale: Option<f64>,
+    pub(super) conduction_model: Option<String>,
     pub(super) until: Option<RawUntil>,
 }
 

@@ -74,6 +74,19 @@ impl Scenario {
             for (key, name) in models::beyond_defaults(m.models, m.cohesion).named() {
                 let _ = writeln!(o, "{key} = {}", text(name));
             }
+            let t = &m.thermal;
+            for (key, x) in [
+                ("thermal_conductivity", t.conductivity),
+                ("heat_capacity", t.capacity),
+                ("initial_temperature", t.initial_temperature),
+                ("heat_source", t.source),
+                ("surface_heat_transfer", t.surface_transfer),
+            ] {
+                // Only where given: a run without heat writes what it wrote before.
+                if x != 0.0 {
+                    let _ = writeln!(o, "{key} = {}", num(x));
+                }
+            }
         };
         if self.uses_materials() {
             for m in &self.materials {
@@ -115,6 +128,9 @@ impl Scenario {
             vec3(k.initial_angular_velocity)
         );
         let _ = writeln!(o, "gravity = {}", vec3(k.gravity));
+        if let Some(t) = k.ambient_temperature {
+            let _ = writeln!(o, "ambient_temperature = {}", num(t));
+        }
     }
 
     fn simulation_toml(&self, o: &mut String) {
@@ -132,6 +148,10 @@ impl Scenario {
         }
         let _ = writeln!(o, "skin = {}", num(s.skin));
         let _ = writeln!(o, "friction_springs = {}", text(s.friction_springs.key()));
+        if self.heat() {
+            let _ = writeln!(o, "thermal_time_scale = {}", num(s.thermal_time_scale));
+            let _ = writeln!(o, "conduction_model = {}", text(s.conduction_model.key()));
+        }
         let u = &s.until;
         if !u.is_empty() {
             let mut conditions = Vec::new();
@@ -172,6 +192,9 @@ impl Scenario {
             }
             if let Some(m) = mesh.motion {
                 let _ = writeln!(o, "motion = {}", motion(m));
+            }
+            if let Some(t) = mesh.temperature {
+                let _ = writeln!(o, "temperature = {}", num(t));
             }
             if let Some(s) = mesh.servo {
                 let _ = writeln!(o, "motion = {}", servo(s));
@@ -234,6 +257,9 @@ impl Scenario {
                 let _ = writeln!(o, "clump = {name}\nscale = {{ min = {min}, max = {max} }}");
             } else if self.uses_materials() {
                 let _ = writeln!(o, "material = {}", self.material_name(r.material));
+            }
+            if let Some(t) = r.temperature {
+                let _ = writeln!(o, "temperature = {}", num(t));
             }
             if let Some(n) = r.count {
                 let _ = writeln!(o, "count = {n}");

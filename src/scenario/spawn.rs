@@ -125,6 +125,7 @@ fn spawn_region(
         .map(|v| check_vec(&k("velocity"), v))
         .transpose()?)
     .unwrap_or(velocity);
+    let temperature = super::heat::temperature(&k("temperature"), r.temperature)?;
     let rate = r
         .rate
         .map(|x| check(&k("rate"), x, Range::Positive))
@@ -159,6 +160,7 @@ fn spawn_region(
         region,
         material,
         velocity,
+        temperature,
         count,
         rate,
         start,

@@ -89,6 +89,7 @@ fn material(table: &str, m: RawMaterial, viscosity: f64) -> Result<Material> {
         m.cohesion.unwrap_or(0.0),
         Range::NonNegative,
     )?;
+    let thermal = super::heat::thermal(table, &m)?;
     let names = [
         m.normal_model,
         m.adhesion_model,
@@ -132,6 +133,7 @@ fn material(table: &str, m: RawMaterial, viscosity: f64) -> Result<Material> {
         viscosity,
         cohesion,
         models: GivenModels::read(table, names)?.of_material(table, cohesion)?,
+        thermal,
     })
 }
 
@@ -468,6 +470,10 @@ fn kinetics(k: RawKinetics) -> Result<Kinetics> {
             k.initial_angular_velocity.unwrap_or([0.0; 3]),
         )?,
         gravity: check_vec("[kinetics] gravity", k.gravity.unwrap_or([0.0, 0.0, -9.81]))?,
+        ambient_temperature: super::heat::temperature(
+            "[kinetics] ambient_temperature",
+            k.ambient_temperature,
+        )?,
     })
 }
 
@@ -493,6 +499,8 @@ fn simulation(
         seed: s.seed.unwrap_or(1),
         skin: check("[simulation] skin", s.skin.unwrap_or(0.5), Range::Positive)?,
         friction_springs: friction_springs(s.friction_springs)?,
+        thermal_time_scale: super::heat::thermal_time_scale(s.thermal_time_scale)?,
+        conduction_model: super::heat::conduction_model(s.conduction_model)?,
         until: until(s.until)?,
     };
     if simulation.spawn_attempts > 1_000_000_000 {

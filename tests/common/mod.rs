@@ -39,6 +39,7 @@ pub fn sphere(radius: f64, x: DVec3, v: DVec3, w: DVec3) -> Particle {
         material: 0,
         fixed: false,
         body: None,
+        ..Particle::default()
     }
 }
 

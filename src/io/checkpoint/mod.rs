@@ -33,11 +33,17 @@ pub fn fingerprint(s: &Scenario, mesh: &Mesh) -> u64 {
         m.friction_twisting,
         m.viscosity
     );
+    // `[kinetics]` as its struct's `Debug` text was before the surroundings' temperature.
+    let k = &s.kinetics;
+    let kinetics = format!(
+        "Kinetics {{ initial_velocity: {:?}, initial_angular_velocity: {:?}, gravity: {:?} }}",
+        k.initial_velocity, k.initial_angular_velocity, k.gravity
+    );
     let text = format!(
-        "{:?}|{}|{:?}|{:?}|{}|{}|{}|{}|{:?}",
+        "{:?}|{}|{}|{:?}|{}|{}|{}|{}|{:?}",
         s.geometry.mesh_radii,
         material,
-        s.kinetics,
+        kinetics,
         (
             s.geometry.radius_min,
             s.geometry.radius_max,
@@ -67,7 +73,36 @@ pub fn fingerprint(s: &Scenario, mesh: &Mesh) -> u64 {
     } else {
         text
     };
+    // Heat transfer (absent from checkpoints of runs without it).
+    let text = if s.heat() {
+        format!("{text}|heat {}", heat_text(s))
+    } else {
+        text
+    };
     hash(&text)
+}
+
+/// What heat transfer depends on: each material's thermal properties, the surroundings,
+/// the thermal step, the conduction model and the meshes' temperatures.
+fn heat_text(s: &Scenario) -> String {
+    let materials: Vec<String> = (s.materials.iter())
+        .map(|m| {
+            let t = &m.properties.thermal;
+            format!(
+                "{:?} {:?} {:?} {:?} {:?}",
+                t.conductivity, t.capacity, t.initial_temperature, t.source, t.surface_transfer
+            )
+        })
+        .collect();
+    let walls: Vec<Option<f64>> = s.meshes.iter().map(|m| m.temperature).collect();
+    format!(
+        "[{}] {:?} {:?} {} {:?}",
+        materials.join(", "),
+        s.kinetics.ambient_temperature,
+        s.simulation.thermal_time_scale,
+        s.simulation.conduction_model.key(),
+        walls
+    )
 }
 
 /// The named materials and interactions of `s` as the fingerprint holds them: in the text

@@ -140,6 +140,7 @@ mod lanes {
             viscosity: 1e-5,
             cohesion: k_c,
             models,
+            thermal: Default::default(),
         };
         let springs = if paper {
             FrictionSprings::Paper
@@ -365,6 +366,7 @@ fn sjkr_without_cohesion_gives_the_bits_of_no_adhesion() {
         viscosity: 1e-5,
         cohesion: 0.0,
         models: Default::default(),
+        thermal: Default::default(),
     };
     let law = ContactLaw::new(&material, 1e-5, FrictionSprings::AdvanceFirst);
     let i = Body {

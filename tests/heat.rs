@@ -1,0 +1,203 @@
+//! Heat transfer against theory: two grains relaxing to their mean temperature, a chain of
+//! grains between a hot and a cold wall, the heat content of a flowing bed kept to the bit,
+//! and the same bits on any number of threads.
+
+use crate::common;
+
+use std::f64::consts::PI;
+
+use glam::DVec3;
+use tinydem::engine::Simulation;
+use tinydem::io::inputs;
+use tinydem::model::particles::{Particle, Particles};
+
+/// A simulation of `particles` (at their temperatures) in the scenario `text`.
+fn simulation(text: &str, particles: Vec<Particle>) -> Simulation {
+    let s = common::scenario(text);
+    let mut input = inputs::read(&s).unwrap();
+    let mut p = Particles::default();
+    p.activate("T");
+    particles.into_iter().for_each(|q| p.push(q));
+    input.particles = p;
+    Simulation::from_inputs(s, input).unwrap()
+}
+
+/// A fixed grain of material `material`, radius `r`, at `x`, at temperature `t`.
+fn grain(material: u16, r: f64, x: f64, t: f64) -> Particle {
+    Particle {
+        material,
+        fixed: true,
+        temperature: t,
+        ..common::sphere(r, DVec3::X * x, DVec3::ZERO, DVec3::ZERO)
+    }
+}
+
+/// m c of a grain of radius `r`, density `rho`, capacity `c`.
+fn mc(r: f64, rho: f64, c: f64) -> f64 {
+    4.0 / 3.0 * PI * r.powi(3) * rho * c
+}
+
+/// H = 2 k_eff sqrt(R* δ) (Batchelor & O'Brien).
+fn conductance(k1: f64, k2: f64, r_star: f64, delta: f64) -> f64 {
+    2.0 * (2.0 * k1 * k2 / (k1 + k2)) * (r_star * delta).sqrt()
+}
+
+const TWO: &str = "[geometry]\nradius_min = 0.004\nradius_max = 0.005\n\
+    [[materials]]\nname = \"glass\"\ndensity = 2500.0\nthermal_conductivity = 2.0\nheat_capacity = 800.0\n\
+    [[materials]]\nname = \"resin\"\ndensity = 1500.0\nthermal_conductivity = 0.5\nheat_capacity = 1200.0\n\
+    [kinetics]\ngravity = [0.0, 0.0, 0.0]\n\
+    [simulation]\ntimestep = 1e-5\nthermal_time_scale = 1e4\nmax_particles = 0\n";
+
+#[test]
+fn two_grains_relax_to_their_mean_temperature_at_the_rate_of_their_conductance() {
+    let (r1, r2, delta) = (0.005, 0.004, 2e-5);
+    let mut sim = simulation(
+        TWO,
+        vec![
+            grain(0, r1, 0.0, 400.0),
+            grain(1, r2, r1 + r2 - delta, 300.0),
+        ],
+    );
+    let (c1, c2) = (mc(r1, 2500.0, 800.0), mc(r2, 1500.0, 1200.0));
+    let h = conductance(2.0, 0.5, r1 * r2 / (r1 + r2), delta);
+    let rate = h * (1.0 / c1 + 1.0 / c2);
+    let dt = 1e-5 * 1e4;
+    let (start, _) = sim.heat_content();
+    let mean = (c1 * 400.0 + c2 * 300.0) / (c1 + c2);
+    let steps = 4000;
+    for _ in 0..steps {
+        sim.step().unwrap();
+        assert_eq!(
+            sim.heat_content().0,
+            start,
+            "conduction keeps the content to the bit"
+        );
+    }
+    let t = |k: u64| {
+        let p = &sim.particles;
+        p.temperature[p.id_order()[k as usize]]
+    };
+    let difference = t(0) - t(1);
+    let measured = (100.0 / difference).ln() / (steps as f64 * dt);
+    assert!(
+        (measured / rate - 1.0).abs() < 0.005,
+        "rate {measured} against {rate} (1/s)"
+    );
+    let now = (c1 * t(0) + c2 * t(1)) / (c1 + c2);
+    assert!(
+        (now - mean).abs() < 1e-9 * mean,
+        "mean {now} against {mean}"
+    );
+}
+
+/// N fixed grains in a row along x between a plane held at `hot` (x = 0) and one held at
+/// `cold`, overlapping each other by `delta` and the planes by `delta_w`.
+fn chain(n: usize, delta: f64, delta_w: f64, scale: f64) -> (Simulation, Vec<f64>) {
+    let r = 0.005;
+    let pitch = 2.0 * r - delta;
+    let x: Vec<f64> = (0..n).map(|k| r - delta_w + k as f64 * pitch).collect();
+    let end = x[n - 1] + r - delta_w;
+    let plane = |at: f64, nx: f64, t: f64| {
+        format!(
+            "[[meshes]]\nshape = {{ type = \"plane\", point = [{at}, 0.0, 0.0], normal = [{nx}, 0.0, 0.0], size = 0.05 }}\nmaterial = \"copper\"\ntemperature = {t}\n"
+        )
+    };
+    let text = format!(
+        "[geometry]\nradius_min = {r}\nradius_max = {r}\n\
+         [[materials]]\nname = \"grain\"\ndensity = 2500.0\nthermal_conductivity = 1.0\nheat_capacity = 800.0\ninitial_temperature = 300.0\n\
+         [[materials]]\nname = \"copper\"\nthermal_conductivity = 400.0\n\
+         {}{}\
+         [kinetics]\ngravity = [0.0, 0.0, 0.0]\n\
+         [simulation]\ntimestep = 1e-6\nthermal_time_scale = {scale}\nmax_particles = 0\n",
+        plane(0.0, 1.0, 400.0),
+        plane(end, -1.0, 300.0),
+    );
+    let grains = x.iter().map(|&x| grain(0, r, x, 300.0)).collect();
+    (simulation(&text, grains), x)
+}
+
+#[test]
+fn a_chain_between_a_hot_and_a_cold_wall_carries_the_flux_of_its_resistances_in_series() {
+    let (n, delta, delta_w, r) = (5, 2e-5, 1e-5, 0.005);
+    let h_pair = conductance(1.0, 1.0, r / 2.0, delta);
+    let h_wall = conductance(1.0, 400.0, r, delta_w);
+    let resistance = 2.0 / h_wall + (n - 1) as f64 / h_pair;
+    let flux = 100.0 / resistance;
+    // Thermal step: a tenth of the fastest grain's m c / ΣH.
+    let tau = mc(r, 2500.0, 800.0) / (h_wall + h_pair);
+    let dt = 0.1 * tau;
+    let (mut sim, _) = chain(n, delta, delta_w, dt / 1e-6);
+    // Steady after some tens of the chain's time constants (n² m c / H).
+    let settle = (40.0 * (n * n) as f64 * mc(r, 2500.0, 800.0) / h_pair / dt) as usize;
+    for _ in 0..settle {
+        sim.step().unwrap();
+    }
+    sim.take_wall_heat();
+    let steps = 100;
+    for _ in 0..steps {
+        sim.step().unwrap();
+    }
+    let heat = sim.take_wall_heat();
+    let watts: Vec<f64> = heat.iter().map(|q| q / (steps as f64 * dt)).collect();
+    // Files: the main mesh (none), the hot plane (heat leaves it), the cold one.
+    assert_eq!(watts[0], 0.0);
+    assert!(
+        (-watts[1] / flux - 1.0).abs() < 0.005,
+        "{watts:?} against {flux} W"
+    );
+    assert!(
+        (watts[2] / flux - 1.0).abs() < 0.005,
+        "{watts:?} against {flux} W"
+    );
+    // The temperatures fall linearly in the resistance met from the hot wall.
+    let p = &sim.particles;
+    for (k, i) in p.id_order().into_iter().enumerate() {
+        let met = 1.0 / h_wall + k as f64 / h_pair;
+        let expected = 400.0 - flux * met;
+        let t = p.temperature[i];
+        assert!(
+            (t - expected).abs() < 0.005 * 100.0,
+            "grain {k}: {t} K against {expected} K"
+        );
+    }
+}
+
+/// A bed poured into a box from two regions at different temperatures.
+const BED: &str = "[geometry]\nradius_min = 0.002\nradius_max = 0.003\n\
+    [[materials]]\nname = \"grain\"\ndensity = 2500.0\nyoungs_modulus = 1e7\n\
+    thermal_conductivity = 5.0\nheat_capacity = 800.0\ninitial_temperature = 300.0\n\
+    [[meshes]]\nshape = { type = \"box\", min = [-0.02, -0.02, 0.0], max = [0.02, 0.02, 0.1], open = [\"+z\"] }\n\
+    [[spawn]]\nmin = [-0.018, -0.018, 0.01]\nmax = [0.0, 0.018, 0.06]\ncount = 150\ntemperature = 500.0\n\
+    [[spawn]]\nmin = [0.0, -0.018, 0.01]\nmax = [0.018, 0.018, 0.06]\ncount = 150\n\
+    [simulation]\ntimestep = 1e-5\nthermal_time_scale = 1000.0\nmax_particles = 300\n";
+
+#[test]
+fn a_flowing_bed_keeps_its_heat_content_to_the_bit_on_any_number_of_threads() {
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut sim = simulation(BED, vec![]);
+            while sim.particles.len() < 300 {
+                sim.step().unwrap();
+            }
+            let (content, joules) = sim.heat_content();
+            assert!(joules > 0.0);
+            for step in 1..10_000 {
+                sim.step().unwrap();
+                assert_eq!(sim.heat_content().0, content, "step {step}");
+            }
+            sim.snapshot().unwrap()
+        })
+    };
+    let (one, two) = (run(1), run(2));
+    let p = &one.particles;
+    assert_eq!(p.len(), 300);
+    assert!(
+        p.temperature.iter().any(|&t| t > 300.5 && t < 499.5),
+        "heat flowed"
+    );
+    assert_eq!(one.particles, two.particles);
+}
