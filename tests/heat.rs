@@ -201,3 +201,130 @@ fn a_flowing_bed_keeps_its_heat_content_to_the_bit_on_any_number_of_threads() {
     );
     assert_eq!(one.particles, two.particles);
 }
+
+/// The error of a scenario given as text.
+fn refused(text: &str) -> String {
+    let path = common::data("inline.toml");
+    let e = tinydem::scenario::Scenario::parse(text, &path).expect_err("refused");
+    format!("{e:#}")
+}
+
+#[test]
+fn bad_heat_keys_are_refused_naming_the_key() {
+    let m = "[[materials]]\nname = \"a\"\n";
+    for (text, key) in [
+        (format!("{m}thermal_conductivity = -1.0\n"), "thermal_conductivity = -1"),
+        (format!("{m}heat_capacity = -5.0\n"), "heat_capacity = -5"),
+        (format!("{m}initial_temperature = -3.0\n"), "initial_temperature = -3 K"),
+        ("[kinetics]\nambient_temperature = -1.0\n".into(), "ambient_temperature = -1 K"),
+        (
+            "[simulation]\nthermal_time_scale = 0.0\n".into(),
+            "thermal_time_scale = 0",
+        ),
+        (
+            "[simulation]\nconduction_model = \"fourier\"\n".into(),
+            "conduction_model = \"fourier\"",
+        ),
+        (
+            "[[spawn]]\nmin = [0.0, 0.0, 0.0]\nmax = [0.1, 0.1, 0.1]\ncount = 1\ntemperature = -2.0\n"
+                .into(),
+            "temperature = -2 K",
+        ),
+    ] {
+        let e = refused(&text);
+        assert!(e.contains(key), "{text}: {e}");
+    }
+    // Grains of a material that conducts need its heat capacity (a wall's material not).
+    let text = "[geometry]\nradius_min = 0.002\nradius_max = 0.003\n\
+        [[materials]]\nname = \"sand\"\nthermal_conductivity = 1.0\n\
+        [simulation]\nmax_particles = 0\n";
+    let e = Simulation::new(common::scenario(text))
+        .err()
+        .expect("refused");
+    assert!(
+        format!("{e:#}").contains("material \"sand\" has no heat_capacity"),
+        "{e:#}"
+    );
+}
+
+#[test]
+fn a_temperature_column_is_read_checked_and_written() {
+    let t = tempfile::tempdir().unwrap();
+    let header = "x,y,z,R,vx,vy,vz,q0,q1,q2,q3,wx,wy,wz,T";
+    let row = |t: &str| format!("0.0,0.0,0.01,0.003,0,0,0,1,0,0,0,0,0,0,{t}");
+    std::fs::write(
+        t.path().join("p.csv"),
+        format!("{header}\n{}\n", row("NaN")),
+    )
+    .unwrap();
+    let scenario = "[geometry]\nradius_min = 0.003\nradius_max = 0.003\n\
+        [material]\nthermal_conductivity = 1.0\nheat_capacity = 800.0\ninitial_temperature = 300.0\n\
+        [input]\nparticles = \"p.csv\"\n[simulation]\nmax_particles = 0\nframes = 1\nsteps_per_frame = 10\n";
+    std::fs::write(t.path().join("s.toml"), scenario).unwrap();
+    let o = common::tinydem(&["run", "s.toml"], t.path());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && err.contains("p.csv:2"), "{err}");
+    std::fs::write(
+        t.path().join("p.csv"),
+        format!("{header}\n{}\n", row("351.5")),
+    )
+    .unwrap();
+    let o = common::tinydem(&["run", "s.toml"], t.path());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let frame = std::fs::read_to_string(t.path().join("output/particles000001.csv")).unwrap();
+    let mut lines = frame.lines();
+    let columns: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let at = columns.iter().position(|c| *c == "T").expect("a T column");
+    let value: f64 = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .nth(at)
+        .unwrap()
+        .parse()
+        .unwrap();
+    // One grain alone: its content unchanged, its temperature that of the file's.
+    assert!((value - 351.5).abs() < 1e-9, "{value}");
+    let log = std::fs::read_to_string(t.path().join("output/log.csv")).unwrap();
+    assert!(
+        log.lines()
+            .next()
+            .unwrap()
+            .contains("T_mean,T_min,T_max,heat_content")
+    );
+}
+
+#[test]
+fn check_prints_the_thermal_step_refuses_an_overshooting_one_and_warns_of_idle_keys() {
+    let t = tempfile::tempdir().unwrap();
+    let text = |scale: f64| {
+        format!(
+            "[geometry]\nradius_min = 0.002\nradius_max = 0.003\n\
+             [material]\nthermal_conductivity = 5.0\nheat_capacity = 800.0\n\
+             [simulation]\ntimestep = 1e-5\nthermal_time_scale = {scale}\n"
+        )
+    };
+    std::fs::write(t.path().join("s.toml"), text(1000.0)).unwrap();
+    let o = common::tinydem(&["check", "s.toml"], t.path());
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        out.contains("thermal step           1.000000e-2 s (f = 1000;"),
+        "{out}"
+    );
+    assert!(!out.contains("warning"), "{out}");
+    std::fs::write(t.path().join("s.toml"), text(1e8)).unwrap();
+    let o = common::tinydem(&["run", "s.toml"], t.path());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("exceeds the grains' thermal time scale"),
+        "{err}"
+    );
+    let idle = "[material]\ninitial_temperature = 400.0\n[kinetics]\nambient_temperature = 290.0\n";
+    std::fs::write(t.path().join("s.toml"), idle).unwrap();
+    let o = common::tinydem(&["check", "s.toml"], t.path());
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        out.contains("warning: material \"default\" initial_temperature, [kinetics] ambient_temperature set, but no material conducts heat"),
+        "{out}"
+    );
+}

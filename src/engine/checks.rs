@@ -79,11 +79,15 @@ impl Simulation {
         what.extend(kind(1).take(5));
         let room = 5 - what.len().min(5);
         what.extend(kind(2).take(room));
+        let hot = (0..self.particles.len()).any(|k| self.own(k) && self.bad_temperature(k));
         Err(Unstable {
             step: self.steps,
             time: self.time,
             what,
-            advice: self.advice(),
+            advice: match hot {
+                true => "the explicit heat update overshoots: lower [simulation] thermal_time_scale (tinydem check prints the thermal time scale)".into(),
+                false => self.advice(),
+            },
         })
     }
 
@@ -109,11 +113,8 @@ impl Simulation {
         {
             let what = match self.model.heat.as_ref().filter(|_| self.bad_temperature(k)) {
                 Some((h, _)) => format!(
-                    "particle {} has a temperature of {} K: heat advanced by f dt = {:.3e} s per step overshoots (the grains' thermal time scale is {:.3e} s): lower [simulation] thermal_time_scale",
-                    p.id[k],
-                    p.temperature[k],
-                    h.dt,
-                    h.time_scale(self.scenario.geometry.radius_min, 12.0)
+                    "particle {} has a temperature of {} K (heat advanced by f dt = {:.3e} s per step)",
+                    p.id[k], p.temperature[k], h.dt,
                 ),
                 None => format!(
                     "particle {} has a non-finite state (x = {}, v = {}, w = {})",

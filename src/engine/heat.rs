@@ -265,23 +265,8 @@ impl Simulation {
         used.sort_unstable();
         used.dedup();
         s.heat_capacity_missing(used)?;
-        let materials: Vec<_> = s.materials.iter().map(|m| m.properties.thermal).collect();
         let r_max = LoadScales::largest_radius(s).max(self.particles.max_radius());
-        let largest = (s.materials.iter())
-            .map(|m| m.properties.density * m.properties.thermal.capacity)
-            .fold(0.0, f64::max)
-            * 4.0
-            / 3.0
-            * std::f64::consts::PI
-            * r_max.powi(3);
-        let model = HeatModel {
-            materials,
-            mass_per_r3: self.model.densities.iter().map(|d| d.mass_per_r3).collect(),
-            dt: s.simulation.timestep * s.simulation.thermal_time_scale,
-            ambient: s.kinetics.ambient_temperature,
-            quantum: HeatModel::quantum_for(largest.max(f64::MIN_POSITIVE)),
-            conduction: s.simulation.conduction_model,
-        };
+        let model = s.heat_model(r_max).expect("heat is transferred");
         let mut temperature = vec![None; self.walls.files.len()];
         for (t, m) in temperature[1..].iter_mut().zip(&s.meshes) {
             *t = m.temperature;

@@ -172,7 +172,8 @@ impl HeatModel {
     pub fn time_scale(&self, r_min: f64, contacts: f64) -> f64 {
         let mut tau = f64::INFINITY;
         for (m, th) in self.materials.iter().enumerate() {
-            if th.conductivity <= 0.0 && th.surface_transfer <= 0.0 {
+            // (A material of walls alone has no capacity.)
+            if th.capacity <= 0.0 || (th.conductivity <= 0.0 && th.surface_transfer <= 0.0) {
                 continue;
             }
             let mc = self.capacity(m as u16, r_min);

@@ -7,6 +7,7 @@ use anyhow::{Result, bail};
 use super::raw::RawMaterial;
 use super::validate::{Range, check};
 use super::*;
+use crate::model::heat::HeatModel;
 
 /// A material's thermal properties (`table` names it in messages). (Whether its grains
 /// have the heat capacity they need: [`Scenario::heat_capacity_missing`], once the
@@ -61,6 +62,42 @@ pub(super) fn thermal_time_scale(f: Option<f64>) -> Result<f64> {
 }
 
 impl Scenario {
+    /// The constants of heat transfer, if heat is transferred, for grains of radius at
+    /// most `r_max` (which sets the quantum of heat).
+    pub fn heat_model(&self, r_max: f64) -> Option<HeatModel> {
+        if !self.heat() {
+            return None;
+        }
+        let densest = (self.materials.iter())
+            .map(|m| m.properties.density * m.properties.thermal.capacity)
+            .fold(0.0, f64::max);
+        let largest = densest * 4.0 / 3.0 * std::f64::consts::PI * r_max.powi(3);
+        let s = &self.simulation;
+        Some(HeatModel {
+            materials: self
+                .materials
+                .iter()
+                .map(|m| m.properties.thermal)
+                .collect(),
+            mass_per_r3: (self.materials.iter())
+                .map(|m| 4.0 / 3.0 * std::f64::consts::PI * m.properties.density)
+                .collect(),
+            dt: s.timestep * s.thermal_time_scale,
+            ambient: self.kinetics.ambient_temperature,
+            quantum: HeatModel::quantum_for(largest.max(f64::MIN_POSITIVE)),
+            conduction: s.conduction_model,
+        })
+    }
+
+    /// The thermal step f Δt and the grains' shortest thermal time scale (m c over the
+    /// conductance of 12 contacts of a tenth of R_min, `HeatModel::time_scale`), if heat
+    /// is transferred.
+    pub fn thermal_steps(&self) -> Option<(f64, f64)> {
+        let g = &self.geometry;
+        let model = self.heat_model(g.radius_max)?;
+        Some((model.dt, model.time_scale(g.radius_min, 12.0)))
+    }
+
     /// Whether heat is transferred: some material conducts, makes heat or exchanges it
     /// with the surroundings. Only then do particles hold a temperature.
     pub fn heat(&self) -> bool {
