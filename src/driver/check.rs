@@ -48,7 +48,7 @@ fn describe_start(s: &Scenario, out: &Path, sim: Simulation) -> Result<String> {
     let bounds = bound_lines(s, &sim);
     let materials = material_lines(s) + &clump_lines(s);
     let default_dt = s.eq50_timestep();
-    let until = until_line(s) + &heat_line(s);
+    let until = until_line(s) + &s.thermal_line();
     Ok(format!(
         "scenario is valid\n\
          {meshes}\
@@ -504,7 +504,7 @@ pub fn most_particles(s: &Scenario, initial: usize) -> usize {
 /// step past [`TIMESTEP_TOLERANCE`] times Eq. 50, more output than the free space.
 pub fn refusals(s: &Scenario, n: usize, out: &Path) -> Vec<String> {
     let mut why: Vec<String> = timestep_refusal(s).into_iter().collect();
-    why.extend(thermal_refusal(s));
+    why.extend(s.thermal_refusal());
     why.extend(until_refusal(s, n as u64));
     let need = OutputEstimate::of(s, n, 0).total;
     if let Some(free) = free_space(out)
@@ -578,35 +578,6 @@ pub fn cautions(s: &Scenario) -> Vec<String> {
         }
     }
     why
-}
-
-/// The thermal step against the grains' thermal time scale, with heat transfer.
-fn heat_line(s: &Scenario) -> String {
-    match s.thermal_steps() {
-        Some((dt, tau)) => format!(
-            "thermal step           {dt:.6e} s (f = {}; {:.3} x the grains' thermal time scale {tau:.6e} s)\n",
-            s.simulation.thermal_time_scale,
-            dt / tau
-        ),
-        None => String::new(),
-    }
-}
-
-/// Why heat transfer is refused: a thermal step f Δt past the grains' thermal time scale
-/// (the explicit update of a grain with that many contacts overshoots, and its temperature
-/// oscillates and grows).
-pub fn thermal_refusal(s: &Scenario) -> Option<String> {
-    let (dt, tau) = s.thermal_steps()?;
-    (dt > tau).then(|| {
-        format!(
-            "the thermal step f dt = {dt:.3e} s ([simulation] thermal_time_scale = {} x timestep) \
-             exceeds the grains' thermal time scale {tau:.3e} s (m c over the conductance of 12 \
-             contacts of radius R_min/10): temperatures would overshoot and blow up (set \
-             thermal_time_scale at most {:.3e})",
-            s.simulation.thermal_time_scale,
-            tau / s.simulation.timestep
-        )
-    })
 }
 
 /// Why the time step is refused: past [`TIMESTEP_TOLERANCE`] times Eq. 50.

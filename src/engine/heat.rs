@@ -315,7 +315,7 @@ impl Simulation {
         }
     }
 
-    /// The heat into each mesh file since the last call [J] (0 without heat transfer),
+    /// The heat into each mesh file since the last call \[J\] (0 without heat transfer),
     /// and the sums set back to zero.
     pub fn take_wall_heat(&mut self) -> Vec<f64> {
         let heat = self.walls.take_heat();
@@ -375,7 +375,7 @@ impl Simulation {
         })
     }
 
-    /// The heat content of the particles Σ m c T [J] (this process's own, in a split run),
+    /// The heat content of the particles Σ m c T \[J\] (this process's own, in a split run),
     /// exactly summed: 0 without heat transfer.
     pub fn heat_content(&self) -> (i128, f64) {
         let Some((model, _)) = &self.model.heat else {

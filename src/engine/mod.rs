@@ -459,11 +459,11 @@ pub struct Thermo {
 /// The particles' temperatures in numbers, for `log.csv`.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Temperatures {
-    /// Mean, least and greatest temperature [K] (0 without particles).
+    /// Mean, least and greatest temperature \[K\] (0 without particles).
     pub mean: f64,
     pub min: f64,
     pub max: f64,
-    /// Σ m c T [J].
+    /// Σ m c T \[J\].
     pub content: f64,
 }
 

@@ -94,7 +94,7 @@ pub struct Walls {
     pub(super) drift: f64,
     /// For each face, its mesh file (an index of `files`).
     pub(super) face_file: Vec<u32>,
-    /// The heat into each mesh file [quanta of the heat model] since the last
+    /// The heat into each mesh file \[quanta of the heat model\] since the last
     /// [`Walls::take_heat`] (over all processes).
     pub(super) heat: Vec<i128>,
     /// For each face, its material.
@@ -323,7 +323,7 @@ impl Walls {
         std::mem::replace(&mut self.sums, zero)
     }
 
-    /// The heat into each mesh file since the last call [quanta], and the sums set back
+    /// The heat into each mesh file since the last call (in quanta), and the sums set back
     /// to zero.
     pub fn take_heat(&mut self) -> Vec<i128> {
         let zero = vec![0; self.heat.len()];

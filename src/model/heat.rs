@@ -12,15 +12,15 @@
 /// The thermal properties of a material.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Thermal {
-    /// k [W/(m K)]: conducts heat where > 0.
+    /// k \[W/(m K)\]: conducts heat where > 0.
     pub conductivity: f64,
-    /// c [J/(kg K)].
+    /// c \[J/(kg K)\].
     pub capacity: f64,
-    /// T_0 [K]: the temperature of its particles that no file or region sets.
+    /// T_0 \[K\]: the temperature of its particles that no file or region sets.
     pub initial_temperature: f64,
-    /// q_V [W/m³]: heat made in its volume.
+    /// q_V \[W/m³\]: heat made in its volume.
     pub source: f64,
-    /// h [W/(m² K)]: exchange with the surroundings over a grain's surface (with `[kinetics]
+    /// h \[W/(m² K)\]: exchange with the surroundings over a grain's surface (with `[kinetics]
     /// ambient_temperature`).
     pub surface_transfer: f64,
 }
@@ -83,7 +83,7 @@ pub fn effective_conductivity(k_i: f64, k_j: f64) -> f64 {
     }
 }
 
-/// H [W/K] = 2 k_eff a: the conductance of a contact of radius `a` between sides of
+/// H \[W/K\] = 2 k_eff a: the conductance of a contact of radius `a` between sides of
 /// conductivities `k_i`, `k_j` (Batchelor & O'Brien 1977, Eq. 4.9).
 pub fn conductance(k_i: f64, k_j: f64, a: f64) -> f64 {
     2.0 * effective_conductivity(k_i, k_j) * a
@@ -96,17 +96,17 @@ pub struct HeatModel {
     pub materials: Vec<Thermal>,
     /// Per material: ρ 4/3 π, a particle's mass over R³.
     pub mass_per_r3: Vec<f64>,
-    /// The thermal step Δt_th = f Δt (`thermal_time_scale` f) [s].
+    /// The thermal step Δt_th = f Δt (`thermal_time_scale` f) \[s\].
     pub dt: f64,
-    /// T_∞ [K] of the surroundings, if grains exchange heat with them.
+    /// T_∞ \[K\] of the surroundings, if grains exchange heat with them.
     pub ambient: Option<f64>,
-    /// The heat content of one quantum [J]: a power of two.
+    /// The heat content of one quantum \[J\]: a power of two.
     pub quantum: f64,
     pub conduction: Conduction,
 }
 
 impl HeatModel {
-    /// The quantum for particles of heat capacity m c at most `largest` [J/K]: 2^-64 of it
+    /// The quantum for particles of heat capacity m c at most `largest` \[J/K\]: 2^-64 of it
     /// (rounded up to a power of two), so a content of 2^63 K times the largest grain's
     /// still fits the 128 bits, and the smallest grain's temperature is resolved far
     /// below a float's last bit.
@@ -118,7 +118,7 @@ impl HeatModel {
         2f64.powi(largest.log2().ceil() as i32 - 64)
     }
 
-    /// m c [J/K] of a particle of material `material` and radius `radius`.
+    /// m c \[J/K\] of a particle of material `material` and radius `radius`.
     #[inline]
     pub fn capacity(&self, material: u16, radius: f64) -> f64 {
         let m = material as usize;

@@ -42,7 +42,7 @@ particle_fields! {
         body: Option<BodyId>, ghost: false, checkpoint: None::<u32>;
     }
     optional {
-        /// T [K], the temperature (held when heat is transferred: a material conducts,
+        /// T \[K\], the temperature (held when heat is transferred: a material conducts,
         /// makes or exchanges heat).
         temperature: f64, ghost: true, unit: "K", name: "T";
         /// The heat content m c T in quanta of the run's heat model (`model/heat.rs`):

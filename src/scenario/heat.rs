@@ -30,7 +30,7 @@ pub(super) fn thermal(table: &str, m: &RawMaterial) -> Result<Thermal> {
     Ok(t)
 }
 
-/// A temperature [K] under `key`, if given: finite and >= 0.
+/// A temperature \[K\] under `key`, if given: finite and >= 0.
 pub(super) fn temperature(key: &str, t: Option<f64>) -> Result<Option<f64>> {
     t.map(|t| {
         if !(t.is_finite() && t >= 0.0) {
@@ -96,6 +96,37 @@ impl Scenario {
         let g = &self.geometry;
         let model = self.heat_model(g.radius_max)?;
         Some((model.dt, model.time_scale(g.radius_min, 12.0)))
+    }
+
+    /// The thermal step against the grains' thermal time scale, with heat transfer.
+    pub fn thermal_line(&self) -> String {
+        let s = self;
+        match s.thermal_steps() {
+            Some((dt, tau)) => format!(
+                "thermal step           {dt:.6e} s (f = {}; {:.3} x the grains' thermal time scale {tau:.6e} s)\n",
+                s.simulation.thermal_time_scale,
+                dt / tau
+            ),
+            None => String::new(),
+        }
+    }
+
+    /// Why heat transfer is refused: a thermal step f Δt past the grains' thermal time scale
+    /// (the explicit update of a grain with that many contacts overshoots, and its temperature
+    /// oscillates and grows).
+    pub fn thermal_refusal(&self) -> Option<String> {
+        let s = self;
+        let (dt, tau) = s.thermal_steps()?;
+        (dt > tau).then(|| {
+            format!(
+                "the thermal step f dt = {dt:.3e} s ([simulation] thermal_time_scale = {} x timestep) \
+                 exceeds the grains' thermal time scale {tau:.3e} s (m c over the conductance of 12 \
+                 contacts of radius R_min/10): temperatures would overshoot and blow up (set \
+                 thermal_time_scale at most {:.3e})",
+                s.simulation.thermal_time_scale,
+                tau / s.simulation.timestep
+            )
+        })
     }
 
     /// Whether heat is transferred: some material conducts, makes heat or exchanges it

@@ -6,11 +6,13 @@
 //!              spawn_max
 //! [material]   density, youngs_modulus, poisson_ratio, restitution, friction_sliding,
 //!              friction_rolling, friction_twisting, cohesion, viscosity, normal_model,
-//!              adhesion_model, rolling_model, tangential_coulomb
-//! [kinetics]   initial_velocity, initial_angular_velocity, gravity
+//!              adhesion_model, rolling_model, tangential_coulomb, thermal_conductivity,
+//!              heat_capacity, initial_temperature, heat_source, surface_heat_transfer
+//! [kinetics]   initial_velocity, initial_angular_velocity, gravity, ambient_temperature
 //! [simulation] timestep, max_particles, frames, steps_per_frame, spawn_attempts, seed, skin,
 //!              friction_springs = "advance_first" | "paper", until = { kinetic_energy_below,
-//!              time, removed_at_least, servo_within }
+//!              time, removed_at_least, servo_within }, thermal_time_scale,
+//!              conduction_model = "batchelor_obrien" | "liggghts"
 //! [[meshes]]   file | shape = { type = "box", min, max, open } | { type = "cylinder", center,
 //!              axis, radius, height, open, orifice, resolution } | { type = "drum", center,
 //!              axis, radius, length, resolution } | { type = "plane", point, normal, size } |
@@ -18,14 +20,14 @@
 //!              resolution }, radii, contacts, material, motion = { type = "harmonic",
 //!              amplitude, frequency, direction, phase } | { type = "velocity", velocity } |
 //!              { type = "rotation", center, axis, angular_velocity } | { type = "servo",
-//!              direction, force | stress, max_speed, gain }   (any number of these)
+//!              direction, force | stress, max_speed, gain }, temperature   (any number)
 //! [[tags]]     min, max, tag   (a box that labels particles entering it; any number)
 //! [domain]     min, max, periodic = [bool, bool, bool]   (particles whose centre leaves
 //!              it through a side that is not periodic are removed)
 //! [[outlets]]  min, max   (particles whose centre enters one are removed; any number)
 //! [[fixed]]    min, max   (the particles whose centre lies in one when the run or stage
 //!              starts are held in place and at rest; any number)
-//! [[spawn]]    min, max, material, velocity, count, rate, start, stop, radius = {
+//! [[spawn]]    min, max, material, velocity, temperature, count, rate, start, stop, radius = {
 //!              distribution = "uniform" | "normal" | "lognormal" | "table", ... }
 //! [[clumps]]  name, spheres = [[x, y, z, r], ...] | file, material, mass, inertia
 //!              (rigid clumps of spheres; spawned by [[spawn]] clump, scale)
@@ -124,7 +126,7 @@ pub struct Kinetics {
     pub initial_angular_velocity: DVec3,
     /// g [L/T²]
     pub gravity: DVec3,
-    /// T_∞ [K] of the surroundings grains exchange heat with (`surface_heat_transfer`).
+    /// T_∞ \[K\] of the surroundings grains exchange heat with (`surface_heat_transfer`).
     pub ambient_temperature: Option<f64>,
 }
 
@@ -235,7 +237,7 @@ pub struct MeshSpec {
     pub servo: Option<Servo>,
     /// The material of its faces (an index of `Scenario::materials`).
     pub material: u16,
-    /// T_w [K]: its faces held at this temperature (heat flows between them and the grains
+    /// T_w \[K\]: its faces held at this temperature (heat flows between them and the grains
     /// that touch them); `None`: adiabatic.
     pub temperature: Option<f64>,
 }
@@ -340,7 +342,7 @@ pub struct SpawnRegion {
     pub material: u16,
     /// Initial velocity of its particles (default `[kinetics] initial_velocity`).
     pub velocity: DVec3,
-    /// Initial temperature [K] of its particles (default: their material's).
+    /// Initial temperature \[K\] of its particles (default: their material's).
     pub temperature: Option<f64>,
     /// How many particles it inserts in all (None: no limit but the rate's and
     /// `max_particles`).
