@@ -328,3 +328,72 @@ fn check_prints_the_thermal_step_refuses_an_overshooting_one_and_warns_of_idle_k
         "{out}"
     );
 }
+
+#[test]
+fn temperatures_are_rendered_and_coarse_grained_into_a_field() {
+    let t = tempfile::tempdir().unwrap();
+    let text = BED.replace(
+        "max_particles = 300\n",
+        "max_particles = 300\nframes = 2\nsteps_per_frame = 400\n",
+    ) + "[output]\ncontacts = true\n";
+    std::fs::write(t.path().join("bed.toml"), text).unwrap();
+    let o = common::tinydem(&["run", "bed.toml", "--output", "out"], t.path());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = common::tinydem(
+        &[
+            "render",
+            "out/particles000002.csv",
+            "--color",
+            "temperature",
+        ],
+        t.path(),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(t.path().join("out/particles000002.png").exists());
+    let o = common::tinydem(
+        &["analyze", "out", "--fields", "--spacing", "0.01"],
+        t.path(),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = std::fs::read_to_string(t.path().join("out/fields000002.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let (at, rho) = (
+        header
+            .iter()
+            .position(|c| *c == "temperature")
+            .expect("a temperature column"),
+        header.iter().position(|c| *c == "density").unwrap(),
+    );
+    let mut seen = 0;
+    for line in lines {
+        let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
+        if v[rho] > 100.0 {
+            assert!(v[at] > 299.0 && v[at] < 501.0, "{line}");
+            seen += 1;
+        }
+    }
+    assert!(seen > 10, "{seen} points in the bed");
+    // A run without heat has no temperatures to colour by: said plainly.
+    std::fs::write(
+        t.path().join("cold.toml"),
+        "[simulation]\nframes = 1\nsteps_per_frame = 10\nmax_particles = 5\n",
+    )
+    .unwrap();
+    let o = common::tinydem(&["run", "cold.toml", "--output", "cold"], t.path());
+    assert!(o.status.success());
+    let o = common::tinydem(
+        &[
+            "render",
+            "cold/particles000001.csv",
+            "--color",
+            "temperature",
+        ],
+        t.path(),
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("no temperatures (a T column)"),
+        "{err}"
+    );
+}

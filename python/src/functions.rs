@@ -91,7 +91,7 @@ pub(crate) fn run(
 /// in one view and colour range (as `tinydem render`); returns a dict with the `pictures`
 /// written and the `animation` (GIF, or MP4 with the system's ffmpeg), if any.
 ///
-/// color: "speed", "height", "radius", "tag", "material" or "clump" (a colour per clump); view: "front", "side", "top"
+/// color: "speed", "height", "radius", "tag", "material", "clump" (a colour per clump) or "temperature"; view: "front", "side", "top"
 /// or "iso"; range: (lo, hi) of the colour bar; bounds: ((x0, y0, z0), (x1, y1, z1)), the
 /// box to show; scenario: whose meshes to draw (default: the directory's run.toml).
 #[pyfunction]
@@ -120,9 +120,10 @@ pub(crate) fn render<'py>(
         "tag" => ColorBy::Tag,
         "material" => ColorBy::Material,
         "clump" => ColorBy::Clump,
+        "temperature" => ColorBy::Temperature,
         other => {
             return Err(PyValueError::new_err(format!(
-                "color {other:?}: one of speed, height, radius, tag, material, clump"
+                "color {other:?}: one of speed, height, radius, tag, material, clump, temperature"
             )));
         }
     };

@@ -115,6 +115,9 @@ impl Simulation {
             sim.walls.sums = snapshot.wall_sums;
         }
         sim.walls.set_servos(&snapshot.servos);
+        if sim.model.heat.is_some() && snapshot.wall_heat.len() == sim.walls.heat.len() {
+            sim.walls.heat = snapshot.wall_heat;
+        }
         let dt = sim.scenario.simulation.timestep;
         if snapshot.anchors.is_empty() {
             // Taken before the first step: the lists are made as that step would make them.

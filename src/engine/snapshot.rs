@@ -64,6 +64,10 @@ impl Simulation {
             face_history: faces,
             removed: self.removed.clone(),
             wall_sums: self.walls.sums.clone(),
+            wall_heat: match self.model.heat {
+                Some(_) => self.walls.heat.clone(),
+                None => Vec::new(),
+            },
             scenario: self.scenario.to_toml(),
             mesh_files: self.walls.signatures(),
             servos: self.walls.servos(),

@@ -252,6 +252,8 @@ pub struct Sums {
     /// Σ m v ⊗ v φ.
     flux: Vec<DMat3>,
     contact: Vec<DMat3>,
+    /// Σ m T φ, of frames with temperatures (heat transfer).
+    heat: Option<Vec<f64>>,
 }
 
 /// Gauss-Legendre nodes and weights on [0, 1], four points.
@@ -274,6 +276,7 @@ impl Sums {
             momentum: vec![DVec3::ZERO; n],
             flux: vec![DMat3::ZERO; n],
             contact: vec![DMat3::ZERO; n],
+            heat: None,
         }
     }
 
@@ -298,6 +301,9 @@ impl Sums {
         contacts: Option<&[ContactRecord]>,
     ) {
         self.frames += 1;
+        if p.active.temperature && self.heat.is_none() {
+            self.heat = Some(vec![0.0; self.density.len()]);
+        }
         for k in 0..p.len() {
             let ((m, vol), v) = (of(k), p.v[k]);
             let mvv = DMat3::from_cols(v * (m * v.x), v * (m * v.y), v * (m * v.z));
@@ -308,13 +314,18 @@ impl Sums {
                 volume,
                 momentum,
                 flux,
+                heat,
                 ..
             } = self;
+            let t = p.temperature.get(k).copied().unwrap_or(0.0);
             grid.spread(kernel, p.x[k], |g, phi| {
                 density[g] += m * phi;
                 volume[g] += vol * phi;
                 momentum[g] += m * phi * v;
                 flux[g] += mvv * phi;
+                if let Some(heat) = heat.as_mut() {
+                    heat[g] += m * t * phi;
+                }
             });
         }
         if let Some(contacts) = contacts {
@@ -382,9 +393,16 @@ impl Sums {
                 *f * (1.0 / n) - DMat3::from_cols(v * (rho * v.x), v * (rho * v.y), v * (rho * v.z))
             })
             .collect();
+        // The mass-weighted mean temperature where there are grains.
+        let temperature = (self.heat.as_ref()).map(|heat| {
+            (heat.iter().zip(&density))
+                .map(|(h, &rho)| if rho > 0.0 { h / n / rho } else { 0.0 })
+                .collect()
+        });
         Fields {
             grid: self.grid.clone(),
             frames: self.frames,
+            temperature,
             density,
             volume_fraction: self.volume.iter().map(|v| v / n).collect(),
             velocity,
@@ -410,6 +428,9 @@ pub struct Fields {
     /// is `matrix.col(c)[r]`.
     pub contact: Vec<DMat3>,
     pub kinetic: Vec<DMat3>,
+    /// The mass-weighted mean temperature \[K\] (0 where there are no grains), of frames
+    /// with temperatures.
+    pub temperature: Option<Vec<f64>>,
 }
 
 impl Fields {
@@ -419,14 +440,19 @@ impl Fields {
     }
 
     /// The columns of [`Fields::row`].
-    pub fn header() -> String {
+    pub fn header(&self) -> String {
         let tensor = |p: &str| {
             ["xx", "xy", "xz", "yx", "yy", "yz", "zx", "zy", "zz"]
                 .map(|c| format!("{p}_{c}"))
                 .join(",")
         };
+        let temperature = if self.temperature.is_some() {
+            ",temperature"
+        } else {
+            ""
+        };
         format!(
-            "x,y,z,density,volume_fraction,vx,vy,vz,{},{},{}",
+            "x,y,z,density,volume_fraction,vx,vy,vz,{},{},{}{temperature}",
             tensor("stress"),
             tensor("contact"),
             tensor("kinetic")
@@ -456,6 +482,7 @@ impl Fields {
         row.extend(rows(self.stress(k)));
         row.extend(rows(self.contact[k]));
         row.extend(rows(self.kinetic[k]));
+        row.extend(self.temperature.as_ref().map(|t| t[k]));
         row
     }
 }

@@ -19,7 +19,9 @@
 //! q0..q3, w, mass, principal moments, bounding radius (19 f64) and its spheres' offsets
 //! (count u32, 3 f64 each); from format 8 (written when the particles hold optional fields,
 //! `model/fields.rs`; without them, format 7) the optional fields: count (u32) and per field
-//! its name (length u8, bytes) and its values in storage order; last a CRC-32 of everything
+//! its name (length u8, bytes) and its values in storage order; from format 9 (written with
+//! heat transfer) the heat into each mesh file since the last frame (count u64, i128 each);
+//! last a CRC-32 of everything
 //! before it. A particle's record is the table's (`model/particles.rs`, the core fields with
 //! a checkpoint format, from that format on, in the table's order).
 //!
@@ -39,10 +41,13 @@ use crate::model::servo::State;
 use crate::neighbours::Entry;
 
 const MAGIC: &[u8; 12] = b"TINYDEM CKPT";
-const VERSION: u32 = 8;
+const VERSION: u32 = 9;
 /// The format of a checkpoint without optional particle fields: 7, whose bytes format 8
 /// adds the section of the optional fields to.
 const WITHOUT_OPTIONAL: u32 = 7;
+/// The format of a checkpoint with optional fields and no heat transfer: 8, whose bytes
+/// format 9 adds the heat into the walls to.
+const WITHOUT_HEAT: u32 = 8;
 /// The oldest version this program reads.
 const OLDEST: u32 = 2;
 
@@ -94,6 +99,7 @@ fn encoded_size(s: &Snapshot) -> usize {
         + s.scenario.len()
         + 16 * s.mesh_files.len()
         + 48 * s.wall_sums.len()
+        + 16 * s.wall_heat.len()
         + 16 * s.removed.outlets.len()
         + 17 * s.spawner.regions.len()
         + 1
@@ -104,7 +110,11 @@ fn encoded_size(s: &Snapshot) -> usize {
 pub fn encode_into(out: &mut Vec<u8>, snapshot: &Snapshot, fingerprint: u64) {
     let optional = !snapshot.particles.active.fields().is_empty()
         || !snapshot.contact_state.fields().is_empty();
-    let version = if optional { VERSION } else { WITHOUT_OPTIONAL };
+    let version = match (optional, snapshot.wall_heat.is_empty()) {
+        (_, false) => VERSION,
+        (true, true) => WITHOUT_HEAT,
+        (false, true) => WITHOUT_OPTIONAL,
+    };
     encode_as(out, snapshot, fingerprint, version);
 }
 
@@ -181,6 +191,12 @@ fn encode_as(out: &mut Vec<u8>, snapshot: &Snapshot, fingerprint: u64, version: 
     if version >= 8 {
         put_optional(out, p);
         put_optional_state(out, snapshot);
+    }
+    if version >= 9 {
+        out.extend_from_slice(&(snapshot.wall_heat.len() as u64).to_le_bytes());
+        for q in &snapshot.wall_heat {
+            out.extend_from_slice(&q.to_le_bytes());
+        }
     }
     let crc = crc32fast::hash(&out[start..]);
     out.extend_from_slice(&crc.to_le_bytes());
@@ -410,6 +426,19 @@ pub fn decode(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<Snapsho
         let histories = (&mut pair_history[..], &mut face_history[..]);
         contact_state = r.optional_state(histories)?;
     }
+    let mut wall_heat = Vec::new();
+    if version >= 9 {
+        let files = r.count(16)?;
+        if files != rest.mesh_files.len() {
+            bail!(
+                "corrupt checkpoint: the heat of {files} mesh files, for {} files",
+                rest.mesh_files.len()
+            );
+        }
+        for _ in 0..files {
+            wall_heat.push(i128::from_le_bytes(r.take(16)?.try_into()?));
+        }
+    }
     if r.at != r.bytes.len() {
         bail!(
             "corrupt checkpoint: {} unexpected bytes at the end",
@@ -433,6 +462,7 @@ pub fn decode(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<Snapsho
         face_history,
         removed: rest.removed,
         wall_sums: rest.wall_sums,
+        wall_heat,
         scenario: rest.scenario,
         mesh_files: rest.mesh_files,
         servos: rest.servos,

@@ -36,6 +36,7 @@ pub fn join(pieces: Vec<Snapshot>) -> Result<Snapshot> {
                 && p.spawner == first.spawner
                 && p.removed == first.removed
                 && p.wall_sums == first.wall_sums
+                && p.wall_heat == first.wall_heat
                 && p.scenario == first.scenario
                 && p.mesh_files == first.mesh_files
                 && p.servos == first.servos,
@@ -90,6 +91,7 @@ pub fn join(pieces: Vec<Snapshot>) -> Result<Snapshot> {
         face_history: springs(|p| &p.face_history),
         removed: first.removed.clone(),
         wall_sums: first.wall_sums.clone(),
+        wall_heat: first.wall_heat.clone(),
         scenario: first.scenario.clone(),
         mesh_files: first.mesh_files.clone(),
         servos: first.servos.clone(),

@@ -33,6 +33,9 @@ pub struct Snapshot {
     pub removed: Removed,
     /// The loads on the mesh files summed since the last frame (`[output] wall_forces`).
     pub wall_sums: Vec<Wrench>,
+    /// The heat into each mesh file since the last frame, in quanta of the run's heat
+    /// model (with heat transfer; format 9).
+    pub wall_heat: Vec<i128>,
     /// The resolved scenario of the run (`Scenario::to_toml`), to tell what a staged run
     /// changes.
     pub scenario: String,

@@ -289,6 +289,7 @@ mod tests {
                 f: DVec3::new(1.0, -2.0, 3.0),
                 tau: DVec3::new(0.5, 0.25, -1e-9),
             }],
+            wall_heat: Vec::new(),
             scenario: "[simulation]\nframes = 3\n".into(),
             mesh_files: vec![(0, 1), (12, 0xdead_beef)],
             servos: vec![(
@@ -377,6 +378,21 @@ mod tests {
         s.pair_history[0].1 += big;
         s.face_history[0].0 += big;
         assert_eq!(decode(&encode(&s, 7), Some(7)).unwrap(), s);
+        // With heat transfer: the temperatures, contents and the heat into each mesh file.
+        s.particles.activate("T");
+        s.particles.activate("heat");
+        (s.particles.temperature[0], s.particles.heat[0]) = (351.25, -(1 << 100) - 3);
+        s.wall_heat = vec![1 << 90, -17];
+        let bytes = encode(&s, 7);
+        assert_eq!(u32::from_le_bytes(bytes[12..16].try_into().unwrap()), 9);
+        assert_eq!(decode(&bytes, Some(7)).unwrap(), s);
+        // Heat into walls for other mesh files than the checkpoint's: refused.
+        s.wall_heat.push(1);
+        let e = decode(&encode(&s, 7), Some(7)).unwrap_err();
+        assert!(
+            format!("{e:#}").contains("the heat of 3 mesh files, for 2 files"),
+            "{e:#}"
+        );
     }
 
     /// A snapshot's bytes with format `version` for `bytes` of the newest format whose
@@ -444,8 +460,8 @@ mod tests {
         flipped[40] ^= 1;
         assert!(msg(&flipped, 7).contains("checksum"));
         let mut version = bytes.clone();
-        version[12] = 9;
-        assert!(msg(&version, 7).contains("version 9"));
+        version[12] = 10;
+        assert!(msg(&version, 7).contains("version 10"));
         version[12] = 1;
         assert!(msg(&version, 7).contains("version 1"));
         assert!(msg(b"hello world, not a checkpoint", 7).contains("not a tinydem checkpoint"));

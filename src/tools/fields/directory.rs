@@ -263,21 +263,27 @@ fn write(dir: &Path, name: &str, fields: &Fields) -> Result<[PathBuf; 2]> {
         spacing: fields.grid.spacing,
         counts: fields.grid.counts,
     };
-    image.write(
-        &vti,
-        &[
-            ("density", 1, &fields.density),
-            ("volume_fraction", 1, &fields.volume_fraction),
-            ("velocity", 3, &velocity),
-            ("stress", 9, &tensor(&stress)),
-            ("contact_stress", 9, &tensor(&fields.contact)),
-            ("kinetic_stress", 9, &tensor(&fields.kinetic)),
-        ],
-    )?;
+    let (stress, contact, kinetic) = (
+        tensor(&stress),
+        tensor(&fields.contact),
+        tensor(&fields.kinetic),
+    );
+    let mut arrays: Vec<(&str, usize, &[f64])> = vec![
+        ("density", 1, &fields.density),
+        ("volume_fraction", 1, &fields.volume_fraction),
+        ("velocity", 3, &velocity),
+        ("stress", 9, &stress),
+        ("contact_stress", 9, &contact),
+        ("kinetic_stress", 9, &kinetic),
+    ];
+    if let Some(t) = &fields.temperature {
+        arrays.push(("temperature", 1, t));
+    }
+    image.write(&vti, &arrays)?;
     let csv = dir.join(format!("{name}.csv"));
     crate::io::files::write_atomically(&csv, |w| {
         use std::io::Write;
-        writeln!(w, "{}", Fields::header())?;
+        writeln!(w, "{}", fields.header())?;
         let mut buf = ryu::Buffer::new();
         for k in 0..n {
             let values = fields.row(k);

@@ -26,6 +26,8 @@ pub enum ColorBy {
     Material,
     /// Each clump in a colour of its own (drawn from ten by its id), plain spheres grey.
     Clump,
+    /// The temperature (frames of a run with heat transfer: the `T` column).
+    Temperature,
 }
 
 /// Where the camera looks from.
@@ -69,6 +71,7 @@ impl ColorBy {
             ColorBy::Tag => "tag",
             ColorBy::Material => "material",
             ColorBy::Clump => "grain",
+            ColorBy::Temperature => "temperature [K]",
         }
     }
 
@@ -105,6 +108,7 @@ impl ColorBy {
             ColorBy::Speed => p.v.iter().map(|v| v.length()).collect(),
             ColorBy::Height => p.x.iter().map(|x| x.z).collect(),
             ColorBy::Radius => p.radius.clone(),
+            ColorBy::Temperature => p.temperature.clone(),
             ColorBy::Tag => p.tag.iter().map(|&t| t as f64).collect(),
             ColorBy::Material => p.material.iter().map(|&m| m as f64).collect(),
             ColorBy::Clump => (p.body.iter())
@@ -427,6 +431,12 @@ pub fn render_path(
     let mut layout = Layout::empty();
     for f in &frames {
         let p = source.particles_of(f)?;
+        if style.color == ColorBy::Temperature && !p.active.temperature {
+            bail!(
+                "{}: no temperatures (a T column) to colour by: the run had no heat transfer",
+                f.display()
+            );
+        }
         let t = source.time_of(f);
         layout.include(&p, &source.mesh_of(f, t), style);
     }
