@@ -5,7 +5,7 @@ the renderer. Needs the Python package
 (`python3 -m pip install ./python`), the built binary (`cargo build --release`, for
 `analyze --plot`) and, for the pictures of two panels, ffmpeg (its hstack filter).
 
-    python3 docs/pictures.py [--reuse] [NAME ...]   # all, or some of: hourglass b c d e f g h j
+    python3 docs/pictures.py [--reuse] [NAME ...]   # all, or some of: hourglass b c d e f g h j k
 
 (--reuse: draw from the runs already in /tmp/tinydem-pictures.)
 
@@ -207,8 +207,21 @@ def i():
                    env={**os.environ, "TINYDEM_BIN": str(BINARY)})
 
 
+def k():
+    """The drum dryer: its study runs three speeds and draws the heating curves and the
+    coefficient; the bed at 3 rad/s at the end, coloured by temperature."""
+    out = WORK / "k"
+    if not (REUSE and (out / "study.csv").is_file()):
+        subprocess.run([sys.executable, str(EXAMPLES / "k_drum_dryer" / "study.py"), "--out", str(out),
+                        "--plots", str(DOCS)], check=True, env={**os.environ, "TINYDEM_BIN": str(BINARY)})
+    run3 = out / "drum_3.0"
+    last = int(tinydem.read_output(run3).numbers[-1])
+    picture(frame(run3, last), DOCS / "k_drum_dryer.png", color="temperature", view="front",
+            width=480, height=480, scenario=run3 / "run.toml", scale_bar=True)
+
+
 ALL = {"hourglass": hourglass, "b": b, "c": c, "d": d, "e": e, "f": f, "g": g, "h": h, "i": i,
-       "j": j}
+       "j": j, "k": k}
 
 if __name__ == "__main__":
     for name in [a for a in sys.argv[1:] if a != "--reuse"] or ALL:
