@@ -397,3 +397,56 @@ fn temperatures_are_rendered_and_coarse_grained_into_a_field() {
         "{err}"
     );
 }
+
+/// One free grain (no contacts) of radius 3 mm, glass-like, at 400 K, with the material
+/// keys `extra` and the `[kinetics]` keys `kinetics`.
+fn alone(extra: &str, kinetics: &str) -> (Simulation, f64) {
+    let text = format!(
+        "[geometry]\nradius_min = 0.003\nradius_max = 0.003\n\
+         [material]\ndensity = 2500.0\nheat_capacity = 800.0\n{extra}\n\
+         [kinetics]\ngravity = [0.0, 0.0, 0.0]\n{kinetics}\n\
+         [simulation]\ntimestep = 1e-5\nthermal_time_scale = 1e4\nmax_particles = 0\n"
+    );
+    let grain = Particle {
+        temperature: 400.0,
+        ..common::sphere(0.003, DVec3::ZERO, DVec3::ZERO, DVec3::ZERO)
+    };
+    (simulation(&text, vec![grain]), mc(0.003, 2500.0, 800.0))
+}
+
+#[test]
+fn a_grain_cools_to_its_surroundings_and_warms_by_its_source_at_the_rates_they_give() {
+    let (r, dt, steps) = (0.003, 0.1, 2000);
+    let area = 4.0 * PI * r * r;
+    // Newton's cooling: T - T_inf falls as exp(-h A t / (m c)).
+    let (mut sim, c) = alone(
+        "surface_heat_transfer = 20.0",
+        "ambient_temperature = 300.0",
+    );
+    for _ in 0..steps {
+        sim.step().unwrap();
+    }
+    let rate = 20.0 * area / c;
+    let expected = 300.0 + 100.0 * (-rate * steps as f64 * dt).exp();
+    let t = sim.particles.temperature[0];
+    assert!(
+        (t - 300.0) / (expected - 300.0) - 1.0 < 0.005,
+        "{t} K against {expected} K"
+    );
+    assert!(
+        (t - 300.0) / (expected - 300.0) - 1.0 > -0.005,
+        "{t} K against {expected} K"
+    );
+    // A source q_V warms it by q_V V t / (m c).
+    let (mut sim, c) = alone("heat_source = 1e4", "");
+    for _ in 0..steps {
+        sim.step().unwrap();
+    }
+    let volume = 4.0 / 3.0 * PI * r.powi(3);
+    let expected = 400.0 + 1e4 * volume * steps as f64 * dt / c;
+    let t = sim.particles.temperature[0];
+    assert!(
+        (t - expected).abs() < 1e-9 * expected,
+        "{t} K against {expected} K"
+    );
+}

@@ -41,11 +41,14 @@ pub(super) fn run(
 ) -> (Vec<i128>, bool) {
     take_new_temperatures(heat, p);
     let p_ = &*p;
-    let mut gain: Vec<i128> = (0..p_.len())
-        .into_par_iter()
-        .with_min_len(MIN_PARALLEL_LEN)
-        .map(|i| heat.own_gain(p_.material[i], p_.radius[i], p_.temperature[i]))
-        .collect();
+    let mut gain: Vec<i128> = match heat.own_gains() {
+        true => (0..p_.len())
+            .into_par_iter()
+            .with_min_len(MIN_PARALLEL_LEN)
+            .map(|i| heat.own_gain(p_.material[i], p_.radius[i], p_.temperature[i]))
+            .collect(),
+        false => vec![0; p_.len()],
+    };
     between_pairs(heat, p_, lists, &mut gain);
     let into_walls = match wall_heat.any() {
         true => from_walls(heat, (walls, wall_heat), &lists.faces, owned, p_, &mut gain),
@@ -90,8 +93,9 @@ fn advance(heat: &HeatModel, p: &mut Particles, gain: &[i128]) -> bool {
         .into_par_iter()
         .with_min_len(MIN_PARALLEL_LEN)
         .map(|(e, t, &r, &m, &q)| {
+            // (A particle that gains nothing keeps its temperature to the bit, as set.)
             let mc = heat.capacity(m, r);
-            if mc > 0.0 {
+            if mc > 0.0 && q != 0 {
                 *e = e.saturating_add(q);
                 *t = heat.temperature(mc, *e);
             }

@@ -325,13 +325,15 @@ impl Spawner {
                 faces,
                 face_grid,
             );
-            let material = &s.materials[r.material as usize].properties;
-            warm(
-                particles,
-                from,
-                r.temperature
-                    .unwrap_or(material.thermal.initial_temperature),
-            );
+            // (A clump's spheres are of its template's material.)
+            let material = r
+                .clump
+                .map_or(r.material, |c| s.clumps[c.template as usize].material);
+            let t0 = s.materials[material as usize]
+                .properties
+                .thermal
+                .initial_temperature;
+            warm(particles, from, r.temperature.unwrap_or(t0));
             self.regions[k] = RegionState {
                 inserted: state.inserted + n,
                 pending_radius: pending,

@@ -128,7 +128,7 @@ impl HeatModel {
     /// The content (in quanta) of heat capacity `mc` at temperature `t`.
     #[inline]
     pub fn content(&self, mc: f64, t: f64) -> i128 {
-        (mc * t / self.quantum).round() as i128
+        (mc * t * (1.0 / self.quantum)).round_ties_even() as i128
     }
 
     /// The temperature of content `e` (in quanta) at heat capacity `mc`.
@@ -137,10 +137,26 @@ impl HeatModel {
         e as f64 * self.quantum / mc
     }
 
-    /// The quanta of heat `joules`, rounded to the nearest.
+    /// The quanta of heat `joules`, rounded to the nearest (ties to even: the quanta of
+    /// `-joules` are minus those of `joules`, so a contact moves as much out of one partner
+    /// as into the other).
     #[inline]
     pub fn quanta(&self, joules: f64) -> i128 {
-        (joules / self.quantum).round() as i128
+        // Exact: the quantum is a power of two. Below 2^62 the hardware's conversion to 64
+        // bits; a contact's heat of a step nearly always is.
+        let x = (joules * (1.0 / self.quantum)).round_ties_even();
+        if x.abs() < 4.6e18 {
+            x as i64 as i128
+        } else {
+            x as i128
+        }
+    }
+
+    /// Whether any material makes heat or exchanges it with the surroundings (else a
+    /// particle gains heat through its contacts only).
+    pub fn own_gains(&self) -> bool {
+        let exchange = self.ambient.is_some();
+        (self.materials.iter()).any(|t| t.source != 0.0 || (exchange && t.surface_transfer > 0.0))
     }
 
     /// The heat of one thermal step through conductance `h` from temperature `from` to

@@ -211,12 +211,44 @@ pub fn default_steps(n: usize) -> u64 {
     (10_000_000 / n as u64).clamp(100, 5000)
 }
 
-/// Runs the benchmark for `n` particles (grains: clumps of `clumps` spheres each, if given)
-/// on the current thread pool, split over the
+/// The benchmark with heat transfer: the grains conduct (glass-like, k = 1 W/(m K), c = 800
+/// J/(kg K)) and start with temperatures from 300 K at the floor to 400 K at the box's top,
+/// so that heat flows through every contact.
+pub fn heated(mut sim: Simulation) -> Result<Simulation> {
+    let text = sim.scenario.to_toml().replace(
+        "viscosity = 0",
+        "thermal_conductivity = 1.0\nheat_capacity = 800.0\ninitial_temperature = 300.0\nviscosity = 0",
+    );
+    let scenario = Scenario::parse(&text, Path::new("bench"))?;
+    anyhow::ensure!(
+        scenario.heat(),
+        "the benchmark's material did not take the heat keys"
+    );
+    let top = sim
+        .walls
+        .mesh
+        .faces
+        .iter()
+        .flat_map(|f| f.corners())
+        .fold(0.0, |z, c| c.z.max(z));
+    let mut p = std::mem::take(&mut sim.particles);
+    p.activate("T");
+    for (t, x) in p.temperature.iter_mut().zip(&p.x) {
+        *t = 300.0 + 100.0 * (x.z / top).clamp(0.0, 1.0);
+    }
+    let mesh = Mesh {
+        faces: sim.walls.mesh.faces.clone(),
+        ..Mesh::default()
+    };
+    Simulation::from_parts(scenario, mesh, p)
+}
+
+/// Runs the benchmark for `n` particles (grains: clumps of `clumps` spheres each, if given;
+/// conducting heat, if `heat`) on the current thread pool, split over the
 /// processes of `world` if given: a warm-up, then `repeats` timed segments of `steps`
 /// steps.
 pub fn measure(
-    (n, clumps): (usize, Option<usize>),
+    (n, clumps, heat): (usize, Option<usize>, bool),
     steps: u64,
     repeats: usize,
     world: Option<Box<dyn crate::parallel::comm::Comm>>,
@@ -226,6 +258,9 @@ pub fn measure(
         None => setup(n)?,
         Some(k) => setup_clumps(n, k)?,
     };
+    if heat {
+        sim = heated(sim)?;
+    }
     let ranks = world.as_ref().map_or(1, |w| w.size());
     if let Some(world) = world.filter(|w| w.size() > 1) {
         sim = sim.split(world)?;

@@ -32,6 +32,10 @@ pub struct BenchArgs {
     /// per body-step of clumps.
     #[arg(long)]
     clumps: Option<usize>,
+    /// With heat transfer: the grains conduct, from 300 K at the floor to 400 K at the top
+    /// (to measure what heat costs).
+    #[arg(long)]
+    heat: bool,
     /// Run one configuration in this process (used by the benchmark itself).
     #[arg(long, hide = true)]
     pub single: bool,
@@ -50,7 +54,8 @@ impl BenchArgs {
             let steps = self
                 .steps
                 .unwrap_or(tinydem::tools::bench::default_steps(n));
-            let m = tinydem::tools::bench::measure((n, self.clumps), steps, self.repeats, world)?;
+            let config = (n, self.clumps, self.heat);
+            let m = tinydem::tools::bench::measure(config, steps, self.repeats, world)?;
             if first {
                 println!("{}", m.row());
             }
@@ -96,6 +101,9 @@ impl BenchArgs {
                 }
                 if let Some(k) = self.clumps {
                     cmd.args(["--clumps", &k.to_string()]);
+                }
+                if self.heat {
+                    cmd.arg("--heat");
                 }
                 let out = cmd.output().context("cannot run the benchmark process")?;
                 if !out.status.success() {
