@@ -304,6 +304,9 @@ fn verify_runs_the_analytic_cases_and_writes_its_report() {
         "chung_ooi_2",
         "slip_to_rolling",
         "stacked_spheres",
+        "heat_relaxation",
+        "heat_chain",
+        "heat_sources",
     ] {
         assert!(out.contains(case), "missing {case} in\n{out}");
     }
