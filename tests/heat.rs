@@ -339,6 +339,7 @@ fn temperatures_are_rendered_and_coarse_grained_into_a_field() {
     std::fs::write(t.path().join("bed.toml"), text).unwrap();
     let o = common::tinydem(&["run", "bed.toml", "--output", "out"], t.path());
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    log_matches_the_frame(&t.path().join("out"), 2);
     let o = common::tinydem(
         &[
             "render",
@@ -449,4 +450,52 @@ fn a_grain_cools_to_its_surroundings_and_warms_by_its_source_at_the_rates_they_g
         (t - expected).abs() < 1e-9 * expected,
         "{t} K against {expected} K"
     );
+}
+
+/// The columns of a CSV text by name, each a column of numbers.
+fn columns(text: &str) -> std::collections::HashMap<String, Vec<f64>> {
+    let mut lines = text.lines();
+    let names: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+    let mut out: std::collections::HashMap<String, Vec<f64>> =
+        names.iter().map(|n| (n.clone(), Vec::new())).collect();
+    for line in lines {
+        for (name, v) in names.iter().zip(line.split(',')) {
+            out.get_mut(name)
+                .unwrap()
+                .push(v.parse().unwrap_or(f64::NAN));
+        }
+    }
+    out
+}
+
+/// `log.csv`'s temperatures and heat content at frame `k` of the bed (`BED`'s material) are
+/// those counted from the frame's `T` and `R` columns.
+fn log_matches_the_frame(out: &std::path::Path, k: usize) {
+    let log = columns(&std::fs::read_to_string(out.join("log.csv")).unwrap());
+    let frame =
+        columns(&std::fs::read_to_string(out.join(format!("particles{k:06}.csv"))).unwrap());
+    let (t, r) = (&frame["T"], &frame["R"]);
+    let mean = t.iter().sum::<f64>() / t.len() as f64;
+    let content: f64 = t
+        .iter()
+        .zip(r)
+        .map(|(t, r)| mc(*r, 2500.0, 800.0) * t)
+        .sum();
+    let (min, max) = (
+        t.iter().copied().fold(f64::INFINITY, f64::min),
+        t.iter().copied().fold(0.0, f64::max),
+    );
+    let at = |name: &str| log[name][k];
+    assert!(
+        (at("T_mean") - mean).abs() < 1e-9 * mean,
+        "{} against {mean}",
+        at("T_mean")
+    );
+    assert_eq!((at("T_min"), at("T_max")), (min, max));
+    assert!(
+        (at("heat_content") - content).abs() < 1e-9 * content,
+        "{} against {content}",
+        at("heat_content")
+    );
+    assert!(min < max, "heat flowed: {min} .. {max}");
 }
