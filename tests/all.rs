@@ -9,6 +9,7 @@ mod book;
 mod cli;
 mod clumps;
 mod cohesion;
+mod contact_models;
 mod decomposition;
 mod domain;
 mod examples;

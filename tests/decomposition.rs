@@ -760,3 +760,28 @@ fn clumps_in_a_sheared_periodic_box_split_over_processes_give_the_bits_of_one() 
         );
     }
 }
+
+#[test]
+fn the_contact_models_split_over_processes_give_the_bits_of_one_process() {
+    let steps = 1500;
+    for models in [
+        "hooke_stiffness = 300.0\ntangential_coulomb = \"spring\"\nrolling_model = \"cdt\"\n",
+        "rolling_model = \"epsd2\"\n",
+    ] {
+        let text = silo(0.5).replace(
+            "friction_twisting = 0.1\n",
+            &format!("friction_twisting = 0.1\n{models}"),
+        );
+        assert!(text.contains(models));
+        let mut single = common::simulate(&text, steps);
+        let reference = end_of(&mut single);
+        for k in [2, 3] {
+            let text = text.clone();
+            let (end, _) = split_run(move || common::scenario(&text), steps, k);
+            assert!(
+                end == reference,
+                "{models} on {k} processes differs from one"
+            );
+        }
+    }
+}

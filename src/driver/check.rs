@@ -17,6 +17,8 @@ use crate::model::contact::{ContactLaw, damping_factor};
 use crate::model::integrate::Inertia;
 use crate::scenario::{FrictionSprings, MassSource, MeshInput, Scenario, Target};
 
+use super::materials::{material_lines, model_lines};
+
 /// The derived quantities `tinydem check` prints.
 pub fn describe(s: &Scenario, out: &Path) -> Result<String> {
     if let Some(why) = s.spawn_box_outside() {
@@ -55,8 +57,9 @@ fn describe_start(s: &Scenario, out: &Path, sim: Simulation) -> Result<String> {
          {materials}\
          {bounds}\
          initial particles      {}\n\
-         time step              {dt:.6e} s ({:.3} x Eq. 50)\n\
+         time step              {dt:.6e} s ({:.3} x {})\n\
          friction springs       {}\n\
+         {}\
          particle mass          {m_min:.6e} .. {m_max:.6e} kg\n\
          stiffness k_n at 10%   {k_10:.6e} N/m (two R_min particles, delta = 0.1 R_min)\n\
          half contact period    {period:.6e} s = {:.1} time steps\n\
@@ -67,11 +70,13 @@ fn describe_start(s: &Scenario, out: &Path, sim: Simulation) -> Result<String> {
          {}",
         sim.particles.len(),
         dt / default_dt,
+        s.timestep_rule(),
         match s.simulation.friction_springs {
             FrictionSprings::AdvanceFirst => "advance_first (advanced, then their force taken)",
             FrictionSprings::Paper =>
                 "paper (the force of the previous step's spring, Eqs. 53-55; the original program's)",
         },
+        model_lines(s, m_min),
         period / dt,
         s.total_time(),
         s.simulation.frames,
@@ -359,81 +364,6 @@ fn clump_lines(s: &Scenario) -> String {
     lines
 }
 
-/// The materials and the coefficients of each pair of them (where named).
-fn material_lines(s: &Scenario) -> String {
-    let mut materials = String::new();
-    if s.materials.len() > 1 || s.materials[0].name != "default" {
-        for (k, m) in s.materials.iter().enumerate() {
-            let p = &m.properties;
-            materials += &format!(
-                "{:<23}{k} \"{}\": density {}, E {:e}, nu {}, e_n {}, mu_s {}, mu_r {}, mu_t {}{}\n",
-                if k == 0 { "materials" } else { "" },
-                m.name,
-                num(p.density),
-                p.youngs_modulus,
-                num(p.poisson_ratio),
-                num(p.restitution),
-                num(p.friction_sliding),
-                num(p.friction_rolling),
-                num(p.friction_twisting),
-                if p.cohesion > 0.0 {
-                    format!(", cohesion {} J/m^3", num(p.cohesion))
-                } else {
-                    String::new()
-                }
-            );
-        }
-        let n = s.materials.len() as u16;
-        let mut first = true;
-        for a in 0..n {
-            for b in a..n {
-                let c = s.pair(a, b);
-                let how = pair_origin(s, a, b);
-                materials += &format!(
-                    "{:<23}{} - {}: e_n {}, mu_s {}, mu_r {}, mu_t {}, k_c {} ({how})\n",
-                    if first { "pairs" } else { "" },
-                    s.materials[a as usize].name,
-                    s.materials[b as usize].name,
-                    num(c.restitution),
-                    num(c.friction_sliding),
-                    num(c.friction_rolling),
-                    num(c.friction_twisting),
-                    num(c.cohesion)
-                );
-                first = false;
-            }
-        }
-    }
-    materials
-}
-
-/// Where the coefficients of the pair of materials `a`, `b` come from: its own material's,
-/// the means of the two, or (some of them, and the sub-models it names) `[[interactions]]`.
-fn pair_origin(s: &Scenario, a: u16, b: u16) -> String {
-    let interaction = (s.interactions.iter()).find(|i| i.materials == (a.min(b), a.max(b)));
-    let Some(i) = interaction else {
-        return if a == b {
-            "its own"
-        } else {
-            "means of the two"
-        }
-        .to_string();
-    };
-    let coefficients = i.coefficients();
-    let given: Vec<&str> = (coefficients.iter().filter(|c| c.2.is_some()).map(|c| c.1))
-        .chain(i.models.named().into_iter().map(|(key, _)| key))
-        .collect();
-    if coefficients.iter().all(|c| c.2.is_some()) {
-        "[[interactions]]".to_string()
-    } else {
-        let rest = if a == b { "its own" } else { "means" };
-        format!(
-            "{} from [[interactions]], the rest {rest}",
-            given.join(", ")
-        )
-    }
-}
-
 /// What `tinydem check SCENARIO --from CHECKPOINT` prints: the scenario's derived
 /// quantities, then what it changes as a stage after the checkpoint's run and what it
 /// carries over.
@@ -466,7 +396,7 @@ pub fn describe_stage(s: &Scenario, from: &Path, dir: &Path) -> Result<String> {
 }
 
 /// A coefficient for people: at most 10 significant digits, no trailing zeros.
-fn num(x: f64) -> String {
+pub(super) fn num(x: f64) -> String {
     let s = format!("{:.10e}", x);
     let (mantissa, exp) = s.split_once('e').unwrap_or((&s, "0"));
     let value: f64 = format!("{mantissa}e{exp}").parse().unwrap_or(x);
@@ -585,10 +515,11 @@ pub fn timestep_refusal(s: &Scenario) -> Option<String> {
     let (dt, eq50) = (s.simulation.timestep, s.eq50_timestep());
     (dt > TIMESTEP_TOLERANCE * eq50).then(|| {
         format!(
-            "time step {dt:.3e} s is {:.1} x Eq. 50's {eq50:.3e} s, more than the {TIMESTEP_TOLERANCE} x \
+            "time step {dt:.3e} s is {:.1} x {}'s {eq50:.3e} s, more than the {TIMESTEP_TOLERANCE} x \
              a contact tolerates: the run is likely to blow up (leave [simulation] timestep unset, \
              or set it at most {:.3e} s)",
             dt / eq50,
+            s.timestep_rule(),
             TIMESTEP_TOLERANCE * eq50
         )
     })

@@ -171,16 +171,16 @@ impl Simulation {
     pub fn advice(&self) -> String {
         let s = &self.scenario;
         let dt = s.simulation.timestep;
-        let eq50 = s.eq50_timestep();
+        let (eq50, rule) = (s.eq50_timestep(), s.timestep_rule());
         if dt > eq50 {
             format!(
-                "timestep {dt:.3e} s exceeds Eq. 50's {eq50:.3e} s for this stiffness and density \
+                "timestep {dt:.3e} s exceeds {rule}'s {eq50:.3e} s for this stiffness and density \
                  ({:.1} x): try timestep <= {eq50:.3e} s (or leave it unset)",
                 dt / eq50
             )
         } else {
             format!(
-                "timestep {dt:.3e} s is within Eq. 50's {eq50:.3e} s: check for particles \
+                "timestep {dt:.3e} s is within {rule}'s {eq50:.3e} s: check for particles \
                  created overlapping each other or the mesh, radii below radius_min, very \
                  high impact speeds or strong friction (try a smaller timestep, e.g. {:.3e} s)",
                 dt / 5.0

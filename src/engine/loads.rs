@@ -44,7 +44,7 @@ impl LoadScales {
     }
 
     /// Room above the largest force of a contact, E* R_max^2 (Hertz at an overlap of R_max,
-    /// or the cohesion k_c pi R_max^2): 2^12, which also holds particles up to 64 R_max.
+    /// Hooke's k_n R_max, or the cohesion k_c pi R_max^2): 2^12, which also holds particles up to 64 R_max.
     const ROOM: f64 = 4096.0;
 
     /// The scales of a scenario: from its parameters only (not from the particles of the
@@ -56,9 +56,12 @@ impl LoadScales {
             let m = &m.properties;
             let e_star = m.youngs_modulus / (1.0 - m.poisson_ratio * m.poisson_ratio);
             stiffest = stiffest.max(e_star).max(std::f64::consts::PI * m.cohesion);
+            // Hooke: k_n R_max at an overlap of R_max.
+            stiffest = stiffest.max(m.hooke_stiffness / r_max);
         }
         for i in &s.interactions {
             stiffest = stiffest.max(std::f64::consts::PI * i.cohesion.unwrap_or(0.0));
+            stiffest = stiffest.max(i.hooke_stiffness.unwrap_or(0.0) / r_max);
         }
         let largest = (LoadScales::ROOM * stiffest * r_max * r_max).max(f64::MIN_POSITIVE);
         let (force, torque) = (

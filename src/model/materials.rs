@@ -25,6 +25,10 @@ pub struct Material {
     /// k_c [M/LT²] = [J/m³]: the simplified JKR cohesion, a pull k_c A over the contact
     /// area A.
     pub cohesion: f64,
+    /// k_n [M/T²] of Hooke's normal sub-model (`normal_model = "hooke"`; 0 otherwise).
+    pub hooke_stiffness: f64,
+    /// k_s / k_n of Hooke's normal sub-model (2/7 by default).
+    pub hooke_stiffness_ratio: f64,
     /// The contact law's sub-models for this material's contacts.
     pub models: ContactModels,
     /// k, c, T_0, q_V, h: heat transfer (conducts where k > 0).
@@ -61,6 +65,9 @@ pub struct PairCoefficients {
     pub friction_rolling: f64,
     pub friction_twisting: f64,
     pub cohesion: f64,
+    /// Hooke's k_n and k_s / k_n (`normal_model = "hooke"`).
+    pub hooke_stiffness: f64,
+    pub hooke_stiffness_ratio: f64,
     pub models: ContactModels,
     /// Whether `[[interactions]]` set any of them (otherwise the means).
     pub given: bool,

@@ -55,6 +55,7 @@ registry! {
     /// The normal sub-model: the elastic stiffnesses (`contact/normal.rs`).
     NormalModel "normal_model" {
         Hertz = "hertz": "Hertz-Mindlin, the paper's Eqs. 12-14",
+        Hooke = "hooke": "the linear spring-dashpot, k_n = hooke_stiffness",
     }
 }
 
@@ -70,6 +71,8 @@ registry! {
     /// The rolling sub-model (`contact/rolling.rs`).
     RollingModel "rolling_model" {
         Spring = "spring": "the paper's rolling spring, Eqs. 34, 39",
+        Cdt = "cdt": "a constant torque against the rolling, Ai et al. 2011's model A",
+        Epsd2 = "epsd2": "an elastic-plastic spring torque, Ai et al. 2011's model C without its damper",
     }
 }
 
@@ -77,6 +80,7 @@ registry! {
     /// What the tangential Coulomb limit clips (`contact/friction.rs`).
     TangentialCoulomb "tangential_coulomb" {
         Total = "total": "the spring and damper force together, the paper's Eq. 55",
+        Spring = "spring": "the spring force alone, no damper while sliding, as LIGGGHTS and LAMMPS",
     }
 }
 

@@ -49,7 +49,7 @@ pub use crate::geometry::shapes::Shape;
 pub use crate::model::heat::{Conduction, Thermal};
 pub use crate::model::materials::{FrictionSprings, Material, PairCoefficients};
 use crate::model::motion::Motion;
-use crate::model::registry::AdhesionModel;
+use crate::model::registry::{AdhesionModel, NormalModel};
 pub use crate::model::servo::{Servo, Target};
 
 mod clumps;
@@ -187,19 +187,28 @@ pub struct Interaction {
     pub friction_rolling: Option<f64>,
     pub friction_twisting: Option<f64>,
     pub cohesion: Option<f64>,
+    /// Hooke's k_n and k_s / k_n for the pair.
+    pub hooke_stiffness: Option<f64>,
+    pub hooke_stiffness_ratio: Option<f64>,
     /// The sub-models it names.
     pub models: GivenModels,
 }
 
 impl Interaction {
     /// Each coefficient with its key and symbol (given or not), in the order of the file.
-    pub fn coefficients(&self) -> [(&'static str, &'static str, Option<f64>); 5] {
+    pub fn coefficients(&self) -> [(&'static str, &'static str, Option<f64>); 7] {
         [
             ("restitution", "e_n", self.restitution),
             ("friction_sliding", "mu_s", self.friction_sliding),
             ("friction_rolling", "mu_r", self.friction_rolling),
             ("friction_twisting", "mu_t", self.friction_twisting),
             ("cohesion", "k_c", self.cohesion),
+            ("hooke_stiffness", "k_n", self.hooke_stiffness),
+            (
+                "hooke_stiffness_ratio",
+                "k_s/k_n",
+                self.hooke_stiffness_ratio,
+            ),
         ]
     }
 }
@@ -449,10 +458,30 @@ pub struct Scenario {
 /// (SIGKILL, a lost node) loses at most this much wall time.
 pub const DEFAULT_CHECKPOINT_MINUTES: f64 = 10.0;
 
-/// Default time step, Eq. (50): Δt = R_min sqrt(ρ (1 - ν²) / E).
+/// Default time step of a material: Eq. (50), Δt = R_min sqrt(ρ (1 - ν²) / E); with Hooke's
+/// normal model t_c / [`HOOKE_STEPS`], t_c = π sqrt(m* / k_n) the undamped contact time of
+/// two grains of R_min (m* = m / 2), which no impact speed shortens.
 pub fn default_timestep(radius_min: f64, material: &Material) -> f64 {
-    let nu = material.poisson_ratio;
-    radius_min * (material.density * (1.0 - nu * nu) / material.youngs_modulus).sqrt()
+    match material.models.normal {
+        NormalModel::Hertz => {
+            let nu = material.poisson_ratio;
+            radius_min * (material.density * (1.0 - nu * nu) / material.youngs_modulus).sqrt()
+        }
+        NormalModel::Hooke => {
+            let m = material.density * 4.0 / 3.0 * std::f64::consts::PI * radius_min.powi(3);
+            hooke_contact_time(0.5 * m, material.hooke_stiffness) / HOOKE_STEPS
+        }
+    }
+}
+
+/// Steps per undamped Hooke contact of the default time step: at 20 a damped impact's
+/// restitution is within 1 % (symplectic Euler), and twice the step (10 per contact, where
+/// `run` refuses) is still far from the bound of stability (ω Δt = 2, 1.6 steps).
+pub const HOOKE_STEPS: f64 = 20.0;
+
+/// The undamped contact time of a Hooke contact of effective mass `m_star`, π sqrt(m* / k_n).
+pub fn hooke_contact_time(m_star: f64, k_n: f64) -> f64 {
+    std::f64::consts::PI * (m_star / k_n).sqrt()
 }
 
 impl Default for Scenario {
@@ -481,7 +510,21 @@ impl Scenario {
         spawn::box_outside(&self.geometry, &self.simulation, self.domain)
     }
 
-    /// The time step of Eq. (50) for the stiffest, lightest of the materials.
+    /// The rule of the default time step: Eq. 50 (Hertz), Hooke's t_c / 20, or both.
+    pub fn timestep_rule(&self) -> &'static str {
+        let hooke = |m: &MaterialSpec| m.properties.models.normal == NormalModel::Hooke;
+        match (
+            self.materials.iter().any(hooke),
+            self.materials.iter().all(hooke),
+        ) {
+            (false, _) => "Eq. 50",
+            (true, true) => "Hooke's t_c/20",
+            (true, false) => "Eq. 50 and Hooke's t_c/20",
+        }
+    }
+
+    /// The default time step: Eq. (50)'s (or Hooke's t_c / 20) for the stiffest, lightest
+    /// of the materials ([`default_timestep`]).
     pub fn eq50_timestep(&self) -> f64 {
         self.materials
             .iter()
@@ -535,6 +578,11 @@ impl Scenario {
                 AdhesionModel::None => 0.0,
                 AdhesionModel::Sjkr => cohesion,
             },
+            hooke_stiffness: given
+                .and_then(|i| i.hooke_stiffness)
+                .unwrap_or_else(|| models::mean_of_hooke([m, n], |m| m.hooke_stiffness)),
+            hooke_stiffness_ratio: (given.and_then(|i| i.hooke_stiffness_ratio))
+                .unwrap_or_else(|| models::mean_of_hooke([m, n], |m| m.hooke_stiffness_ratio)),
             models,
             given: given.is_some(),
         }

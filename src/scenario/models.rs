@@ -4,6 +4,9 @@
 
 use anyhow::{Result, anyhow, bail};
 
+use super::Scenario;
+use super::validate::Range;
+use crate::model::materials::Material;
 use crate::model::registry::{
     AdhesionModel, ContactModels, Named, NormalModel, RollingModel, TangentialCoulomb,
 };
@@ -84,12 +87,153 @@ impl GivenModels {
     }
 }
 
+/// Hooke's k_s / k_n unless given: 2/7, at which a sphere's tangential oscillation on a
+/// plane has the period of its normal one (LIGGGHTS's `ktToKnUser`, LAMMPS's examples).
+pub const HOOKE_RATIO: f64 = 2.0 / 7.0;
+
+/// Hooke's keys of a table, `hooke_stiffness` (k_n) and `hooke_stiffness_ratio` (k_s / k_n).
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Hooke {
+    pub stiffness: Option<f64>,
+    pub ratio: Option<f64>,
+}
+
+impl Hooke {
+    /// The keys of table `table`, checked.
+    pub(super) fn read(table: &str, [stiffness, ratio]: [Option<f64>; 2]) -> Result<Hooke> {
+        let positive = |key: &str, x: Option<f64>| {
+            x.map(|x| super::validate::check(&format!("{table} {key}"), x, Range::Positive))
+                .transpose()
+        };
+        Ok(Hooke {
+            stiffness: positive("hooke_stiffness", stiffness)?,
+            ratio: positive("hooke_stiffness_ratio", ratio)?,
+        })
+    }
+
+    /// The normal sub-model of a table that names `normal` (or not) with these keys: a
+    /// stiffness alone chooses Hooke; Hooke named needs it (in a material; an interaction
+    /// may take the mean of its materials'), and Hertz takes neither key.
+    pub(super) fn choose(self, table: &str, normal: &mut Option<NormalModel>) -> Result<()> {
+        match *normal {
+            None if self.stiffness.is_some() => *normal = Some(NormalModel::Hooke),
+            Some(NormalModel::Hertz) if self.stiffness.is_some() || self.ratio.is_some() => bail!(
+                "{table} normal_model = \"hertz\" takes no hooke_stiffness or \
+                 hooke_stiffness_ratio: drop them, or choose normal_model = \"hooke\""
+            ),
+            None if self.ratio.is_some() => bail!(
+                "{table} hooke_stiffness_ratio needs Hooke's normal model: give hooke_stiffness \
+                 (k_n, N/m) too"
+            ),
+            Some(NormalModel::Hooke)
+                if self.stiffness.is_none() && table.starts_with("[material") =>
+            {
+                bail!(
+                    "{table} normal_model = \"hooke\" needs hooke_stiffness, the normal \
+                     stiffness k_n in N/m"
+                )
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+}
+
+/// The mean of `f` over those of `materials` with Hooke's normal sub-model (of both if
+/// neither has it): a pair's Hooke coefficients unless `[[interactions]]` gives them.
+pub fn mean_of_hooke(materials: [&Material; 2], f: impl Fn(&Material) -> f64) -> f64 {
+    let hooke: Vec<f64> = (materials.iter())
+        .filter(|m| m.models.normal == NormalModel::Hooke)
+        .map(|m| f(m))
+        .collect();
+    match hooke[..] {
+        [x] => x,
+        [x, y] => 0.5 * (x + y),
+        _ => 0.5 * (f(materials[0]) + f(materials[1])),
+    }
+}
+
+impl Scenario {
+    /// What must hold between the pairs of materials: one normal sub-model per pair (an
+    /// `[[interactions]]` entry names it for two materials that differ), a Hooke stiffness
+    /// for each Hooke pair, and one rolling sub-model and one tangential Coulomb test in the
+    /// whole run.
+    pub(super) fn consistent_models(&self) -> Result<()> {
+        let n = self.materials.len() as u16;
+        let name = |a: u16| &self.materials[a as usize].name;
+        let (mut rolling, mut tangential) = (Vec::new(), Vec::new());
+        for a in 0..n {
+            for b in a..n {
+                let (m, o) = (
+                    &self.materials[a as usize].properties,
+                    &self.materials[b as usize].properties,
+                );
+                let given = (self.interactions.iter()).find(|i| i.materials == (a, b));
+                if m.models.normal != o.models.normal
+                    && given.and_then(|i| i.models.normal).is_none()
+                {
+                    bail!(
+                        "materials \"{}\" (normal_model = \"{}\") and \"{}\" (\"{}\") differ in \
+                         their normal model: name the pair's in [[interactions]] (normal_model, \
+                         and hooke_stiffness for \"hooke\")",
+                        name(a),
+                        m.models.normal.name(),
+                        name(b),
+                        o.models.normal.name()
+                    );
+                }
+                let pair = self.pair(a, b);
+                if pair.models.normal == NormalModel::Hooke && pair.hooke_stiffness <= 0.0 {
+                    bail!(
+                        "the contacts of \"{}\" and \"{}\" follow Hooke without a stiffness: give \
+                         hooke_stiffness in their [[interactions]]",
+                        name(a),
+                        name(b)
+                    );
+                }
+                rolling.push((pair.models.rolling, (a, b)));
+                tangential.push((pair.models.tangential, (a, b)));
+            }
+        }
+        one_per_run(&rolling, &name)?;
+        one_per_run(&tangential, &name)
+    }
+}
+
+/// That every pair of materials has the same sub-model of one slot (the law reads it as a
+/// constant of the run).
+fn one_per_run<'a, M: Named>(
+    pairs: &[(M, (u16, u16))],
+    name: &dyn Fn(u16) -> &'a String,
+) -> Result<()> {
+    let (first, (a, b)) = pairs[0];
+    if let Some((other, (c, d))) = pairs.iter().find(|(m, _)| *m != first) {
+        bail!(
+            "one {} for a whole run: \"{}\"-\"{}\" have \"{}\", \"{}\"-\"{}\" \"{}\" (give \
+             every material, or [[interactions]], the same)",
+            M::KEY,
+            name(a),
+            name(b),
+            first.name(),
+            name(*c),
+            name(*d),
+            other.name()
+        );
+    }
+    Ok(())
+}
+
 /// A material's sub-models that differ from what its keys' defaults give (for `run.toml`,
-/// which names only those, so that a scenario without the keys writes none).
-pub fn beyond_defaults(models: ContactModels, cohesion: f64) -> GivenModels {
-    let default = GivenModels::default()
+/// which names only those, so that a scenario without the keys writes none; Hooke follows
+/// from `hooke_stiffness`).
+pub fn beyond_defaults(m: &Material) -> GivenModels {
+    let (models, cohesion) = (m.models, m.cohesion);
+    let mut default = GivenModels::default()
         .of_material("", cohesion)
         .expect("the defaults agree with any cohesion");
+    if m.hooke_stiffness > 0.0 {
+        default.normal = NormalModel::Hooke;
+    }
     GivenModels {
         normal: (models.normal != default.normal).then_some(models.normal),
         adhesion: (models.adhesion != default.adhesion).then_some(models.adhesion),

@@ -229,6 +229,8 @@ pub(super) struct RawGeometry {
 #[serde(deny_unknown_fields)]
 pub(super) struct RawMaterial {
     pub(super) cohesion: Option<f64>,
+    pub(super) hooke_stiffness: Option<f64>,
+    pub(super) hooke_stiffness_ratio: Option<f64>,
     pub(super) normal_model: Option<String>,
     pub(super) adhesion_model: Option<String>,
     pub(super) rolling_model: Option<String>,
@@ -259,6 +261,8 @@ impl RawMaterial {
             || self.friction_rolling.is_some()
             || self.friction_twisting.is_some()
             || self.cohesion.is_some()
+            || self.hooke_stiffness.is_some()
+            || self.hooke_stiffness_ratio.is_some()
             || self.normal_model.is_some()
             || self.adhesion_model.is_some()
             || self.rolling_model.is_some()
@@ -281,6 +285,8 @@ impl RawMaterial {
 pub(super) struct RawNamedMaterial {
     pub(super) name: String,
     pub(super) cohesion: Option<f64>,
+    pub(super) hooke_stiffness: Option<f64>,
+    pub(super) hooke_stiffness_ratio: Option<f64>,
     pub(super) normal_model: Option<String>,
     pub(super) adhesion_model: Option<String>,
     pub(super) rolling_model: Option<String>,
@@ -311,6 +317,8 @@ impl From<RawNamedMaterial> for RawMaterial {
             friction_twisting: m.friction_twisting,
             viscosity: None,
             cohesion: m.cohesion,
+            hooke_stiffness: m.hooke_stiffness,
+            hooke_stiffness_ratio: m.hooke_stiffness_ratio,
             normal_model: m.normal_model,
             adhesion_model: m.adhesion_model,
             rolling_model: m.rolling_model,
@@ -329,6 +337,8 @@ impl From<RawNamedMaterial> for RawMaterial {
 pub(super) struct RawInteraction {
     pub(super) materials: [String; 2],
     pub(super) cohesion: Option<f64>,
+    pub(super) hooke_stiffness: Option<f64>,
+    pub(super) hooke_stiffness_ratio: Option<f64>,
     pub(super) normal_model: Option<String>,
     pub(super) adhesion_model: Option<String>,
     pub(super) rolling_model: Option<String>,

@@ -71,7 +71,15 @@ impl Scenario {
             ] {
                 let _ = writeln!(o, "{key} = {}", num(x));
             }
-            for (key, name) in models::beyond_defaults(m.models, m.cohesion).named() {
+            if m.models.normal == NormalModel::Hooke {
+                let _ = writeln!(o, "hooke_stiffness = {}", num(m.hooke_stiffness));
+                let _ = writeln!(
+                    o,
+                    "hooke_stiffness_ratio = {}",
+                    num(m.hooke_stiffness_ratio)
+                );
+            }
+            for (key, name) in models::beyond_defaults(m).named() {
                 let _ = writeln!(o, "{key} = {}", text(name));
             }
             let t = &m.thermal;

@@ -7,6 +7,7 @@ use anyhow::{Context, Result, bail};
 use glam::DVec3;
 
 use super::meshes::meshes;
+use super::models::Hooke;
 use super::raw::*;
 use super::spawn::spawn;
 use super::*;
@@ -96,6 +97,9 @@ fn material(table: &str, m: RawMaterial, viscosity: f64) -> Result<Material> {
         m.rolling_model,
         m.tangential_coulomb,
     ];
+    let mut given = GivenModels::read(table, names)?;
+    let hooke = Hooke::read(table, [m.hooke_stiffness, m.hooke_stiffness_ratio])?;
+    hooke.choose(table, &mut given.normal)?;
     let friction_sliding = check(
         &key("friction_sliding"),
         m.friction_sliding.unwrap_or(0.3),
@@ -132,7 +136,9 @@ fn material(table: &str, m: RawMaterial, viscosity: f64) -> Result<Material> {
         )?,
         viscosity,
         cohesion,
-        models: GivenModels::read(table, names)?.of_material(table, cohesion)?,
+        hooke_stiffness: hooke.stiffness.unwrap_or(0.0),
+        hooke_stiffness_ratio: hooke.ratio.unwrap_or(super::models::HOOKE_RATIO),
+        models: given.of_material(table, cohesion)?,
         thermal,
     })
 }
@@ -250,6 +256,7 @@ impl Scenario {
             gather: Gather::parse(raw.output.gather)?,
         };
         scenario.consistent()?;
+        scenario.consistent_models()?;
         Ok(scenario)
     }
 
@@ -430,8 +437,9 @@ fn interactions(
             x.map(|x| check(&key(name), x, r)).transpose()
         };
         let cohesion = opt("cohesion", i.cohesion, Range::NonNegative)?;
-        let models = GivenModels::read(
-            &format!("[[interactions]] #{}", k + 1),
+        let table = format!("[[interactions]] #{}", k + 1);
+        let mut models = GivenModels::read(
+            &table,
             [
                 i.normal_model,
                 i.adhesion_model,
@@ -439,6 +447,8 @@ fn interactions(
                 i.tangential_coulomb,
             ],
         )?;
+        let hooke = Hooke::read(&table, [i.hooke_stiffness, i.hooke_stiffness_ratio])?;
+        hooke.choose(&table, &mut models.normal)?;
         if models.adhesion == Some(AdhesionModel::None) && cohesion.is_some_and(|k_c| k_c > 0.0) {
             bail!(
                 "{} = \"none\" contradicts cohesion: drop one of them",
@@ -452,6 +462,8 @@ fn interactions(
             friction_rolling: opt("friction_rolling", i.friction_rolling, Range::NonNegative)?,
             friction_twisting: opt("friction_twisting", i.friction_twisting, Range::NonNegative)?,
             cohesion,
+            hooke_stiffness: hooke.stiffness,
+            hooke_stiffness_ratio: hooke.ratio,
             models,
         });
     }

@@ -8,6 +8,7 @@ use std::path::Path;
 use crate::engine::records::Snapshot;
 pub use crate::engine::records::{decode, encode, encode_into, hash, join, shared_part};
 use crate::geometry::mesh::Mesh;
+use crate::model::registry::NormalModel;
 use crate::scenario::{FrictionSprings, GivenModels, Scenario, beyond_defaults};
 use anyhow::{Context, Result};
 
@@ -149,15 +150,23 @@ fn materials_text(s: &Scenario) -> String {
     };
     for (k, m) in s.materials.iter().enumerate() {
         let p = &m.properties;
-        let beyond = named(beyond_defaults(p.models, p.cohesion));
+        let beyond = named(beyond_defaults(p));
         if !beyond.is_empty() {
             text += &format!("|models of material {k}:{beyond}");
+        }
+        if p.models.normal == NormalModel::Hooke {
+            let (k_n, ratio) = (p.hooke_stiffness, p.hooke_stiffness_ratio);
+            text += &format!("|hooke of material {k}: {k_n:?} {ratio:?}");
         }
     }
     for i in &s.interactions {
         let given = named(i.models);
         if !given.is_empty() {
             text += &format!("|models of {:?}:{given}", i.materials);
+        }
+        if i.hooke_stiffness.is_some() || i.hooke_stiffness_ratio.is_some() {
+            let (k_n, ratio) = (i.hooke_stiffness, i.hooke_stiffness_ratio);
+            text += &format!("|hooke of {:?}: {k_n:?} {ratio:?}", i.materials);
         }
     }
     text

@@ -6,7 +6,7 @@ use std::marker::PhantomData;
 use super::adhesion::Adhesion;
 use super::friction::Order;
 use crate::model::materials::FrictionSprings;
-use crate::model::registry::AdhesionModel;
+use crate::model::registry::{AdhesionModel, RollingModel, TangentialCoulomb};
 
 /// The sub-models a run's law is composed of, as types: the loops over contacts are
 /// generic over it, so that no contact asks which model is in force.
@@ -29,6 +29,10 @@ pub struct Choice {
     /// Sjkr if any pair has k_c > 0.
     pub adhesion: AdhesionModel,
     pub springs: FrictionSprings,
+    /// The rolling sub-model and what the tangential Coulomb limit clips: one each per run,
+    /// read by the law as constants (a branch that always goes the same way), not types.
+    pub rolling: RollingModel,
+    pub tangential: TangentialCoulomb,
 }
 
 /// `$body` with the type `$M` set to the composition of `$choice` (a [`Choice`]): the one

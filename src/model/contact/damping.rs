@@ -1,10 +1,17 @@
 //! The damping sub-model: viscoelastic dashpots c_n, c_s from the pair's restitution
 //! (Eqs. 18, 19, 21, 25), in parallel with the springs of every mode.
+//!
+//! With Hooke's constant stiffness the contact is a damped linear oscillator, whose
+//! restitution is e = exp(-π ζ / sqrt(1 - ζ²)) at the damping ratio ζ = c_n / (2 sqrt(m* k_n)):
+//! ζ = -ln e / sqrt(ln² e + π²), which is Eq. (21)'s β. So c_n = 2 β sqrt(m* k_n), written
+//! as Eq. (18) with β' = 2 β / sqrt(5); and c_s = 2 β sqrt(m* k_s), the same ratio in the
+//! tangential mode (LIGGGHTS's `hooke/stiffness` takes γ_n and γ_t as given numbers).
 
 use crate::model::lanes::Lanes;
 use crate::model::materials::Material;
+use crate::model::registry::NormalModel;
 
-use super::normal::Hertz;
+use super::normal::Elastic;
 
 coefficients! {
     /// β of the pair's restitution (Eq. 21) and c_s / c_n = sqrt(k_s / (30 k_n)) =
@@ -28,8 +35,16 @@ pub fn damping_factor(e_n: f64) -> f64 {
 
 impl Viscoelastic {
     /// Of two particles of materials `m` and `n` (whose moduli are `elastic`) with the
-    /// pair's restitution `e_n`.
-    pub fn of_particles(m: &Material, n: &Material, elastic: &Hertz, e_n: f64) -> Viscoelastic {
+    /// pair's restitution `e_n`, for its normal sub-model `normal`.
+    pub fn of_particles(
+        m: &Material,
+        n: &Material,
+        elastic: &Elastic,
+        (e_n, normal): (f64, NormalModel),
+    ) -> Viscoelastic {
+        if normal == NormalModel::Hooke {
+            return Viscoelastic::hooke(elastic, e_n);
+        }
         let c_s_per_c_n = if m == n {
             let nu = m.poisson_ratio;
             ((1.0 - nu) / (10.0 * (2.0 - nu))).sqrt() // Eq. (25)
@@ -42,12 +57,31 @@ impl Viscoelastic {
         }
     }
 
-    /// Of a particle of material `m` against a rigid wall with the pair's restitution `e_n`.
-    pub fn against_wall(m: &Material, e_n: f64) -> Viscoelastic {
+    /// Of a particle of material `m` against a rigid wall (moduli `elastic`) with the
+    /// pair's restitution `e_n`, for its normal sub-model `normal`.
+    pub fn against_wall(
+        m: &Material,
+        elastic: &Elastic,
+        (e_n, normal): (f64, NormalModel),
+    ) -> Viscoelastic {
+        if normal == NormalModel::Hooke {
+            return Viscoelastic::hooke(elastic, e_n);
+        }
         let nu = m.poisson_ratio;
         Viscoelastic {
             beta: damping_factor(e_n),                              // Eq. (21)
             c_s_per_c_n: ((1.0 - nu) / (10.0 * (2.0 - nu))).sqrt(), // Eq. (25)
+        }
+    }
+}
+
+impl Viscoelastic {
+    /// Of a Hooke pair (constant stiffnesses `elastic`) with restitution `e_n`: see the
+    /// module's comment.
+    fn hooke(elastic: &Elastic, e_n: f64) -> Viscoelastic {
+        Viscoelastic {
+            beta: 2.0 * damping_factor(e_n) / 5f64.sqrt(),
+            c_s_per_c_n: (elastic.k_s0 / elastic.k_n0).sqrt(),
         }
     }
 }

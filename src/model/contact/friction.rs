@@ -63,6 +63,10 @@ pub(super) fn project_onto_tangent_plane<T: Lanes>(u: T::Vec, n: T::Vec) -> T::V
 /// settled bed keeps spinning. Advancing first is symplectic Euler: undamped it keeps
 /// the area exactly (|trace| < 2 for ωΔt < 2, so the energy stays bounded and returns),
 /// and any damping only removes energy.
+///
+/// With `spring_only` (`tangential_coulomb = "spring"`, LIGGGHTS's and LAMMPS's test) the
+/// limit clips the spring's force k u alone: sticking, the force is -k u - c v; sliding,
+/// the spring is cut to |k u| = f_max and the force is -k u, the damper idle.
 #[inline(always)]
 pub(super) fn coulomb_spring<T: Lanes, V: Displacement<T>>(
     u: &mut V,
@@ -70,18 +74,28 @@ pub(super) fn coulomb_spring<T: Lanes, V: Displacement<T>>(
     k: T,
     c: T,
     f_max: T,
-    dt: T,
-    advance_first: bool,
+    (dt, advance_first): (T, bool),
+    spring_only: bool,
 ) -> V {
     let spring = if advance_first { *u + v * dt } else { *u }; // Eq. (53), first
+    let advanced = || if advance_first { spring } else { *u + v * dt }; // Eq. (53)
+    if spring_only {
+        let f_spring = -(spring * k);
+        let f_norm2 = f_spring.norm_squared();
+        let sticking = f_norm2.le(f_max * f_max);
+        let cut = V::pick(sticking, || spring, || spring * (f_max / f_norm2.sqrt()));
+        let f = V::pick(sticking, || f_spring + -(v * c), || -(cut * k));
+        *u = V::pick(sticking, advanced, || cut);
+        return f;
+    }
     let f = -(spring * k) + -(v * c);
     let f_norm2 = f.norm_squared();
     let sticking = f_norm2.le(f_max * f_max);
     let f = V::pick(sticking, || f, || f * (f_max / f_norm2.sqrt())); // Eq. (54)
     *u = V::pick(
         sticking,
-        || if advance_first { spring } else { *u + v * dt }, // Eq. (53)
-        || -(f + v * c) * (T::splat(1.0) / k),               // Eq. (55)
+        advanced,
+        || -(f + v * c) * (T::splat(1.0) / k), // Eq. (55)
     );
     f
 }

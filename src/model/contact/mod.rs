@@ -25,7 +25,7 @@
 
 use crate::model::lanes::{Displacement, Lanes};
 use crate::model::materials::{FrictionSprings, Material, PairCoefficients};
-use crate::model::registry::AdhesionModel;
+use crate::model::registry::{AdhesionModel, RollingModel, TangentialCoulomb};
 pub use crate::model::springs::Springs;
 
 /// A sub-model's coefficients of one pair, over lanes: the struct, with `splat` (the same
@@ -71,7 +71,7 @@ pub use kinematics::{Body, Kinematics, Other};
 
 use adhesion::{Adhesion, Cohesion};
 use damping::Viscoelastic;
-use normal::{Hertz, Stiffness};
+use normal::{Elastic, Stiffness};
 use rolling::Rolling;
 use sliding::Sliding;
 use twisting::Twisting;
@@ -81,7 +81,7 @@ use twisting::Twisting;
 /// Each sub-model owns its part.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Coefficients<T: Lanes = f64> {
-    pub normal: Hertz<T>,
+    pub normal: Elastic<T>,
     pub damping: Viscoelastic<T>,
     pub sliding: Sliding<T>,
     pub rolling: Rolling<T>,
@@ -92,9 +92,10 @@ pub struct Coefficients<T: Lanes = f64> {
 impl Coefficients {
     /// Of two particles of materials `m` and `n` with the pair's coefficients `pair`.
     fn of_particles(m: &Material, n: &Material, pair: &PairCoefficients) -> Coefficients {
-        let normal = Hertz::of_particles(m, n);
+        let normal = Elastic::of_particles(m, n, pair);
+        let e_n = (pair.restitution, pair.models.normal);
         Coefficients {
-            damping: Viscoelastic::of_particles(m, n, &normal, pair.restitution),
+            damping: Viscoelastic::of_particles(m, n, &normal, e_n),
             normal,
             ..Self::friction_and_adhesion(pair)
         }
@@ -103,9 +104,11 @@ impl Coefficients {
     /// Of a particle of material `m` against a rigid wall; the wall's material enters
     /// through the pair's restitution and friction.
     fn against_wall(m: &Material, pair: &PairCoefficients) -> Coefficients {
+        let normal = Elastic::against_wall(m, pair);
+        let e_n = (pair.restitution, pair.models.normal);
         Coefficients {
-            normal: Hertz::against_wall(m),
-            damping: Viscoelastic::against_wall(m, pair.restitution),
+            damping: Viscoelastic::against_wall(m, &normal, e_n),
+            normal,
             ..Self::friction_and_adhesion(pair)
         }
     }
@@ -113,9 +116,11 @@ impl Coefficients {
     /// The pair's friction and adhesion, with the elastic parts left zero.
     fn friction_and_adhesion(pair: &PairCoefficients) -> Coefficients {
         Coefficients {
-            normal: Hertz {
+            normal: Elastic {
                 e_star: 0.0,
                 g_star: 0.0,
+                k_n0: 0.0,
+                k_s0: 0.0,
             },
             damping: Viscoelastic {
                 beta: 0.0,
@@ -153,7 +158,7 @@ impl Coefficients {
         c: [&Coefficients; N],
     ) -> Coefficients<T> {
         Coefficients {
-            normal: Hertz::gather(c.map(|c| &c.normal)),
+            normal: Elastic::gather(c.map(|c| &c.normal)),
             damping: Viscoelastic::gather(c.map(|c| &c.damping)),
             sliding: Sliding::gather(c.map(|c| &c.sliding)),
             rolling: Rolling::gather(c.map(|c| &c.rolling)),
@@ -222,6 +227,8 @@ impl ContactLaw {
             friction_rolling: material.friction_rolling,
             friction_twisting: material.friction_twisting,
             cohesion: material.cohesion,
+            hooke_stiffness: material.hooke_stiffness,
+            hooke_stiffness_ratio: material.hooke_stiffness_ratio,
             models: material.models,
             given: false,
         };
@@ -247,6 +254,8 @@ impl ContactLaw {
             choice: Choice {
                 adhesion: AdhesionModel::None,
                 springs,
+                rolling: RollingModel::default(),
+                tangential: TangentialCoulomb::default(),
             },
         };
         for a in 0..n {
@@ -258,6 +267,10 @@ impl ContactLaw {
                 if pair.models.adhesion == AdhesionModel::Sjkr && pair.cohesion > 0.0 {
                     law.choice.adhesion = AdhesionModel::Sjkr;
                 }
+                // One rolling model and one Coulomb test per run (the scenario refuses
+                // pairs that differ).
+                law.choice.rolling = pair.models.rolling;
+                law.choice.tangential = pair.models.tangential;
             }
         }
         law
@@ -292,6 +305,7 @@ impl ContactLaw {
     pub(crate) fn stiffer(&mut self, factor: f64) {
         for c in self.pairs.iter_mut().chain(&mut self.walls) {
             c.normal.e_star *= factor;
+            c.normal.k_n0 *= factor;
         }
     }
 
@@ -369,8 +383,13 @@ impl ContactLaw {
             dt: T::splat(self.dt),
         };
 
-        let (f_s, tau_s) = coef.sliding.force::<M::Order>(&at, &mut springs.u_s);
-        let tau_r = coef.rolling.torque::<M::Order>(&at, &mut springs.u_r);
+        let (rolling, tangential) = (self.choice.rolling, self.choice.tangential);
+        let (f_s, tau_s) = coef
+            .sliding
+            .force::<M::Order>(tangential, &at, &mut springs.u_s);
+        let tau_r = coef
+            .rolling
+            .torque::<M::Order>(rolling, &at, &mut springs.u_r);
         let tau_t = coef.twisting.torque::<M::Order>(&at, &mut springs.u_t);
         let f = M::Adhesion::add_pull(&coef.adhesion, f_n + f_s, n, radius_i, other, delta);
 

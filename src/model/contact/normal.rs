@@ -1,15 +1,27 @@
-//! The normal sub-model: the elastic stiffnesses k_n and k_s of a contact. Hertz-Mindlin,
-//! the paper's (Eqs. 12-16, 22, 23): both grow with the radius a of the contact area.
+//! The normal sub-model: the elastic stiffnesses k_n and k_s of a contact.
+//!
+//! - Hertz-Mindlin, the paper's (Eqs. 12-16, 22, 23): both grow with the radius a of the
+//!   contact area, k_n = 4/3 E* a, k_s = 8 G* a.
+//! - Hooke, the linear spring-dashpot (Cundall & Strack 1979; LIGGGHTS `hooke/stiffness`,
+//!   LAMMPS `gran/hooke/history`): constant k_n (`hooke_stiffness`) and k_s = κ k_n
+//!   (`hooke_stiffness_ratio` κ, 2/7 by default, the ratio at which the normal and tangential
+//!   periods of a sphere on a plane agree).
+//!
+//! A pair's coefficients hold one of the two: `k_n = k_n0 + 4/3 E* a` with E* = 0 for a
+//! Hooke pair and k_n0 = 0 for a Hertz one, so that pairs of both kinds share one loop.
 
 use crate::model::lanes::Lanes;
-use crate::model::materials::Material;
+use crate::model::materials::{Material, PairCoefficients};
+use crate::model::registry::NormalModel;
 
 coefficients! {
-    /// E* and G* of a pair: Eqs. (22), (23) for two particles; for a wall, of the particle
-    /// against a rigid body (text after Eq. 25).
-    pub struct Hertz {
+    /// E* and G* of a Hertz pair: Eqs. (22), (23) for two particles; for a wall, of the
+    /// particle against a rigid body (text after Eq. 25). k_n0 and k_s0 of a Hooke pair.
+    pub struct Elastic {
         e_star,
         g_star,
+        k_n0,
+        k_s0,
     }
 }
 
@@ -22,14 +34,19 @@ pub struct Stiffness<T: Lanes> {
     pub k_s: T,
 }
 
-impl Hertz {
-    /// Of two particles of materials `m` and `n`.
-    pub fn of_particles(m: &Material, n: &Material) -> Hertz {
+impl Elastic {
+    /// Of two particles of materials `m` and `n` whose contacts have the coefficients `pair`.
+    pub fn of_particles(m: &Material, n: &Material, pair: &PairCoefficients) -> Elastic {
+        if pair.models.normal == NormalModel::Hooke {
+            return Elastic::hooke(pair);
+        }
         if m == n {
             let (e, nu) = (m.youngs_modulus, m.poisson_ratio);
-            Hertz {
+            Elastic {
                 e_star: e / (2.0 * (1.0 - nu * nu)),         // Eq. (22)
                 g_star: e / (4.0 * (2.0 - nu) * (1.0 + nu)), // Eq. (23)
+                k_n0: 0.0,
+                k_s0: 0.0,
             }
         } else {
             // Eqs. (22), (23) for two materials: 1/E* = (1 - ν_i²)/E_i + (1 - ν_j²)/E_j,
@@ -37,32 +54,49 @@ impl Hertz {
             let g = |m: &Material| m.youngs_modulus / (2.0 * (1.0 + m.poisson_ratio));
             let compliance =
                 |m: &Material| (1.0 - m.poisson_ratio * m.poisson_ratio) / m.youngs_modulus;
-            Hertz {
+            Elastic {
                 e_star: 1.0 / (compliance(m) + compliance(n)),
                 g_star: 1.0 / ((2.0 - m.poisson_ratio) / g(m) + (2.0 - n.poisson_ratio) / g(n)),
+                k_n0: 0.0,
+                k_s0: 0.0,
             }
         }
     }
 
-    /// Of a particle of material `m` against a rigid wall.
-    pub fn against_wall(m: &Material) -> Hertz {
+    /// Of a particle of material `m` against a rigid wall, the contacts' coefficients `pair`.
+    pub fn against_wall(m: &Material, pair: &PairCoefficients) -> Elastic {
+        if pair.models.normal == NormalModel::Hooke {
+            return Elastic::hooke(pair);
+        }
         let (e, nu) = (m.youngs_modulus, m.poisson_ratio);
         let g = e / (2.0 * (1.0 + nu)); // Eq. (16), G_i
-        Hertz {
+        Elastic {
             e_star: e / (1.0 - nu * nu),
             g_star: g / (2.0 - nu),
+            k_n0: 0.0,
+            k_s0: 0.0,
+        }
+    }
+
+    /// A Hooke pair: the pair's k_n and κ k_n.
+    fn hooke(pair: &PairCoefficients) -> Elastic {
+        Elastic {
+            e_star: 0.0,
+            g_star: 0.0,
+            k_n0: pair.hooke_stiffness,
+            k_s0: pair.hooke_stiffness_ratio * pair.hooke_stiffness,
         }
     }
 }
 
-impl<T: Lanes> Hertz<T> {
+impl<T: Lanes> Elastic<T> {
     /// k_n and k_s at overlap `delta` of a contact of effective radius `r_star`.
     #[inline(always)]
     pub fn stiffness(&self, r_star: T, delta: T) -> Stiffness<T> {
         let a = (r_star * delta).sqrt(); // Eq. (14)
         Stiffness {
-            k_n: T::splat(4.0 / 3.0) * self.e_star * a, // Eq. (12)
-            k_s: T::splat(8.0) * self.g_star * a,       // Eq. (13)
+            k_n: self.k_n0 + T::splat(4.0 / 3.0) * self.e_star * a, // Eq. (12)
+            k_s: self.k_s0 + T::splat(8.0) * self.g_star * a,       // Eq. (13)
         }
     }
 }

@@ -30,16 +30,16 @@ fn projection_keeps_length_and_removes_normal_part() {
 fn static_spring_accumulates_and_kinetic_spring_matches_coulomb() {
     // The paper's order: the force of the old spring, then the spring grows.
     let mut u = 0.0;
-    let f = coulomb_spring(&mut u, 2.0, 10.0, 1.0, 100.0, 0.5, false);
+    let f = coulomb_spring(&mut u, 2.0, 10.0, 1.0, 100.0, (0.5, false), false);
     assert_eq!((f, u), (-2.0, 1.0));
     // Advancing first: the spring grows, then gives the force.
     let mut u = 0.0;
-    let f = coulomb_spring(&mut u, 2.0, 10.0, 1.0, 100.0, 0.5, true);
+    let f = coulomb_spring(&mut u, 2.0, 10.0, 1.0, 100.0, (0.5, true), false);
     assert_eq!((f, u), (-12.0, 1.0));
     // Kinetic: |f| is clipped to the limit and the spring reproduces it (Eq. 55).
     for first in [false, true] {
         let mut u = 1.0;
-        let f = coulomb_spring(&mut u, 2.0, 10.0, 1.0, 3.0, 0.5, first);
+        let f = coulomb_spring(&mut u, 2.0, 10.0, 1.0, 3.0, (0.5, first), false);
         assert_eq!(f, -3.0);
         assert!((-10.0 * u - 2.0 - f).abs() < 1e-15);
     }
@@ -55,7 +55,7 @@ fn sticking_oscillator_gains_energy_only_in_the_papers_order() {
         let mut most: f64 = 0.0;
         for _ in 0..steps {
             // The contact sees the velocity of the body, which moves with it.
-            let f = coulomb_spring(&mut u, v, k, 0.0, f64::INFINITY, dt, first);
+            let f = coulomb_spring(&mut u, v, k, 0.0, f64::INFINITY, (dt, first), false);
             v += dt * f / m;
             most = most.max(0.5 * m * v * v + 0.5 * k * u * u);
         }
@@ -139,6 +139,8 @@ mod lanes {
             friction_twisting: 0.02,
             viscosity: 1e-5,
             cohesion: k_c,
+            hooke_stiffness: 0.0,
+            hooke_stiffness_ratio: 2.0 / 7.0,
             models,
             thermal: Default::default(),
         };
@@ -365,6 +367,8 @@ fn sjkr_without_cohesion_gives_the_bits_of_no_adhesion() {
         friction_twisting: 0.02,
         viscosity: 1e-5,
         cohesion: 0.0,
+        hooke_stiffness: 0.0,
+        hooke_stiffness_ratio: 2.0 / 7.0,
         models: Default::default(),
         thermal: Default::default(),
     };

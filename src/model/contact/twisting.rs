@@ -28,8 +28,8 @@ where
             at.stiffness.k_s,
             at.c_s,
             self.mu_t * at.f_n_norm,
-            at.dt,
-            O::ADVANCE_FIRST,
+            (at.dt, O::ADVANCE_FIRST),
+            false,
         ); // Eqs. (35), (40), (53)-(55)
         at.n * (f_t * at.r_star) // Eq. (33)
     }
