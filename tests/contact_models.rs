@@ -1,7 +1,8 @@
 //! The contact law's sub-models beyond the paper's: Hooke's linear spring-dashpot against
 //! the damped linear oscillator (pair and wall), the rolling resistance of `cdt` and
 //! `epsd2` against the stopping distance of a constant torque, the tangential Coulomb test
-//! on the spring alone, and their bits on 1 and 2 threads.
+//! on the spring alone, DMT's pull-off force and resting overlap, and their bits on 1 and 2
+//! threads.
 
 use crate::common;
 
@@ -20,6 +21,17 @@ const FLOOR: &str = "OFF\n4 1 0\n-1 -1 0\n1 -1 0\n1 1 0\n-1 1 0\n4 0 1 2 3\n";
 /// A simulation of `particles` with the `[material]` lines `material`, gravity `g` down, a
 /// floor if `floor`, and time step `dt`.
 fn sim(material: &str, g: f64, floor: bool, dt: f64, particles: Vec<Particle>) -> Simulation {
+    sim_with_mesh(material, g, if floor { FLOOR } else { "" }, dt, particles)
+}
+
+/// As [`sim`], with the mesh `off` (OFF text; none if empty).
+fn sim_with_mesh(
+    material: &str,
+    g: f64,
+    off: &str,
+    dt: f64,
+    particles: Vec<Particle>,
+) -> Simulation {
     let s = common::scenario(&format!(
         "[geometry]\nradius_min = {R}\nradius_max = {R}\nmesh_radii = [0.0]\n\
          [material]\ndensity = {RHO}\n{material}\n\
@@ -27,10 +39,10 @@ fn sim(material: &str, g: f64, floor: bool, dt: f64, particles: Vec<Particle>) -
          [simulation]\ntimestep = {dt:e}\nmax_particles = 0\nspawn_attempts = 0\n",
         -g
     ));
-    let mesh = if floor {
-        Mesh::parse_off(FLOOR, "floor", &s.geometry.mesh_radii).unwrap()
-    } else {
+    let mesh = if off.is_empty() {
         Mesh::default()
+    } else {
+        Mesh::parse_off(off, "mesh", &s.geometry.mesh_radii).unwrap()
     };
     Simulation::from_parts(s, mesh, particles.into_iter().collect::<Particles>()).unwrap()
 }
@@ -222,6 +234,7 @@ fn each_contact_model_gives_the_same_bits_on_one_and_two_threads() {
     for models in [
         "hooke_stiffness = 400.0\ntangential_coulomb = \"spring\"\nrolling_model = \"cdt\"",
         "rolling_model = \"epsd2\"\nfriction_rolling = 0.2",
+        "adhesion_model = \"dmt\"\nsurface_energy = 0.02",
     ] {
         let text = format!(
             "[geometry]\nradius_min = 0.002\nradius_max = 0.003\nmesh = \"stages/silo.off\"\nmesh_radii = [0.0]\n\
@@ -244,4 +257,96 @@ fn each_contact_model_gives_the_same_bits_on_one_and_two_threads() {
         assert!(one.particles.len() > 100, "{models}");
         assert_eq!(one.particles, two.particles, "{models}");
     }
+}
+
+/// A ceiling (a rectangle facing down at z = 0).
+const CEILING: &str = "OFF\n4 1 0\n-1 -1 0\n-1 1 0\n1 1 0\n1 -1 0\n4 0 1 2 3\n";
+
+/// The overlap at which Hertz's force of E* and R* is `f`.
+fn hertz_overlap(f: f64, e_star: f64, r_star: f64) -> f64 {
+    (3.0 * f / (4.0 * e_star * r_star.sqrt())).powf(2.0 / 3.0)
+}
+
+#[test]
+fn a_dmt_grain_hangs_below_its_pull_off_force_and_falls_above_it() {
+    // DMT's pull 2 π γ R* acts while the grain touches: against a plane R* = R, and the
+    // largest weight it holds is the pull itself (at vanishing overlap).
+    let (gamma, e) = (0.05, 1e7);
+    let e_star = e / (1.0 - 0.09);
+    let pull_off = 2.0 * std::f64::consts::PI * gamma * R;
+    let m = Inertia::mass(R, RHO);
+    let material = format!(
+        "youngs_modulus = {e:e}\nrestitution = 0.3\nadhesion_model = \"dmt\"\nsurface_energy = {gamma}"
+    );
+    for (share, holds) in [(0.9, true), (1.1, false)] {
+        let g = share * pull_off / m;
+        // Hanging: Hertz carries what the weight leaves of the pull.
+        let delta = hertz_overlap((1.0 - share).abs() * pull_off, e_star, R);
+        let start = if holds { delta } else { 1e-9 };
+        let grain = common::sphere(
+            R,
+            DVec3::new(0.0, 0.0, -(R - start)),
+            DVec3::ZERO,
+            DVec3::ZERO,
+        );
+        let mut s = sim_with_mesh(&material, g, CEILING, 1e-6, vec![grain]);
+        for _ in 0..50_000 {
+            s.step().unwrap();
+        }
+        let z = s.particles.x[0].z;
+        if holds {
+            let overlap = R + z;
+            assert!(
+                (overlap / delta - 1.0).abs() < 1e-3,
+                "at {share} of the pull-off force: overlap {overlap} vs {delta}"
+            );
+        } else {
+            assert!(
+                z < -R - 1e-5,
+                "at {share} of the pull-off force it should fall: z = {z}"
+            );
+        }
+    }
+    // Two grains at rest settle where Hertz balances the pull 2 π γ R / 2.
+    let e_pair = e / (2.0 * (1.0 - 0.09));
+    let delta = hertz_overlap(pull_off / 2.0, e_pair, R / 2.0);
+    let pair = vec![
+        common::sphere(R, DVec3::new(-R + 1e-7, 0.0, 0.0), DVec3::ZERO, DVec3::ZERO),
+        common::sphere(R, DVec3::new(R - 1e-7, 0.0, 0.0), DVec3::ZERO, DVec3::ZERO),
+    ];
+    let mut s = sim(&material, 0.0, false, 1e-6, pair);
+    for _ in 0..100_000 {
+        s.step().unwrap();
+    }
+    let overlap = 2.0 * R - (s.particles.x[1] - s.particles.x[0]).length();
+    assert!(
+        (overlap / delta - 1.0).abs() < 1e-3,
+        "a pair: overlap {overlap} m, Hertz balances the pull at {delta} m"
+    );
+}
+
+#[test]
+fn dmt_keys_are_checked() {
+    let refused = |text: &str| {
+        let e = tinydem::scenario::Scenario::parse(text, std::path::Path::new("s.toml"));
+        format!("{:#}", e.expect_err(text))
+    };
+    let e = refused("[material]\nsurface_energy = -1.0\nadhesion_model = \"dmt\"\n");
+    assert!(e.contains("surface_energy = -1 is not allowed"), "{e}");
+    let e = refused("[material]\nadhesion_model = \"dmt\"\n");
+    assert!(e.contains("needs surface_energy > 0"), "{e}");
+    let e = refused("[material]\nsurface_energy = 0.1\n");
+    assert!(e.contains("needs adhesion_model = \"dmt\""), "{e}");
+    let e = refused("[material]\nadhesion_model = \"dmt\"\nsurface_energy = 0.1\ncohesion = 5.0\n");
+    assert!(e.contains("contradicts cohesion"), "{e}");
+    let e = refused(
+        "[[materials]]\nname = \"a\"\ncohesion = 5.0\n[[materials]]\nname = \"b\"\n\
+         adhesion_model = \"dmt\"\nsurface_energy = 0.1\n",
+    );
+    assert!(e.contains("adhere by different models"), "{e}");
+    // Given, it reads back from the run's text.
+    let s = common::scenario("[material]\nadhesion_model = \"dmt\"\nsurface_energy = 0.1\n");
+    let again = common::scenario(&s.to_toml());
+    assert_eq!(again.pair(0, 0), s.pair(0, 0));
+    assert_eq!(s.pair(0, 0).surface_energy, 0.1);
 }

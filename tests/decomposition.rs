@@ -766,7 +766,7 @@ fn the_contact_models_split_over_processes_give_the_bits_of_one_process() {
     let steps = 1500;
     for models in [
         "hooke_stiffness = 300.0\ntangential_coulomb = \"spring\"\nrolling_model = \"cdt\"\n",
-        "rolling_model = \"epsd2\"\n",
+        "rolling_model = \"epsd2\"\nadhesion_model = \"dmt\"\nsurface_energy = 0.02\n",
     ] {
         let text = silo(0.5).replace(
             "friction_twisting = 0.1\n",

@@ -58,10 +58,14 @@ impl LoadScales {
             stiffest = stiffest.max(e_star).max(std::f64::consts::PI * m.cohesion);
             // Hooke: k_n R_max at an overlap of R_max.
             stiffest = stiffest.max(m.hooke_stiffness / r_max);
+            // DMT: 2 pi gamma R_max.
+            stiffest = stiffest.max(2.0 * std::f64::consts::PI * m.surface_energy / r_max);
         }
         for i in &s.interactions {
             stiffest = stiffest.max(std::f64::consts::PI * i.cohesion.unwrap_or(0.0));
             stiffest = stiffest.max(i.hooke_stiffness.unwrap_or(0.0) / r_max);
+            let gamma = i.surface_energy.unwrap_or(0.0);
+            stiffest = stiffest.max(2.0 * std::f64::consts::PI * gamma / r_max);
         }
         let largest = (LoadScales::ROOM * stiffest * r_max * r_max).max(f64::MIN_POSITIVE);
         let (force, torque) = (

@@ -25,6 +25,8 @@ pub struct Material {
     /// k_c [M/LT²] = [J/m³]: the simplified JKR cohesion, a pull k_c A over the contact
     /// area A.
     pub cohesion: f64,
+    /// γ [J/m²], the work of adhesion of DMT (`adhesion_model = "dmt"`; 0 otherwise).
+    pub surface_energy: f64,
     /// k_n [M/T²] of Hooke's normal sub-model (`normal_model = "hooke"`; 0 otherwise).
     pub hooke_stiffness: f64,
     /// k_s / k_n of Hooke's normal sub-model (2/7 by default).
@@ -65,6 +67,8 @@ pub struct PairCoefficients {
     pub friction_rolling: f64,
     pub friction_twisting: f64,
     pub cohesion: f64,
+    /// γ of DMT [J/m²] (0 unless the pair's adhesion is DMT).
+    pub surface_energy: f64,
     /// Hooke's k_n and k_s / k_n (`normal_model = "hooke"`).
     pub hooke_stiffness: f64,
     pub hooke_stiffness_ratio: f64,

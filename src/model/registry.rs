@@ -64,6 +64,7 @@ registry! {
     AdhesionModel "adhesion_model" {
         None = "none": "no adhesion",
         Sjkr = "sjkr": "the simplified JKR cohesion, a pull cohesion x area",
+        Dmt = "dmt": "the DMT pull 2 pi surface_energy R* while in contact",
     }
 }
 
@@ -99,7 +100,7 @@ impl ContactModels {
     /// coefficients do), the others as both have them (each slot has one sub-model today;
     /// a second one decides its mixing here).
     pub fn mix(self, other: ContactModels) -> ContactModels {
-        let adhesion = if other.adhesion == AdhesionModel::Sjkr {
+        let adhesion = if other.adhesion != AdhesionModel::None {
             other.adhesion
         } else {
             self.adhesion
@@ -132,7 +133,8 @@ mod tests {
         assert_eq!(
             e,
             "adhesion_model = \"jkr\" is not a known model: it must be \"none\" (no adhesion) \
-             or \"sjkr\" (the simplified JKR cohesion, a pull cohesion x area)"
+             or \"sjkr\" (the simplified JKR cohesion, a pull cohesion x area) or \"dmt\" (the DMT \
+             pull 2 pi surface_energy R* while in contact)"
         );
         assert!(NormalModel::parse("Hertz").is_err(), "names are exact");
     }

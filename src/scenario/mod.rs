@@ -187,6 +187,8 @@ pub struct Interaction {
     pub friction_rolling: Option<f64>,
     pub friction_twisting: Option<f64>,
     pub cohesion: Option<f64>,
+    /// DMT's γ for the pair.
+    pub surface_energy: Option<f64>,
     /// Hooke's k_n and k_s / k_n for the pair.
     pub hooke_stiffness: Option<f64>,
     pub hooke_stiffness_ratio: Option<f64>,
@@ -196,13 +198,14 @@ pub struct Interaction {
 
 impl Interaction {
     /// Each coefficient with its key and symbol (given or not), in the order of the file.
-    pub fn coefficients(&self) -> [(&'static str, &'static str, Option<f64>); 7] {
+    pub fn coefficients(&self) -> [(&'static str, &'static str, Option<f64>); 8] {
         [
             ("restitution", "e_n", self.restitution),
             ("friction_sliding", "mu_s", self.friction_sliding),
             ("friction_rolling", "mu_r", self.friction_rolling),
             ("friction_twisting", "mu_t", self.friction_twisting),
             ("cohesion", "k_c", self.cohesion),
+            ("surface_energy", "gamma", self.surface_energy),
             ("hooke_stiffness", "k_n", self.hooke_stiffness),
             (
                 "hooke_stiffness_ratio",
@@ -575,14 +578,21 @@ impl Scenario {
             ),
             // A pair without adhesion (named so in its [[interactions]]) pulls not.
             cohesion: match models.adhesion {
-                AdhesionModel::None => 0.0,
                 AdhesionModel::Sjkr => cohesion,
+                AdhesionModel::None | AdhesionModel::Dmt => 0.0,
             },
-            hooke_stiffness: given
-                .and_then(|i| i.hooke_stiffness)
-                .unwrap_or_else(|| models::mean_of_hooke([m, n], |m| m.hooke_stiffness)),
-            hooke_stiffness_ratio: (given.and_then(|i| i.hooke_stiffness_ratio))
-                .unwrap_or_else(|| models::mean_of_hooke([m, n], |m| m.hooke_stiffness_ratio)),
+            surface_energy: match models.adhesion {
+                AdhesionModel::Dmt => given.and_then(|i| i.surface_energy).unwrap_or_else(|| {
+                    models::mean_of([m, n], models::is_dmt, |m| m.surface_energy)
+                }),
+                AdhesionModel::None | AdhesionModel::Sjkr => 0.0,
+            },
+            hooke_stiffness: given.and_then(|i| i.hooke_stiffness).unwrap_or_else(|| {
+                models::mean_of([m, n], models::is_hooke, |m| m.hooke_stiffness)
+            }),
+            hooke_stiffness_ratio: (given.and_then(|i| i.hooke_stiffness_ratio)).unwrap_or_else(
+                || models::mean_of([m, n], models::is_hooke, |m| m.hooke_stiffness_ratio),
+            ),
             models,
             given: given.is_some(),
         }

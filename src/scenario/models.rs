@@ -40,12 +40,25 @@ impl GivenModels {
     }
 
     /// A material's sub-models: those named, or the defaults (the paper's; adhesion "sjkr"
-    /// where `cohesion` > 0, "none" otherwise).
-    pub(super) fn of_material(self, table: &str, cohesion: f64) -> Result<ContactModels> {
+    /// where `cohesion` > 0, "none" otherwise; "dmt" is named, with `surface_energy`).
+    pub(super) fn of_material(
+        self,
+        table: &str,
+        cohesion: f64,
+        surface_energy: f64,
+    ) -> Result<ContactModels> {
         let adhesion = match self.adhesion {
-            Some(AdhesionModel::None) if cohesion > 0.0 => bail!(
-                "{table} adhesion_model = \"none\" contradicts cohesion = {cohesion}: drop one of them"
+            Some(AdhesionModel::None | AdhesionModel::Dmt) if cohesion > 0.0 => bail!(
+                "{table} adhesion_model = \"{}\" contradicts cohesion = {cohesion}: drop one of them",
+                self.adhesion.unwrap_or_default().name()
             ),
+            Some(AdhesionModel::Dmt) if surface_energy <= 0.0 => bail!(
+                "{table} adhesion_model = \"dmt\" needs surface_energy > 0 (the work of \
+                 adhesion gamma, J/m^2)"
+            ),
+            Some(AdhesionModel::None | AdhesionModel::Sjkr) | None if surface_energy > 0.0 => {
+                bail!("{table} surface_energy = {surface_energy} needs adhesion_model = \"dmt\"")
+            }
             Some(model) => model,
             None if cohesion > 0.0 => AdhesionModel::Sjkr,
             None => AdhesionModel::None,
@@ -139,14 +152,28 @@ impl Hooke {
     }
 }
 
-/// The mean of `f` over those of `materials` with Hooke's normal sub-model (of both if
-/// neither has it): a pair's Hooke coefficients unless `[[interactions]]` gives them.
-pub fn mean_of_hooke(materials: [&Material; 2], f: impl Fn(&Material) -> f64) -> f64 {
-    let hooke: Vec<f64> = (materials.iter())
-        .filter(|m| m.models.normal == NormalModel::Hooke)
+/// Whether a material's contacts follow Hooke.
+pub fn is_hooke(m: &Material) -> bool {
+    m.models.normal == NormalModel::Hooke
+}
+
+/// Whether a material adheres by DMT.
+pub fn is_dmt(m: &Material) -> bool {
+    m.models.adhesion == AdhesionModel::Dmt
+}
+
+/// The mean of `f` over those of `materials` that have a sub-model (`has`; of both if
+/// neither has it): a pair's coefficients of that model unless `[[interactions]]` gives them.
+pub fn mean_of(
+    materials: [&Material; 2],
+    has: impl Fn(&Material) -> bool,
+    f: impl Fn(&Material) -> f64,
+) -> f64 {
+    let having: Vec<f64> = (materials.iter())
+        .filter(|m| has(m))
         .map(|m| f(m))
         .collect();
-    match hooke[..] {
+    match having[..] {
         [x] => x,
         [x, y] => 0.5 * (x + y),
         _ => 0.5 * (f(materials[0]) + f(materials[1])),
@@ -169,6 +196,20 @@ impl Scenario {
                     &self.materials[b as usize].properties,
                 );
                 let given = (self.interactions.iter()).find(|i| i.materials == (a, b));
+                let adhere = [m.models.adhesion, o.models.adhesion];
+                if adhere[0] != adhere[1]
+                    && !adhere.contains(&AdhesionModel::None)
+                    && given.and_then(|i| i.models.adhesion).is_none()
+                {
+                    bail!(
+                        "materials \"{}\" and \"{}\" adhere by different models (\"{}\", \"{}\"): \
+                         name the pair's adhesion_model in [[interactions]]",
+                        name(a),
+                        name(b),
+                        adhere[0].name(),
+                        adhere[1].name()
+                    );
+                }
                 if m.models.normal != o.models.normal
                     && given.and_then(|i| i.models.normal).is_none()
                 {
@@ -187,6 +228,14 @@ impl Scenario {
                     bail!(
                         "the contacts of \"{}\" and \"{}\" follow Hooke without a stiffness: give \
                          hooke_stiffness in their [[interactions]]",
+                        name(a),
+                        name(b)
+                    );
+                }
+                if pair.models.adhesion == AdhesionModel::Dmt && pair.surface_energy <= 0.0 {
+                    bail!(
+                        "the contacts of \"{}\" and \"{}\" follow DMT without a surface energy: \
+                         give surface_energy in their [[interactions]]",
                         name(a),
                         name(b)
                     );
@@ -229,7 +278,7 @@ fn one_per_run<'a, M: Named>(
 pub fn beyond_defaults(m: &Material) -> GivenModels {
     let (models, cohesion) = (m.models, m.cohesion);
     let mut default = GivenModels::default()
-        .of_material("", cohesion)
+        .of_material("", cohesion, 0.0)
         .expect("the defaults agree with any cohesion");
     if m.hooke_stiffness > 0.0 {
         default.normal = NormalModel::Hooke;

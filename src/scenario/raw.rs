@@ -229,6 +229,7 @@ pub(super) struct RawGeometry {
 #[serde(deny_unknown_fields)]
 pub(super) struct RawMaterial {
     pub(super) cohesion: Option<f64>,
+    pub(super) surface_energy: Option<f64>,
     pub(super) hooke_stiffness: Option<f64>,
     pub(super) hooke_stiffness_ratio: Option<f64>,
     pub(super) normal_model: Option<String>,
@@ -261,6 +262,7 @@ impl RawMaterial {
             || self.friction_rolling.is_some()
             || self.friction_twisting.is_some()
             || self.cohesion.is_some()
+            || self.surface_energy.is_some()
             || self.hooke_stiffness.is_some()
             || self.hooke_stiffness_ratio.is_some()
             || self.normal_model.is_some()
@@ -285,6 +287,7 @@ impl RawMaterial {
 pub(super) struct RawNamedMaterial {
     pub(super) name: String,
     pub(super) cohesion: Option<f64>,
+    pub(super) surface_energy: Option<f64>,
     pub(super) hooke_stiffness: Option<f64>,
     pub(super) hooke_stiffness_ratio: Option<f64>,
     pub(super) normal_model: Option<String>,
@@ -317,6 +320,7 @@ impl From<RawNamedMaterial> for RawMaterial {
             friction_twisting: m.friction_twisting,
             viscosity: None,
             cohesion: m.cohesion,
+            surface_energy: m.surface_energy,
             hooke_stiffness: m.hooke_stiffness,
             hooke_stiffness_ratio: m.hooke_stiffness_ratio,
             normal_model: m.normal_model,
@@ -337,6 +341,7 @@ impl From<RawNamedMaterial> for RawMaterial {
 pub(super) struct RawInteraction {
     pub(super) materials: [String; 2],
     pub(super) cohesion: Option<f64>,
+    pub(super) surface_energy: Option<f64>,
     pub(super) hooke_stiffness: Option<f64>,
     pub(super) hooke_stiffness_ratio: Option<f64>,
     pub(super) normal_model: Option<String>,

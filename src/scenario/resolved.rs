@@ -71,6 +71,9 @@ impl Scenario {
             ] {
                 let _ = writeln!(o, "{key} = {}", num(x));
             }
+            if m.surface_energy > 0.0 {
+                let _ = writeln!(o, "surface_energy = {}", num(m.surface_energy));
+            }
             if m.models.normal == NormalModel::Hooke {
                 let _ = writeln!(o, "hooke_stiffness = {}", num(m.hooke_stiffness));
                 let _ = writeln!(

@@ -90,6 +90,11 @@ fn material(table: &str, m: RawMaterial, viscosity: f64) -> Result<Material> {
         m.cohesion.unwrap_or(0.0),
         Range::NonNegative,
     )?;
+    let surface_energy = check(
+        &key("surface_energy"),
+        m.surface_energy.unwrap_or(0.0),
+        Range::NonNegative,
+    )?;
     let thermal = super::heat::thermal(table, &m)?;
     let names = [
         m.normal_model,
@@ -136,9 +141,10 @@ fn material(table: &str, m: RawMaterial, viscosity: f64) -> Result<Material> {
         )?,
         viscosity,
         cohesion,
+        surface_energy,
         hooke_stiffness: hooke.stiffness.unwrap_or(0.0),
         hooke_stiffness_ratio: hooke.ratio.unwrap_or(super::models::HOOKE_RATIO),
-        models: given.of_material(table, cohesion)?,
+        models: given.of_material(table, cohesion, surface_energy)?,
         thermal,
     })
 }
@@ -437,6 +443,7 @@ fn interactions(
             x.map(|x| check(&key(name), x, r)).transpose()
         };
         let cohesion = opt("cohesion", i.cohesion, Range::NonNegative)?;
+        let surface_energy = opt("surface_energy", i.surface_energy, Range::NonNegative)?;
         let table = format!("[[interactions]] #{}", k + 1);
         let mut models = GivenModels::read(
             &table,
@@ -462,6 +469,7 @@ fn interactions(
             friction_rolling: opt("friction_rolling", i.friction_rolling, Range::NonNegative)?,
             friction_twisting: opt("friction_twisting", i.friction_twisting, Range::NonNegative)?,
             cohesion,
+            surface_energy,
             hooke_stiffness: hooke.stiffness,
             hooke_stiffness_ratio: hooke.ratio,
             models,

@@ -211,19 +211,22 @@ pub fn default_steps(n: usize) -> u64 {
     (10_000_000 / n as u64).clamp(100, 5000)
 }
 
+/// The bed with `lines` added to its `[material]` (a contact model's keys, heat's).
+fn with_material(sim: Simulation, lines: &str) -> Result<Simulation> {
+    let text =
+        (sim.scenario.to_toml()).replace("viscosity = 0", &format!("{lines}\nviscosity = 0"));
+    let scenario = Scenario::parse(&text, Path::new("bench"))?;
+    let mesh = Mesh {
+        faces: sim.walls.mesh.faces.clone(),
+        ..Mesh::default()
+    };
+    Simulation::from_parts(scenario, mesh, sim.particles)
+}
+
 /// The benchmark with heat transfer: the grains conduct (glass-like, k = 1 W/(m K), c = 800
 /// J/(kg K)) and start with temperatures from 300 K at the floor to 400 K at the box's top,
 /// so that heat flows through every contact.
 pub fn heated(mut sim: Simulation) -> Result<Simulation> {
-    let text = sim.scenario.to_toml().replace(
-        "viscosity = 0",
-        "thermal_conductivity = 1.0\nheat_capacity = 800.0\ninitial_temperature = 300.0\nviscosity = 0",
-    );
-    let scenario = Scenario::parse(&text, Path::new("bench"))?;
-    anyhow::ensure!(
-        scenario.heat(),
-        "the benchmark's material did not take the heat keys"
-    );
     let top = sim
         .walls
         .mesh
@@ -231,34 +234,50 @@ pub fn heated(mut sim: Simulation) -> Result<Simulation> {
         .iter()
         .flat_map(|f| f.corners())
         .fold(0.0, |z, c| c.z.max(z));
-    let mut p = std::mem::take(&mut sim.particles);
+    let p = &mut sim.particles;
     p.activate("T");
     for (t, x) in p.temperature.iter_mut().zip(&p.x) {
         *t = 300.0 + 100.0 * (x.z / top).clamp(0.0, 1.0);
     }
-    let mesh = Mesh {
-        faces: sim.walls.mesh.faces.clone(),
-        ..Mesh::default()
-    };
-    Simulation::from_parts(scenario, mesh, p)
+    let sim = with_material(
+        sim,
+        "thermal_conductivity = 1.0\nheat_capacity = 800.0\ninitial_temperature = 300.0",
+    )?;
+    anyhow::ensure!(
+        sim.scenario.heat(),
+        "the benchmark's material did not take the heat keys"
+    );
+    Ok(sim)
 }
 
-/// Runs the benchmark for `n` particles (grains: clumps of `clumps` spheres each, if given;
-/// conducting heat, if `heat`) on the current thread pool, split over the
-/// processes of `world` if given: a warm-up, then `repeats` timed segments of `steps`
-/// steps.
+/// A benchmark bed: `n` particles (grains: clumps of `clumps` spheres each, if given),
+/// conducting heat if `heat`, with the lines `material` added to its `[material]`.
+#[derive(Clone, Debug, Default)]
+pub struct Bed {
+    pub n: usize,
+    pub clumps: Option<usize>,
+    pub heat: bool,
+    pub material: Vec<String>,
+}
+
+/// Runs the benchmark `bed` on the current thread pool, split over the processes of
+/// `world` if given: a warm-up, then `repeats` timed segments of `steps` steps.
 pub fn measure(
-    (n, clumps, heat): (usize, Option<usize>, bool),
+    bed: &Bed,
     steps: u64,
     repeats: usize,
     world: Option<Box<dyn crate::parallel::comm::Comm>>,
 ) -> Result<Measurement> {
     let rss_before = proc_status_bytes("VmRSS:");
-    let mut sim = match clumps {
+    let n = bed.n;
+    let mut sim = match bed.clumps {
         None => setup(n)?,
         Some(k) => setup_clumps(n, k)?,
     };
-    if heat {
+    if !bed.material.is_empty() {
+        sim = with_material(sim, &bed.material.join("\n"))?;
+    }
+    if bed.heat {
         sim = heated(sim)?;
     }
     let ranks = world.as_ref().map_or(1, |w| w.size());

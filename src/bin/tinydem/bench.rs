@@ -36,6 +36,10 @@ pub struct BenchArgs {
     /// (to measure what heat costs).
     #[arg(long)]
     heat: bool,
+    /// A line added to the bed's `[material]` (repeatable), e.g. `--material
+    /// 'rolling_model = "cdt"'`: to measure what a contact model costs.
+    #[arg(long = "material")]
+    material: Vec<String>,
     /// Run one configuration in this process (used by the benchmark itself).
     #[arg(long, hide = true)]
     pub single: bool,
@@ -54,8 +58,13 @@ impl BenchArgs {
             let steps = self
                 .steps
                 .unwrap_or(tinydem::tools::bench::default_steps(n));
-            let config = (n, self.clumps, self.heat);
-            let m = tinydem::tools::bench::measure(config, steps, self.repeats, world)?;
+            let bed = tinydem::tools::bench::Bed {
+                n,
+                clumps: self.clumps,
+                heat: self.heat,
+                material: self.material.clone(),
+            };
+            let m = tinydem::tools::bench::measure(&bed, steps, self.repeats, world)?;
             if first {
                 println!("{}", m.row());
             }
@@ -104,6 +113,9 @@ impl BenchArgs {
                 }
                 if self.heat {
                     cmd.arg("--heat");
+                }
+                for line in &self.material {
+                    cmd.args(["--material", line]);
                 }
                 let out = cmd.output().context("cannot run the benchmark process")?;
                 if !out.status.success() {

@@ -154,6 +154,9 @@ fn materials_text(s: &Scenario) -> String {
         if !beyond.is_empty() {
             text += &format!("|models of material {k}:{beyond}");
         }
+        if p.surface_energy > 0.0 {
+            text += &format!("|surface energy of material {k}: {:?}", p.surface_energy);
+        }
         if p.models.normal == NormalModel::Hooke {
             let (k_n, ratio) = (p.hooke_stiffness, p.hooke_stiffness_ratio);
             text += &format!("|hooke of material {k}: {k_n:?} {ratio:?}");
@@ -163,6 +166,9 @@ fn materials_text(s: &Scenario) -> String {
         let given = named(i.models);
         if !given.is_empty() {
             text += &format!("|models of {:?}:{given}", i.materials);
+        }
+        if let Some(gamma) = i.surface_energy {
+            text += &format!("|surface energy of {:?}: {gamma:?}", i.materials);
         }
         if i.hooke_stiffness.is_some() || i.hooke_stiffness_ratio.is_some() {
             let (k_n, ratio) = (i.hooke_stiffness, i.hooke_stiffness_ratio);

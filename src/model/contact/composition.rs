@@ -26,7 +26,7 @@ impl<A: Adhesion, O: Order> Models for Composition<A, O> {
 /// Which composition a run uses, found once from its pairs of materials.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Choice {
-    /// Sjkr if any pair has k_c > 0.
+    /// Not `None` if any pair pulls (k_c > 0 or γ > 0).
     pub adhesion: AdhesionModel,
     pub springs: FrictionSprings,
     /// The rolling sub-model and what the tangential Coulomb limit clips: one each per run,
@@ -39,7 +39,7 @@ pub struct Choice {
 /// place where the scenario's names become types.
 macro_rules! with_models {
     ($choice:expr, $M:ident => $body:expr) => {{
-        use $crate::model::contact::adhesion::{NoAdhesion, Sjkr};
+        use $crate::model::contact::adhesion::{NoAdhesion, Pull};
         use $crate::model::contact::composition::Composition;
         use $crate::model::contact::friction::{AdvanceFirst, PaperOrder};
         use $crate::model::materials::FrictionSprings;
@@ -54,12 +54,12 @@ macro_rules! with_models {
                 type $M = Composition<NoAdhesion, PaperOrder>;
                 $body
             }
-            (AdhesionModel::Sjkr, FrictionSprings::AdvanceFirst) => {
-                type $M = Composition<Sjkr, AdvanceFirst>;
+            (_, FrictionSprings::AdvanceFirst) => {
+                type $M = Composition<Pull, AdvanceFirst>;
                 $body
             }
-            (AdhesionModel::Sjkr, FrictionSprings::Paper) => {
-                type $M = Composition<Sjkr, PaperOrder>;
+            (_, FrictionSprings::Paper) => {
+                type $M = Composition<Pull, PaperOrder>;
                 $body
             }
         }

@@ -135,7 +135,10 @@ impl Coefficients {
             twisting: Twisting {
                 mu_t: pair.friction_twisting,
             },
-            adhesion: Cohesion { k_c: pair.cohesion },
+            adhesion: Cohesion {
+                k_c: pair.cohesion,
+                dmt: 2.0 * std::f64::consts::PI * pair.surface_energy,
+            },
         }
     }
 
@@ -227,6 +230,7 @@ impl ContactLaw {
             friction_rolling: material.friction_rolling,
             friction_twisting: material.friction_twisting,
             cohesion: material.cohesion,
+            surface_energy: material.surface_energy,
             hooke_stiffness: material.hooke_stiffness,
             hooke_stiffness_ratio: material.hooke_stiffness_ratio,
             models: material.models,
@@ -264,8 +268,8 @@ impl ContactLaw {
                 law.pairs
                     .push(Coefficients::of_particles(m(a), m(b), &pair));
                 law.walls.push(Coefficients::against_wall(m(a), &pair));
-                if pair.models.adhesion == AdhesionModel::Sjkr && pair.cohesion > 0.0 {
-                    law.choice.adhesion = AdhesionModel::Sjkr;
+                if pair.cohesion > 0.0 || pair.surface_energy > 0.0 {
+                    law.choice.adhesion = pair.models.adhesion;
                 }
                 // One rolling model and one Coulomb test per run (the scenario refuses
                 // pairs that differ).
@@ -391,7 +395,8 @@ impl ContactLaw {
             .rolling
             .torque::<M::Order>(rolling, &at, &mut springs.u_r);
         let tau_t = coef.twisting.torque::<M::Order>(&at, &mut springs.u_t);
-        let f = M::Adhesion::add_pull(&coef.adhesion, f_n + f_s, n, radius_i, other, delta);
+        let radii = (radius_i, r_star);
+        let f = M::Adhesion::add_pull(&coef.adhesion, f_n + f_s, n, radii, other, delta);
 
         ContactForce {
             f,

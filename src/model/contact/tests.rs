@@ -139,6 +139,7 @@ mod lanes {
             friction_twisting: 0.02,
             viscosity: 1e-5,
             cohesion: k_c,
+            surface_energy: 0.0,
             hooke_stiffness: 0.0,
             hooke_stiffness_ratio: 2.0 / 7.0,
             models,
@@ -354,7 +355,7 @@ mod lanes {
 /// must then give the bits it has without adhesion, in either spring order.
 #[test]
 fn sjkr_without_cohesion_gives_the_bits_of_no_adhesion() {
-    use adhesion::{NoAdhesion, Sjkr};
+    use adhesion::{NoAdhesion, Pull};
     use composition::Composition;
     use friction::{AdvanceFirst, PaperOrder};
     let material = Material {
@@ -367,6 +368,7 @@ fn sjkr_without_cohesion_gives_the_bits_of_no_adhesion() {
         friction_twisting: 0.02,
         viscosity: 1e-5,
         cohesion: 0.0,
+        surface_energy: 0.0,
         hooke_stiffness: 0.0,
         hooke_stiffness_ratio: 2.0 / 7.0,
         models: Default::default(),
@@ -398,7 +400,7 @@ fn sjkr_without_cohesion_gives_the_bits_of_no_adhesion() {
         (compose(&mut s), s)
     };
     type Dry<O> = Composition<NoAdhesion, O>;
-    type Wet<O> = Composition<Sjkr, O>;
+    type Wet<O> = Composition<Pull, O>;
     assert_eq!(
         run(&|s| law.compose::<Dry<AdvanceFirst>, f64>(coef, 1e-3, 1e-5, other, &kin, s)),
         run(&|s| law.compose::<Wet<AdvanceFirst>, f64>(coef, 1e-3, 1e-5, other, &kin, s)),
