@@ -307,6 +307,9 @@ fn verify_runs_the_analytic_cases_and_writes_its_report() {
         "heat_relaxation",
         "heat_chain",
         "heat_sources",
+        "hooke_impact",
+        "rolling_resistance",
+        "dmt_contact",
     ] {
         assert!(out.contains(case), "missing {case} in\n{out}");
     }
