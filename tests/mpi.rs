@@ -777,7 +777,14 @@ fn sigterm_to_mpirun_keeps_a_checkpoint_that_takes_seconds_to_gather() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success());
     assert!(ended < Duration::from_secs(5), "mpirun took {ended:?}");
-    assert_eq!(err.matches("interrupted after step").count(), 1, "{err}");
+    // The parts written on SIGCONT are what must survive; with both cores busy the
+    // processes may be killed before they report SIGTERM (seen on a loaded machine), and
+    // the resume below shows that the parts suffice.
+    let reported = err.matches("interrupted after step").count();
+    assert!(
+        reported == 1 || (reported == 0 && err.contains("SIGCONT: checkpoint of step")),
+        "{err}"
+    );
     assert!(frames_out(&cut) < 4, "stopped after the run: {err}");
     resume(1, name, dir.path());
     run(1, &["run", name, "-o", "whole", "-q"], dir.path());

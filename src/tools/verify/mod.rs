@@ -12,6 +12,9 @@
 //! - `free_fall`: a sphere dropped onto a floor: fall time, impact speed, rebound height.
 //! - `wall_impact`: an elastic impact on a rigid floor against Hertz, and an oblique one in
 //!   gross sliding: the tangential speed and spin after it.
+//! - `chung_ooi_1`, `chung_ooi_4` (`chung_ooi.rs`): Chung & Ooi's (2011) test 1 (two glass and
+//!   two limestone spheres at 10 m/s each, Hertz) and test 4 (oblique impacts of an alumina
+//!   sphere on a rigid plane at 3.9 m/s, in gross sliding: tangential restitution and spin).
 //! - `chung_ooi_2`: Chung & Ooi's (2011) test 2, an elastic normal impact on a rigid plane
 //!   (two alloys): peak overlap, peak force, contact time against Hertz.
 //! - `slip_to_rolling`: a sphere launched sliding on a floor ends rolling at 5/7 of its speed.
@@ -29,6 +32,7 @@
 use anyhow::{Result, bail};
 use glam::{DQuat, DVec3};
 
+mod chung_ooi;
 mod contacts;
 mod heat;
 mod models;
@@ -132,10 +136,22 @@ pub const CASES: &[Case] = &[
         run: contacts::wall_impact,
     },
     Case {
+        name: "chung_ooi_1",
+        what: "Chung & Ooi (2011) test 1: elastic normal impact of two identical spheres",
+        quick: true,
+        run: chung_ooi::chung_ooi_1,
+    },
+    Case {
         name: "chung_ooi_2",
         what: "Chung & Ooi (2011) test 2: elastic normal impact of a sphere on a rigid plane",
         quick: true,
         run: contacts::chung_ooi_2,
+    },
+    Case {
+        name: "chung_ooi_4",
+        what: "Chung & Ooi (2011) test 4: oblique impacts on a rigid plane in gross sliding",
+        quick: true,
+        run: chung_ooi::chung_ooi_4,
     },
     Case {
         name: "slip_to_rolling",
