@@ -303,6 +303,7 @@ fn verify_runs_the_analytic_cases_and_writes_its_report() {
         "wall_impact",
         "chung_ooi_1",
         "chung_ooi_2",
+        "chung_ooi_3",
         "chung_ooi_4",
         "slip_to_rolling",
         "stacked_spheres",

@@ -13,14 +13,38 @@ use crate::model::registry::{AdhesionModel, RollingModel, TangentialCoulomb};
 pub trait Models {
     type Adhesion: Adhesion;
     type Order: Order;
+    /// Whether the slots read as constants of the run (the rolling model, the Coulomb test)
+    /// are read (`Dynamic`), or are the paper's (`Papers`), so that a run of the paper's law
+    /// is compiled without their branches.
+    const DYNAMIC: bool;
 }
 
-/// The composition of adhesion `A` and spring order `O` with the paper's other sub-models.
-pub struct Composition<A, O>(PhantomData<(A, O)>);
+/// The rolling model and Coulomb test are the paper's: compiled in.
+pub struct Papers;
+/// The rolling model and Coulomb test are read from the run's [`Choice`].
+pub struct Dynamic;
 
-impl<A: Adhesion, O: Order> Models for Composition<A, O> {
+/// Whether a composition reads the run's constants (see [`Models::DYNAMIC`]).
+pub trait Constants {
+    const DYNAMIC: bool;
+}
+
+impl Constants for Papers {
+    const DYNAMIC: bool = false;
+}
+
+impl Constants for Dynamic {
+    const DYNAMIC: bool = true;
+}
+
+/// The composition of adhesion `A`, spring order `O` and the run's constants `D` with the
+/// paper's other sub-models.
+pub struct Composition<A, O, D = Papers>(PhantomData<(A, O, D)>);
+
+impl<A: Adhesion, O: Order, D: Constants> Models for Composition<A, O, D> {
     type Adhesion = A;
     type Order = O;
+    const DYNAMIC: bool = D::DYNAMIC;
 }
 
 /// Which composition a run uses, found once from its pairs of materials.
@@ -35,31 +59,50 @@ pub struct Choice {
     pub tangential: TangentialCoulomb,
 }
 
+impl Choice {
+    /// Whether the run's constants are the paper's (its loops compiled without their
+    /// branches).
+    pub fn papers_constants(self) -> bool {
+        self.rolling == RollingModel::Spring && self.tangential == TangentialCoulomb::Total
+    }
+}
+
 /// `$body` with the type `$M` set to the composition of `$choice` (a [`Choice`]): the one
 /// place where the scenario's names become types.
 macro_rules! with_models {
     ($choice:expr, $M:ident => $body:expr) => {{
+        let choice: $crate::model::contact::composition::Choice = $choice;
+        if choice.papers_constants() {
+            $crate::model::contact::composition::with_models!(
+                @order choice, $crate::model::contact::composition::Papers, $M => $body
+            )
+        } else {
+            $crate::model::contact::composition::with_models!(
+                @order choice, $crate::model::contact::composition::Dynamic, $M => $body
+            )
+        }
+    }};
+    (@order $choice:ident, $D:ty, $M:ident => $body:expr) => {{
         use $crate::model::contact::adhesion::{NoAdhesion, Pull};
         use $crate::model::contact::composition::Composition;
         use $crate::model::contact::friction::{AdvanceFirst, PaperOrder};
         use $crate::model::materials::FrictionSprings;
         use $crate::model::registry::AdhesionModel;
-        let choice: $crate::model::contact::composition::Choice = $choice;
-        match (choice.adhesion, choice.springs) {
+        match ($choice.adhesion, $choice.springs) {
             (AdhesionModel::None, FrictionSprings::AdvanceFirst) => {
-                type $M = Composition<NoAdhesion, AdvanceFirst>;
+                type $M = Composition<NoAdhesion, AdvanceFirst, $D>;
                 $body
             }
             (AdhesionModel::None, FrictionSprings::Paper) => {
-                type $M = Composition<NoAdhesion, PaperOrder>;
+                type $M = Composition<NoAdhesion, PaperOrder, $D>;
                 $body
             }
             (_, FrictionSprings::AdvanceFirst) => {
-                type $M = Composition<Pull, AdvanceFirst>;
+                type $M = Composition<Pull, AdvanceFirst, $D>;
                 $body
             }
             (_, FrictionSprings::Paper) => {
-                type $M = Composition<Pull, PaperOrder>;
+                type $M = Composition<Pull, PaperOrder, $D>;
                 $body
             }
         }

@@ -387,7 +387,11 @@ impl ContactLaw {
             dt: T::splat(self.dt),
         };
 
-        let (rolling, tangential) = (self.choice.rolling, self.choice.tangential);
+        let (rolling, tangential) = if M::DYNAMIC {
+            (self.choice.rolling, self.choice.tangential)
+        } else {
+            (RollingModel::Spring, TangentialCoulomb::Total)
+        };
         let (f_s, tau_s) = coef
             .sliding
             .force::<M::Order>(tangential, &at, &mut springs.u_s);

@@ -1,7 +1,7 @@
 //! Chung & Ooi's (2011, Granular Matter 13:643) benchmark tests with their materials and
 //! speeds (as the published test scripts set them), against the analytic solutions their
-//! figures show: test 1 (two identical spheres, Hertz) and test 4 (oblique impacts on a rigid
-//! plane in gross sliding). Test 2 is in `contacts.rs`.
+//! figures show: test 1 (two identical spheres, Hertz), test 3 (restitution on a rigid plane)
+//! and test 4 (oblique impacts on a rigid plane in gross sliding). Test 2 is in `contacts.rs`.
 
 use anyhow::Result;
 use glam::DVec3;
@@ -77,6 +77,34 @@ pub(super) fn chung_ooi_1(setup: Setup) -> Result<Vec<Check>> {
     Ok(checks)
 }
 
+/// Test 3: a sphere of radius 2.5 mm meets a rigid plane at 3.9 m/s, frictionless, of
+/// aluminium oxide (E = 380 GPa, ν = 0.23, ρ = 4000 kg/m³) and of cast iron (100 GPa, 0.25,
+/// 7000 kg/m³), with e = 0.2, 0.4, 0.6, 0.8 and 1.0: the rebound speed over the impact speed
+/// against the restitution asked for (their figure's diagonal).
+pub(super) fn chung_ooi_3(setup: Setup) -> Result<Vec<Check>> {
+    let (r, v0, dt) = (0.0025, 3.9, 2e-9);
+    let mut checks = Vec::new();
+    for (name, e, nu, rho) in [
+        ("aluminium oxide", 3.8e11, 0.23, 4000.0),
+        ("cast iron", 1.0e11, 0.25, 7000.0),
+    ] {
+        for e_n in [0.2, 0.4, 0.6, 0.8, 1.0] {
+            let material = format!(
+                "density = {rho:e}\nyoungs_modulus = {e:e}\npoisson_ratio = {nu}\n\
+                 restitution = {e_n}\nfriction_sliding = 0.0\nfriction_rolling = 0.0"
+            );
+            let s = off_the_plane(setup, &material, dt, (r, -DVec3::Z * v0))?;
+            checks.push(Check::of(
+                "chung_ooi_3",
+                format!("{name}, e = {e_n}: restitution"),
+                "-",
+                (s.particles.v[0].z / v0, e_n, 1e-3),
+            ));
+        }
+    }
+    Ok(checks)
+}
+
 /// Test 4: a sphere of aluminium oxide (R = 2.5 mm, E = 380 GPa, ν = 0.23, ρ = 4000 kg/m³,
 /// μ = 0.092, e = 0.98) meets a rigid plane at 3.9 m/s, at angles θ from the normal. Past
 /// tan θ = 7/2 μ (1 + e) (32.5°) it slides throughout: the tangential restitution v_t'/v_t =
@@ -95,21 +123,7 @@ pub(super) fn chung_ooi_4(setup: Setup) -> Result<Vec<Check>> {
     for degrees in [40.0f64, 50.0, 60.0, 70.0, 80.0] {
         let theta = degrees.to_radians();
         let (v_n, v_t) = (speed * theta.cos(), speed * theta.sin());
-        let ball = sphere_of(
-            r,
-            DVec3::new(0.0, 0.0, r + 1e-9),
-            DVec3::new(v_t, 0.0, -v_n),
-        );
-        let mut s = simulation(setup, &material, 0.0, Some(dt), true, vec![ball])?;
-        let mut touched = false;
-        for _ in 0..10_000_000 {
-            s.step()?;
-            if s.particles.x[0].z < r {
-                touched = true;
-            } else if touched {
-                break;
-            }
-        }
+        let s = off_the_plane(setup, &material, dt, (r, DVec3::new(v_t, 0.0, -v_n)))?;
         let impulse = mu * (1.0 + e_n) * v_n;
         let check = |quantity: &str, unit, tinydem, reference, tolerance| {
             let quantity = format!("{degrees}°: {quantity}");
@@ -133,4 +147,26 @@ pub(super) fn chung_ooi_4(setup: Setup) -> Result<Vec<Check>> {
         ]);
     }
     Ok(checks)
+}
+
+/// A sphere of radius `r` touching a plane at velocity `v` (of `material`, time step `dt`),
+/// stepped until it leaves the plane again.
+fn off_the_plane(
+    setup: Setup,
+    material: &str,
+    dt: f64,
+    (r, v): (f64, DVec3),
+) -> Result<crate::engine::Simulation> {
+    let ball = sphere_of(r, DVec3::new(0.0, 0.0, r + 1e-9), v);
+    let mut s = simulation(setup, material, 0.0, Some(dt), true, vec![ball])?;
+    let mut touched = false;
+    for _ in 0..10_000_000 {
+        s.step()?;
+        if s.particles.x[0].z < r {
+            touched = true;
+        } else if touched {
+            break;
+        }
+    }
+    Ok(s)
 }

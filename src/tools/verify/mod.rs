@@ -12,8 +12,9 @@
 //! - `free_fall`: a sphere dropped onto a floor: fall time, impact speed, rebound height.
 //! - `wall_impact`: an elastic impact on a rigid floor against Hertz, and an oblique one in
 //!   gross sliding: the tangential speed and spin after it.
-//! - `chung_ooi_1`, `chung_ooi_4` (`chung_ooi.rs`): Chung & Ooi's (2011) test 1 (two glass and
-//!   two limestone spheres at 10 m/s each, Hertz) and test 4 (oblique impacts of an alumina
+//! - `chung_ooi_1`, `chung_ooi_3`, `chung_ooi_4` (`chung_ooi.rs`): Chung & Ooi's (2011) test 1
+//!   (two glass and two limestone spheres at 10 m/s each, Hertz), test 3 (restitution of
+//!   alumina and cast iron on a plane at 3.9 m/s) and test 4 (oblique impacts of an alumina
 //!   sphere on a rigid plane at 3.9 m/s, in gross sliding: tangential restitution and spin).
 //! - `chung_ooi_2`: Chung & Ooi's (2011) test 2, an elastic normal impact on a rigid plane
 //!   (two alloys): peak overlap, peak force, contact time against Hertz.
@@ -146,6 +147,12 @@ pub const CASES: &[Case] = &[
         what: "Chung & Ooi (2011) test 2: elastic normal impact of a sphere on a rigid plane",
         quick: true,
         run: contacts::chung_ooi_2,
+    },
+    Case {
+        name: "chung_ooi_3",
+        what: "Chung & Ooi (2011) test 3: normal impacts on a rigid plane at five restitutions",
+        quick: true,
+        run: chung_ooi::chung_ooi_3,
     },
     Case {
         name: "chung_ooi_4",
