@@ -350,3 +350,36 @@ fn dmt_keys_are_checked() {
     assert_eq!(again.pair(0, 0), s.pair(0, 0));
     assert_eq!(s.pair(0, 0).surface_energy, 0.1);
 }
+
+/// `check` names the models in force, and Hooke's contact time as counted here.
+#[test]
+fn check_names_the_contact_models_and_hookes_contact_time() {
+    let dir = tempfile::tempdir().unwrap();
+    let describe = |text: &str| {
+        let s = common::scenario(&format!(
+            "[geometry]\nradius_min = {R}\nradius_max = {R}\n[simulation]\nframes = 1\nsteps_per_frame = 1\n{text}"
+        ));
+        tinydem::driver::check::describe(&s, dir.path()).unwrap()
+    };
+    let paper = describe("");
+    assert!(
+        paper.contains(
+            "contact models         normal \"hertz\", rolling \"spring\", tangential_coulomb \"total\" (the paper's)"
+        ),
+        "{paper}"
+    );
+    assert!(!paper.contains("Hooke contact time"), "{paper}");
+    let hooke = describe(&format!(
+        "[material]\ndensity = {RHO}\nhooke_stiffness = 2000.0\nrolling_model = \"cdt\"\n\
+         tangential_coulomb = \"spring\"\n"
+    ));
+    let t_c = std::f64::consts::PI * (0.5 * Inertia::mass(R, RHO) / 2000.0).sqrt();
+    for line in [
+        "contact models         normal \"hooke\", rolling \"cdt\", tangential_coulomb \"spring\"\n"
+            .to_string(),
+        format!("Hooke contact time     {t_c:.6e} s = 20.0 time steps"),
+        "(1.000 x Hooke's t_c/20)".to_string(),
+    ] {
+        assert!(hooke.contains(&line), "{line} in\n{hooke}");
+    }
+}
