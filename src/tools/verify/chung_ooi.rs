@@ -6,7 +6,7 @@
 use anyhow::Result;
 use glam::DVec3;
 
-use super::{Check, Setup, simulation, sphere_of};
+use super::{Check, Setup, hertz_checks, simulation, sphere_of};
 use crate::model::integrate::Inertia;
 
 /// Test 1: two identical spheres of radius 10 mm meet head-on at 10 m/s each, elastic, of
@@ -47,32 +47,9 @@ pub(super) fn chung_ooi_1(setup: Setup) -> Result<Vec<Check>> {
             }
         }
         let (e_star, r_star, m_star, v0) = (e / (2.0 * (1.0 - nu * nu)), r / 2.0, m / 2.0, 2.0 * v);
-        let delta_m = (15.0 * m_star * v0 * v0 / (16.0 * e_star * r_star.sqrt())).powf(0.4);
-        let check = |quantity: &str, unit, tinydem, reference, tolerance| {
-            Check::of(
-                "chung_ooi_1",
-                format!("{name}: {quantity}"),
-                unit,
-                (tinydem, reference, tolerance),
-            )
-        };
-        checks.extend([
-            check("peak overlap", "m", peak_overlap, delta_m, 1e-4),
-            check(
-                "peak force",
-                "N",
-                peak_force,
-                4.0 / 3.0 * e_star * r_star.sqrt() * delta_m.powf(1.5),
-                1e-4,
-            ),
-            check(
-                "contact time",
-                "s",
-                steps as f64 * dt,
-                2.0 * 1.471_637_6 * delta_m / v0,
-                5e-4,
-            ),
-        ]);
+        let measured = (peak_overlap, peak_force, steps as f64 * dt);
+        let label = ("chung_ooi_1", name);
+        checks.extend(hertz_checks(label, measured, (e_star, r_star, m_star, v0)));
     }
     Ok(checks)
 }

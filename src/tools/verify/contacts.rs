@@ -261,33 +261,12 @@ pub(super) fn chung_ooi_2(setup: Setup) -> Result<Vec<Check>> {
             }
         }
         let e_star = e / (1.0 - nu * nu);
-        let delta_m = (15.0 * m * v0 * v0 / (16.0 * e_star * r.sqrt())).powf(0.4);
-        let check = |quantity: &str, unit, tinydem, reference, tolerance| {
-            let quantity = format!("{name}: {quantity}");
-            Check::of(
-                "chung_ooi_2",
-                quantity,
-                unit,
-                (tinydem, reference, tolerance),
-            )
-        };
-        checks.extend([
-            check("peak overlap", "m", peak_overlap, delta_m, 1e-4),
-            check(
-                "peak force",
-                "N",
-                peak_force,
-                4.0 / 3.0 * e_star * r.sqrt() * delta_m.powf(1.5),
-                1e-4,
-            ),
-            check(
-                "contact time",
-                "s",
-                steps as f64 * dt,
-                2.0 * 1.471_637_6 * delta_m / v0,
-                5e-4,
-            ),
-        ]);
+        let measured = (peak_overlap, peak_force, steps as f64 * dt);
+        checks.extend(hertz_checks(
+            ("chung_ooi_2", name),
+            measured,
+            (e_star, r, m, v0),
+        ));
     }
     Ok(checks)
 }

@@ -303,6 +303,38 @@ pub fn report(checks: &[Check]) -> String {
     out
 }
 
+/// The checks of an elastic Hertz impact of `case` (on `name`): the `measured` peak overlap,
+/// peak force and contact time against Hertz's solution for E*, R*, m* and the approach speed
+/// v0: δ_m = (15 m* v0² / (16 E* sqrt(R*)))^(2/5), F_m = 4/3 E* sqrt(R*) δ_m^(3/2),
+/// t_c = 2.943 δ_m / v0.
+fn hertz_checks(
+    (case, name): (&'static str, &str),
+    (peak_overlap, peak_force, time): (f64, f64, f64),
+    (e_star, r_star, m_star, v0): (f64, f64, f64, f64),
+) -> [Check; 3] {
+    let delta_m = (15.0 * m_star * v0 * v0 / (16.0 * e_star * r_star.sqrt())).powf(0.4);
+    let force = 4.0 / 3.0 * e_star * r_star.sqrt() * delta_m.powf(1.5);
+    let check = |quantity: &str, unit, measured, reference, tolerance| {
+        Check::of(
+            case,
+            format!("{name}: {quantity}"),
+            unit,
+            (measured, reference, tolerance),
+        )
+    };
+    [
+        check("peak overlap", "m", peak_overlap, delta_m, 1e-4),
+        check("peak force", "N", peak_force, force, 1e-4),
+        check(
+            "contact time",
+            "s",
+            time,
+            2.0 * 1.471_637_6 * delta_m / v0,
+            5e-4,
+        ),
+    ]
+}
+
 /// The spheres of the single-contact cases: radius, density, Young's modulus, Poisson's
 /// ratio (a soft glass-like grain, Table 2's scale).
 const R: f64 = 0.005;
