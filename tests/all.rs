@@ -5,6 +5,7 @@
 mod common;
 
 mod bad_inputs;
+mod beyond_touch;
 mod book;
 mod cli;
 mod clumps;

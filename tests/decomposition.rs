@@ -767,6 +767,8 @@ fn the_contact_models_split_over_processes_give_the_bits_of_one_process() {
     for models in [
         "hooke_stiffness = 300.0\ntangential_coulomb = \"spring\"\nrolling_model = \"cdt\"\n",
         "rolling_model = \"epsd2\"\nadhesion_model = \"dmt\"\nsurface_energy = 0.02\n",
+        "adhesion_model = \"jkr\"\nsurface_energy = 0.05\n",
+        "liquid_volume = 1e-10\nsurface_tension = 0.07\ncontact_angle = 20.0\n",
     ] {
         let text = silo(0.5).replace(
             "friction_twisting = 0.1\n",

@@ -2,7 +2,7 @@
 //! of them and the contact sub-models in force.
 
 use super::check::num;
-use crate::model::registry::{Named, NormalModel, RollingModel, TangentialCoulomb};
+use crate::model::registry::{AdhesionModel, Named, NormalModel, RollingModel, TangentialCoulomb};
 use crate::scenario::Scenario;
 
 /// The contact sub-models in force (where any differs from the paper's) and, with Hooke,
@@ -30,6 +30,7 @@ pub(super) fn model_lines(s: &Scenario, m_min: f64) -> String {
         first.rolling.name(),
         first.tangential.name(),
     );
+    out += &adhesion_lines(s, &pairs);
     let stiffest = (pairs.iter())
         .map(|&(a, b)| s.pair(a, b))
         .filter(|p| p.models.normal == NormalModel::Hooke)
@@ -42,6 +43,40 @@ pub(super) fn model_lines(s: &Scenario, m_min: f64) -> String {
             t_c / s.simulation.timestep,
             num(stiffest)
         );
+    }
+    out
+}
+
+/// The adhesion models in force, and each wet pair's liquid bridges.
+fn adhesion_lines(s: &Scenario, pairs: &[(u16, u16)]) -> String {
+    let mut out = String::new();
+    let mut adhesion: Vec<&str> = (pairs.iter())
+        .map(|&(a, b)| s.pair(a, b).models.adhesion)
+        .filter(|&m| m != AdhesionModel::None)
+        .map(|m| m.name())
+        .collect();
+    adhesion.sort();
+    adhesion.dedup();
+    if !adhesion.is_empty() {
+        let names: Vec<String> = adhesion.iter().map(|m| format!("\"{m}\"")).collect();
+        out += &format!("adhesion               {}\n", names.join(" and "));
+    }
+    let mut first = true;
+    for &(a, b) in pairs {
+        let l = s.pair(a, b).liquid;
+        if l.wet() {
+            out += &format!(
+                "{:<23}\"{}\" - \"{}\": volume {:e} m^3, surface tension {} N/m, contact angle {} deg, rupture at {:e} m\n",
+                if first { "liquid bridges" } else { "" },
+                s.materials[a as usize].name,
+                s.materials[b as usize].name,
+                l.volume,
+                num(l.surface_tension),
+                num(l.contact_angle),
+                l.rupture_distance()
+            );
+            first = false;
+        }
     }
     out
 }

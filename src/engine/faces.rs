@@ -160,7 +160,7 @@ impl FaceStage<'_> {
             order,
             fates,
         } = scratch;
-        self.near(owners.clone(), first, contact, store, near);
+        self.near::<M>(owners.clone(), first, contact, store, near);
         self.one_per_touch(
             first,
             (contact, store),
@@ -183,9 +183,10 @@ impl FaceStage<'_> {
 
     /// The faces within reach of the particles `owners` (their slots from `first`), each with
     /// its closest point and kinematics, into `near`; the slots of a particle are
-    /// consecutive, so are its candidates. A contact that ended forgets its springs.
+    /// consecutive, so are its candidates. A contact that ended forgets its springs; one
+    /// beyond touch (JKR, a liquid bridge) lasts while its gap is within the reach.
     #[inline]
-    fn near(
+    fn near<M: Models>(
         &self,
         owners: std::ops::Range<usize>,
         first: usize,
@@ -208,13 +209,19 @@ impl FaceStage<'_> {
             for (k, &f) in run.clone().zip(&self.partner[run]) {
                 let kl = k - first;
                 let face = &self.walls.mesh.faces[f as usize];
-                let touch = if face.certainly_beyond(body.x, body.radius + face.radius) {
+                let gap = if M::BEYOND_TOUCH && contact[kl] != NONE {
+                    let m = (self.p.material[i], self.walls.face_material[f as usize]);
+                    ContactLaw::reach::<M>(self.law.with_wall(m.0, m.1), body.radius)
+                } else {
+                    0.0
+                };
+                let touch = if face.certainly_beyond(body.x, body.radius + face.radius + gap) {
                     None
                 } else {
                     let wall = self.walls.velocity(f as usize);
                     let (d, feature) = face.separation_and_feature(body.x);
                     let (d, interior) = surface::snap(face, body.x, body.radius, d, feature);
-                    Kinematics::with_wall(&body, d, face.radius, &wall)
+                    Kinematics::with_wall_within(&body, d, face.radius, &wall, gap)
                         .map(|kin| (kin, d, interior))
                 };
                 match touch {
@@ -272,9 +279,7 @@ impl FaceStage<'_> {
                 for (c, fate) in near[a..b].iter().zip(fates.iter()) {
                     let Fate::Absorbed(s) = *fate else { continue };
                     let (k, s) = (c.slot, near[a + s].slot);
-                    let none = |e: u32| {
-                        e == NONE || store.state.get(e as usize) == ContactState::default()
-                    };
+                    let none = |e: u32| e == NONE || store.state.get(e as usize).is_first_touch();
                     if none(contact[s]) && contact[k] != NONE {
                         if contact[s] == NONE {
                             // The absorbing contact takes over the entry.

@@ -52,20 +52,24 @@ impl LoadScales {
     pub fn of(s: &Scenario) -> LoadScales {
         let r_max = LoadScales::largest_radius(s);
         let mut stiffest: f64 = 0.0;
+        let bridge = |tension: f64| 4.0 * std::f64::consts::PI * tension / r_max;
         for m in &s.materials {
             let m = &m.properties;
             let e_star = m.youngs_modulus / (1.0 - m.poisson_ratio * m.poisson_ratio);
             stiffest = stiffest.max(e_star).max(std::f64::consts::PI * m.cohesion);
             // Hooke: k_n R_max at an overlap of R_max.
             stiffest = stiffest.max(m.hooke_stiffness / r_max);
-            // DMT: 2 pi gamma R_max.
+            // DMT: 2 pi gamma R_max (JKR's pull-off force is less).
             stiffest = stiffest.max(2.0 * std::f64::consts::PI * m.surface_energy / r_max);
+            // A liquid bridge: 4 pi gamma_l R_max.
+            stiffest = stiffest.max(bridge(m.liquid.surface_tension));
         }
         for i in &s.interactions {
             stiffest = stiffest.max(std::f64::consts::PI * i.cohesion.unwrap_or(0.0));
             stiffest = stiffest.max(i.hooke_stiffness.unwrap_or(0.0) / r_max);
             let gamma = i.surface_energy.unwrap_or(0.0);
             stiffest = stiffest.max(2.0 * std::f64::consts::PI * gamma / r_max);
+            stiffest = stiffest.max(bridge(i.liquid.surface_tension.unwrap_or(0.0)));
         }
         let largest = (LoadScales::ROOM * stiffest * r_max * r_max).max(f64::MIN_POSITIVE);
         let (force, torque) = (

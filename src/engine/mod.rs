@@ -53,7 +53,6 @@ mod split;
 mod walls;
 use crate::engine::spawn::{Spawner, SpawnerState};
 use crate::geometry::surface::{self, Candidate, Fate};
-use crate::model::contact_state::ContactState;
 use crate::model::springs::Springs;
 use crate::scenario::{Scenario, TagRegion};
 use loads::Load;

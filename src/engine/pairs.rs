@@ -146,7 +146,12 @@ fn wrapped<M: Models>(
                     w: p.w[k],
                 };
                 let (bi, bj) = (body(i, p.x[i], DVec3::ZERO), body(j, p.x[j] + shift, dv));
-                let Some(kin) = Kinematics::between_particles(&bi, &bj) else {
+                // An open contact beyond touch lasts within its reach.
+                let gap = match contact[k] {
+                    NONE => 0.0,
+                    _ => stage_reach::<M>(law, p, i, j),
+                };
+                let Some(kin) = Kinematics::between_particles_within(&bi, &bj, gap) else {
                     if contact[k] != NONE {
                         store.close(contact[k]);
                         contact[k] = NONE;
@@ -225,7 +230,7 @@ impl PairStage<'_> {
             store,
         } = slab;
         let mut next_loads = next.map(|n| (n.owners.start, n.loads));
-        self.touching(owners.clone(), first, contact, store, touching);
+        self.touching::<M>(owners.clone(), first, contact, store, touching);
         let at = (owners.start, owners.end);
         for group in touching.chunks(WIDTH) {
             self.group::<M>(group, store, (at, &mut *loads, &mut next_loads), found);
@@ -235,9 +240,9 @@ impl PairStage<'_> {
     /// The touching pairs of owners `owners` (their slots from `first`): the particle of the
     /// lower id (body i of the law, whatever the storage order), the other, and the
     /// contact's entry in the slab's store (opened at first touch, closed when the pair
-    /// parts).
+    /// parts, or, beyond touch, when its gap passes the adhesion's reach).
     #[inline]
-    fn touching(
+    fn touching<M: Models>(
         &self,
         owners: std::ops::Range<usize>,
         first: usize,
@@ -258,7 +263,12 @@ impl PairStage<'_> {
             for kl in run {
                 let j = self.partner[first + kl] as usize;
                 let reach = ri + self.p.radius[j];
-                let touches = (xi - self.p.x[j]).length_squared() < reach * reach;
+                let dist2 = (xi - self.p.x[j]).length_squared();
+                let mut touches = dist2 < reach * reach;
+                if M::BEYOND_TOUCH && !touches && contact[kl] != NONE {
+                    let within = reach + stage_reach::<M>(self.law, self.p, i, j);
+                    touches = dist2 < within * within;
+                }
                 if touches != (contact[kl] != NONE) {
                     if touches {
                         contact[kl] = store.open();
@@ -349,6 +359,18 @@ impl PairStage<'_> {
             }
         }
     }
+}
+
+/// The gap at which an open contact of particles `i` and `j` ends under the sub-models `M`
+/// (0: at touch).
+#[inline]
+fn stage_reach<M: Models>(law: &ContactLaw, p: &Particles, i: usize, j: usize) -> f64 {
+    if !M::BEYOND_TOUCH {
+        return 0.0;
+    }
+    let (r_i, r_j) = (p.radius[i], p.radius[j]);
+    let coef = law.pair(p.material[i], p.material[j]);
+    ContactLaw::reach::<M>(coef, r_i * r_j / (r_i + r_j))
 }
 
 /// The load of a particle of this slab (from owner `base` to `owned`) or of the next one.

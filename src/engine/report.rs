@@ -69,14 +69,17 @@ impl Simulation {
                 v: p.v[j] + dv,
                 ..self.body_of(j)
             };
-            let Some(kin) = Kinematics::between_particles(&self.body_of(i), &bj) else {
+            // An open contact may lie beyond touch (JKR, a liquid bridge), within its reach.
+            let coef = self.model.law.pair(p.material[i], p.material[j]);
+            let r_star = p.radius[i] * p.radius[j] / (p.radius[i] + p.radius[j]);
+            let gap = self.model.law.reach_of(coef, r_star);
+            let Some(kin) = Kinematics::between_particles_within(&self.body_of(i), &bj, gap) else {
                 continue;
             };
             let other = Other::Particle {
                 r: p.radius[j],
                 m: self.mass_of(j),
             };
-            let coef = self.model.law.pair(p.material[i], p.material[j]);
             let with = Partner::Particle(p.id[j]);
             out.push(self.record(i, other, &kin, coef, springs, with));
         }
@@ -93,13 +96,14 @@ impl Simulation {
             let b = self.body_of(i);
             let (d, feature) = face.separation_and_feature(b.x);
             let (d, _) = surface::snap(face, b.x, b.radius, d, feature);
-            let Some(kin) = Kinematics::with_wall(&b, d, face.radius, &wall) else {
-                continue;
-            };
             let coef = self
                 .model
                 .law
                 .with_wall(p.material[i], self.walls.face_material[f]);
+            let gap = self.model.law.reach_of(coef, b.radius);
+            let Some(kin) = Kinematics::with_wall_within(&b, d, face.radius, &wall, gap) else {
+                continue;
+            };
             out.push(self.record(i, Other::Wall, &kin, coef, springs, Partner::Face(f)));
         }
         out

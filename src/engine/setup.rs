@@ -432,11 +432,14 @@ impl Simulation {
                 }
             }
         }
-        let skin = scenario.simulation.skin * g.radius_max;
+        let law = contact_law(&scenario);
+        // The lists' skin covers the gap at which a contact beyond touch (JKR, a liquid
+        // bridge) ends, so that its pair stays listed while it lasts.
+        let skin = (scenario.simulation.skin * g.radius_max).max(law.largest_reach(max_radius));
         let face_grid = FaceGrid::of(&mesh.faces, max_radius, skin);
         let mut sim = Simulation {
             model: Model {
-                law: contact_law(&scenario),
+                law,
                 densities: scenario
                     .materials
                     .iter()
@@ -464,6 +467,10 @@ impl Simulation {
             scenario,
             particles,
         };
+        if sim.model.law.beyond_touch() {
+            // An open contact is kept while it lasts, whatever its springs.
+            sim.neighbours.state.activate("beyond");
+        }
         sim.sum_wall_loads();
         sim.start_heat()?;
         Ok(sim)

@@ -14,8 +14,22 @@ contact_fields! {
         springs: Springs;
     }
     optional {
+        /// Whether the contact is open in a run whose contacts outlast touch (JKR's neck, a
+        /// liquid bridge): an open contact there is kept, springs or not, while its gap is
+        /// within the adhesion's reach.
+        beyond: bool;
         #[cfg(test)]
         /// The steps the contact has touched (the state of the tests' sub-model).
         touches: u32;
+    }
+}
+
+impl ContactState {
+    /// Whether nothing is kept but that the contact is open (a first touch).
+    pub fn is_first_touch(&self) -> bool {
+        ContactState {
+            beyond: false,
+            ..*self
+        } == ContactState::default()
     }
 }

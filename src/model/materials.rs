@@ -25,8 +25,11 @@ pub struct Material {
     /// k_c [M/LT²] = [J/m³]: the simplified JKR cohesion, a pull k_c A over the contact
     /// area A.
     pub cohesion: f64,
-    /// γ [J/m²], the work of adhesion of DMT (`adhesion_model = "dmt"`; 0 otherwise).
+    /// γ [J/m²], the work of adhesion of DMT and JKR (`adhesion_model = "dmt" | "jkr"`;
+    /// 0 otherwise).
     pub surface_energy: f64,
+    /// The liquid of its bridges (none: volume 0).
+    pub liquid: Liquid,
     /// k_n [M/T²] of Hooke's normal sub-model (`normal_model = "hooke"`; 0 otherwise).
     pub hooke_stiffness: f64,
     /// k_s / k_n of Hooke's normal sub-model (2/7 by default).
@@ -35,6 +38,31 @@ pub struct Material {
     pub models: ContactModels,
     /// k, c, T_0, q_V, h: heat transfer (conducts where k > 0).
     pub thermal: Thermal,
+}
+
+/// The liquid that wets a material's contacts: each contact, once touched, holds a bridge of
+/// `volume` (Willett et al. 2000's capillary force) until its gap passes the rupture
+/// distance (Lian et al. 1993). Volume 0: dry.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Liquid {
+    /// V \[L³\], the liquid of one bridge (`liquid_volume`).
+    pub volume: f64,
+    /// γ_l [M/T²] = [N/m] (`surface_tension`).
+    pub surface_tension: f64,
+    /// θ in degrees (`contact_angle`), from 0 to 90.
+    pub contact_angle: f64,
+}
+
+impl Liquid {
+    /// Whether it makes bridges.
+    pub fn wet(&self) -> bool {
+        self.volume > 0.0
+    }
+
+    /// The gap at which a bridge breaks, (1 + θ/2) V^(1/3) (Lian et al. 1993, θ in radians).
+    pub fn rupture_distance(&self) -> f64 {
+        (1.0 + 0.5 * self.contact_angle.to_radians()) * self.volume.cbrt()
+    }
 }
 
 /// When a friction spring is advanced by Δt v relative to the force taken from it
@@ -67,8 +95,10 @@ pub struct PairCoefficients {
     pub friction_rolling: f64,
     pub friction_twisting: f64,
     pub cohesion: f64,
-    /// γ of DMT [J/m²] (0 unless the pair's adhesion is DMT).
+    /// γ of DMT and JKR [J/m²] (0 unless the pair's adhesion is one of them).
     pub surface_energy: f64,
+    /// The liquid of the pair's bridges (none: volume 0).
+    pub liquid: Liquid,
     /// Hooke's k_n and k_s / k_n (`normal_model = "hooke"`).
     pub hooke_stiffness: f64,
     pub hooke_stiffness_ratio: f64,

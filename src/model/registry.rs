@@ -65,6 +65,7 @@ registry! {
         None = "none": "no adhesion",
         Sjkr = "sjkr": "the simplified JKR cohesion, a pull cohesion x area",
         Dmt = "dmt": "the DMT pull 2 pi surface_energy R* while in contact",
+        Jkr = "jkr": "JKR's elastic adhesion, the contact kept until the pull-off separation",
     }
 }
 
@@ -129,12 +130,13 @@ mod tests {
 
     #[test]
     fn an_unknown_name_is_refused_with_the_known_ones() {
-        let e = AdhesionModel::parse("jkr").unwrap_err();
+        let e = AdhesionModel::parse("capillary").unwrap_err();
         assert_eq!(
             e,
-            "adhesion_model = \"jkr\" is not a known model: it must be \"none\" (no adhesion) \
+            "adhesion_model = \"capillary\" is not a known model: it must be \"none\" (no adhesion) \
              or \"sjkr\" (the simplified JKR cohesion, a pull cohesion x area) or \"dmt\" (the DMT \
-             pull 2 pi surface_energy R* while in contact)"
+             pull 2 pi surface_energy R* while in contact) or \"jkr\" (JKR's elastic adhesion, the \
+             contact kept until the pull-off separation)"
         );
         assert!(NormalModel::parse("Hertz").is_err(), "names are exact");
     }

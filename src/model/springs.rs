@@ -14,6 +14,17 @@ pub struct Springs<T: Lanes = f64> {
     pub u_t: T,
 }
 
+impl<T: Lanes> Springs<T> {
+    /// Zero in the lanes of `mask` (a contact that starts afresh).
+    #[inline(always)]
+    pub fn forget_where(&mut self, mask: T::Mask) {
+        let zero = T::splat_vec(glam::DVec3::ZERO);
+        self.u_s = T::pick_vec(mask, || zero, || self.u_s);
+        self.u_r = T::pick_vec(mask, || zero, || self.u_r);
+        self.u_t = T::pick(mask, || T::splat(0.0), || self.u_t);
+    }
+}
+
 /// u_s, u_r, u_t: 7 numbers.
 impl Value for Springs {
     const SIZE: usize = 56;

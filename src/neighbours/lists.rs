@@ -19,12 +19,17 @@ pub struct Store {
 }
 
 impl Store {
-    /// A new entry, in the state of a first touch (zero springs).
+    /// A new entry, in the state of a first touch (zero springs; open, in a run whose
+    /// contacts outlast touch).
     #[inline]
     pub fn open(&mut self) -> u32 {
+        let first = ContactState {
+            beyond: self.state.active.beyond,
+            ..ContactState::default()
+        };
         match self.free.pop() {
             Some(k) => {
-                self.state.set(k as usize, ContactState::default());
+                self.state.set(k as usize, first);
                 k
             }
             None => {
@@ -32,7 +37,7 @@ impl Store {
                     // A little room at a time: contacts come and go, the count changes slowly.
                     self.state.reserve_exact(self.state.len() / 8 + 8);
                 }
-                self.state.push(ContactState::default());
+                self.state.push(first);
                 (self.state.len() - 1) as u32
             }
         }

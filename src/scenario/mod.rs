@@ -64,7 +64,7 @@ mod text;
 mod until;
 mod validate;
 pub use clumps::{ClumpTemplate, MassSource};
-pub use models::{GivenModels, beyond_defaults};
+pub use models::{GivenLiquid, GivenModels, beyond_defaults};
 pub use output::{Formats, Gather};
 pub use resolved::changes;
 pub use text::MOST_SCENARIO_BYTES;
@@ -187,8 +187,10 @@ pub struct Interaction {
     pub friction_rolling: Option<f64>,
     pub friction_twisting: Option<f64>,
     pub cohesion: Option<f64>,
-    /// DMT's γ for the pair.
+    /// DMT's or JKR's γ for the pair.
     pub surface_energy: Option<f64>,
+    /// The liquid of the pair's bridges, key by key.
+    pub liquid: GivenLiquid,
     /// Hooke's k_n and k_s / k_n for the pair.
     pub hooke_stiffness: Option<f64>,
     pub hooke_stiffness_ratio: Option<f64>,
@@ -198,7 +200,7 @@ pub struct Interaction {
 
 impl Interaction {
     /// Each coefficient with its key and symbol (given or not), in the order of the file.
-    pub fn coefficients(&self) -> [(&'static str, &'static str, Option<f64>); 8] {
+    pub fn coefficients(&self) -> [(&'static str, &'static str, Option<f64>); 11] {
         [
             ("restitution", "e_n", self.restitution),
             ("friction_sliding", "mu_s", self.friction_sliding),
@@ -206,6 +208,9 @@ impl Interaction {
             ("friction_twisting", "mu_t", self.friction_twisting),
             ("cohesion", "k_c", self.cohesion),
             ("surface_energy", "gamma", self.surface_energy),
+            ("liquid_volume", "V", self.liquid.volume),
+            ("surface_tension", "gamma_l", self.liquid.surface_tension),
+            ("contact_angle", "theta", self.liquid.contact_angle),
             ("hooke_stiffness", "k_n", self.hooke_stiffness),
             (
                 "hooke_stiffness_ratio",
@@ -579,14 +584,17 @@ impl Scenario {
             // A pair without adhesion (named so in its [[interactions]]) pulls not.
             cohesion: match models.adhesion {
                 AdhesionModel::Sjkr => cohesion,
-                AdhesionModel::None | AdhesionModel::Dmt => 0.0,
+                AdhesionModel::None | AdhesionModel::Dmt | AdhesionModel::Jkr => 0.0,
             },
             surface_energy: match models.adhesion {
-                AdhesionModel::Dmt => given.and_then(|i| i.surface_energy).unwrap_or_else(|| {
-                    models::mean_of([m, n], models::is_dmt, |m| m.surface_energy)
-                }),
+                AdhesionModel::Dmt | AdhesionModel::Jkr => {
+                    given.and_then(|i| i.surface_energy).unwrap_or_else(|| {
+                        models::mean_of([m, n], models::has_surface_energy, |m| m.surface_energy)
+                    })
+                }
                 AdhesionModel::None | AdhesionModel::Sjkr => 0.0,
             },
+            liquid: given.map(|i| i.liquid).unwrap_or_default().over([m, n]),
             hooke_stiffness: given.and_then(|i| i.hooke_stiffness).unwrap_or_else(|| {
                 models::mean_of([m, n], models::is_hooke, |m| m.hooke_stiffness)
             }),

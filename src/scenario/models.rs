@@ -6,7 +6,7 @@ use anyhow::{Result, anyhow, bail};
 
 use super::Scenario;
 use super::validate::Range;
-use crate::model::materials::Material;
+use crate::model::materials::{Liquid, Material, PairCoefficients};
 use crate::model::registry::{
     AdhesionModel, ContactModels, Named, NormalModel, RollingModel, TangentialCoulomb,
 };
@@ -48,17 +48,31 @@ impl GivenModels {
         surface_energy: f64,
     ) -> Result<ContactModels> {
         let adhesion = match self.adhesion {
-            Some(AdhesionModel::None | AdhesionModel::Dmt) if cohesion > 0.0 => bail!(
-                "{table} adhesion_model = \"{}\" contradicts cohesion = {cohesion}: drop one of them",
-                self.adhesion.unwrap_or_default().name()
-            ),
-            Some(AdhesionModel::Dmt) if surface_energy <= 0.0 => bail!(
-                "{table} adhesion_model = \"dmt\" needs surface_energy > 0 (the work of \
-                 adhesion gamma, J/m^2)"
-            ),
-            Some(AdhesionModel::None | AdhesionModel::Sjkr) | None if surface_energy > 0.0 => {
-                bail!("{table} surface_energy = {surface_energy} needs adhesion_model = \"dmt\"")
+            Some(AdhesionModel::None | AdhesionModel::Dmt | AdhesionModel::Jkr)
+                if cohesion > 0.0 =>
+            {
+                bail!(
+                    "{table} adhesion_model = \"{}\" contradicts cohesion = {cohesion}: drop one of them",
+                    self.adhesion.unwrap_or_default().name()
+                )
             }
+            Some(model @ (AdhesionModel::Dmt | AdhesionModel::Jkr)) if surface_energy <= 0.0 => {
+                bail!(
+                    "{table} adhesion_model = \"{}\" needs surface_energy > 0 (the work of \
+                     adhesion gamma, J/m^2)",
+                    model.name()
+                )
+            }
+            Some(AdhesionModel::None | AdhesionModel::Sjkr) | None if surface_energy > 0.0 => {
+                bail!(
+                    "{table} surface_energy = {surface_energy} needs adhesion_model = \"dmt\" \
+                     or \"jkr\""
+                )
+            }
+            Some(AdhesionModel::Jkr) if self.normal == Some(NormalModel::Hooke) => bail!(
+                "{table} adhesion_model = \"jkr\" needs Hertz's normal model: JKR's contact \
+                 area is Hertz's with adhesion"
+            ),
             Some(model) => model,
             None if cohesion > 0.0 => AdhesionModel::Sjkr,
             None => AdhesionModel::None,
@@ -157,9 +171,74 @@ pub fn is_hooke(m: &Material) -> bool {
     m.models.normal == NormalModel::Hooke
 }
 
-/// Whether a material adheres by DMT.
-pub fn is_dmt(m: &Material) -> bool {
-    m.models.adhesion == AdhesionModel::Dmt
+/// Whether a material adheres by a surface energy (DMT or JKR).
+pub fn has_surface_energy(m: &Material) -> bool {
+    matches!(m.models.adhesion, AdhesionModel::Dmt | AdhesionModel::Jkr)
+}
+
+/// Whether a material's contacts make liquid bridges.
+pub fn is_wet(m: &Material) -> bool {
+    m.liquid.wet()
+}
+
+/// The liquid keys of a table, `liquid_volume` (V, m³ per bridge), `surface_tension`
+/// (N/m) and `contact_angle` (deg, in [0, 90]), checked; those of a material need each
+/// other (a volume with a surface tension, a tension or angle with a volume).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct GivenLiquid {
+    pub volume: Option<f64>,
+    pub surface_tension: Option<f64>,
+    pub contact_angle: Option<f64>,
+}
+
+impl GivenLiquid {
+    /// The keys of table `table`, checked.
+    pub(super) fn read(table: &str, [volume, tension, angle]: [Option<f64>; 3]) -> Result<Self> {
+        let check = |key: &str, x: Option<f64>, range: Range| {
+            x.map(|x| super::validate::check(&format!("{table} {key}"), x, range))
+                .transpose()
+        };
+        Ok(GivenLiquid {
+            volume: check("liquid_volume", volume, Range::NonNegative)?,
+            surface_tension: check("surface_tension", tension, Range::NonNegative)?,
+            contact_angle: check("contact_angle", angle, Range::Closed(0.0, 90.0))?,
+        })
+    }
+
+    /// A material's liquid: dry unless a volume is given, which needs a surface tension.
+    pub(super) fn of_material(self, table: &str) -> Result<Liquid> {
+        let liquid = Liquid {
+            volume: self.volume.unwrap_or(0.0),
+            surface_tension: self.surface_tension.unwrap_or(0.0),
+            contact_angle: self.contact_angle.unwrap_or(0.0),
+        };
+        if liquid.wet() && liquid.surface_tension <= 0.0 {
+            bail!(
+                "{table} liquid_volume = {} needs surface_tension > 0 (N/m) for its bridges",
+                liquid.volume
+            );
+        }
+        if !liquid.wet() && (self.surface_tension.is_some() || self.contact_angle.is_some()) {
+            bail!(
+                "{table} surface_tension and contact_angle describe liquid bridges: give \
+                 liquid_volume > 0 (m^3 per bridge) too"
+            );
+        }
+        Ok(liquid)
+    }
+
+    /// The liquid of a pair of materials `m`, `n` with these keys given for it: each key
+    /// given, or the mean over the wet ones.
+    pub fn over(self, [m, n]: [&Material; 2]) -> Liquid {
+        let mean = |f: fn(&Liquid) -> f64| mean_of([m, n], is_wet, |m| f(&m.liquid));
+        Liquid {
+            volume: self.volume.unwrap_or_else(|| mean(|l| l.volume)),
+            surface_tension: (self.surface_tension).unwrap_or_else(|| mean(|l| l.surface_tension)),
+            contact_angle: self
+                .contact_angle
+                .unwrap_or_else(|| mean(|l| l.contact_angle)),
+        }
+    }
 }
 
 /// The mean of `f` over those of `materials` that have a sub-model (`has`; of both if
@@ -189,6 +268,7 @@ impl Scenario {
         let n = self.materials.len() as u16;
         let name = |a: u16| &self.materials[a as usize].name;
         let (mut rolling, mut tangential) = (Vec::new(), Vec::new());
+        let (mut jkr, mut wet) = (false, false);
         for a in 0..n {
             for b in a..n {
                 let (m, o) = (
@@ -232,20 +312,48 @@ impl Scenario {
                         name(b)
                     );
                 }
-                if pair.models.adhesion == AdhesionModel::Dmt && pair.surface_energy <= 0.0 {
-                    bail!(
-                        "the contacts of \"{}\" and \"{}\" follow DMT without a surface energy: \
-                         give surface_energy in their [[interactions]]",
-                        name(a),
-                        name(b)
-                    );
-                }
+                self.pair_models_hold(&pair, (name(a), name(b)))?;
+                jkr |= pair.models.adhesion == AdhesionModel::Jkr;
+                wet |= pair.liquid.wet();
                 rolling.push((pair.models.rolling, (a, b)));
                 tangential.push((pair.models.tangential, (a, b)));
             }
         }
+        if jkr && wet {
+            bail!(
+                "JKR and liquid bridges in one run: the law keeps one kind of contact beyond \
+                 touch per run; choose one"
+            );
+        }
         one_per_run(&rolling, &name)?;
         one_per_run(&tangential, &name)
+    }
+
+    /// What a pair's coefficients need for its sub-models (`names`: the materials').
+    fn pair_models_hold(&self, pair: &PairCoefficients, names: (&String, &String)) -> Result<()> {
+        let (a, b) = names;
+        let adhesion = pair.models.adhesion;
+        if matches!(adhesion, AdhesionModel::Dmt | AdhesionModel::Jkr) && pair.surface_energy <= 0.0
+        {
+            bail!(
+                "the contacts of \"{a}\" and \"{b}\" follow {} without a surface energy: \
+                 give surface_energy in their [[interactions]]",
+                adhesion.name().to_uppercase()
+            );
+        }
+        if adhesion == AdhesionModel::Jkr && pair.models.normal == NormalModel::Hooke {
+            bail!(
+                "the contacts of \"{a}\" and \"{b}\" follow JKR and Hooke: JKR needs Hertz's \
+                 normal model (name normal_model = \"hertz\" in their [[interactions]])"
+            );
+        }
+        if pair.liquid.wet() && pair.liquid.surface_tension <= 0.0 {
+            bail!(
+                "the liquid bridges of \"{a}\" and \"{b}\" have no surface tension: give \
+                 surface_tension (N/m) in their [[interactions]]"
+            );
+        }
+        Ok(())
     }
 }
 

@@ -230,6 +230,9 @@ pub(super) struct RawGeometry {
 pub(super) struct RawMaterial {
     pub(super) cohesion: Option<f64>,
     pub(super) surface_energy: Option<f64>,
+    pub(super) liquid_volume: Option<f64>,
+    pub(super) surface_tension: Option<f64>,
+    pub(super) contact_angle: Option<f64>,
     pub(super) hooke_stiffness: Option<f64>,
     pub(super) hooke_stiffness_ratio: Option<f64>,
     pub(super) normal_model: Option<String>,
@@ -263,6 +266,9 @@ impl RawMaterial {
             || self.friction_twisting.is_some()
             || self.cohesion.is_some()
             || self.surface_energy.is_some()
+            || self.liquid_volume.is_some()
+            || self.surface_tension.is_some()
+            || self.contact_angle.is_some()
             || self.hooke_stiffness.is_some()
             || self.hooke_stiffness_ratio.is_some()
             || self.normal_model.is_some()
@@ -288,6 +294,9 @@ pub(super) struct RawNamedMaterial {
     pub(super) name: String,
     pub(super) cohesion: Option<f64>,
     pub(super) surface_energy: Option<f64>,
+    pub(super) liquid_volume: Option<f64>,
+    pub(super) surface_tension: Option<f64>,
+    pub(super) contact_angle: Option<f64>,
     pub(super) hooke_stiffness: Option<f64>,
     pub(super) hooke_stiffness_ratio: Option<f64>,
     pub(super) normal_model: Option<String>,
@@ -321,6 +330,9 @@ impl From<RawNamedMaterial> for RawMaterial {
             viscosity: None,
             cohesion: m.cohesion,
             surface_energy: m.surface_energy,
+            liquid_volume: m.liquid_volume,
+            surface_tension: m.surface_tension,
+            contact_angle: m.contact_angle,
             hooke_stiffness: m.hooke_stiffness,
             hooke_stiffness_ratio: m.hooke_stiffness_ratio,
             normal_model: m.normal_model,
@@ -342,6 +354,9 @@ pub(super) struct RawInteraction {
     pub(super) materials: [String; 2],
     pub(super) cohesion: Option<f64>,
     pub(super) surface_energy: Option<f64>,
+    pub(super) liquid_volume: Option<f64>,
+    pub(super) surface_tension: Option<f64>,
+    pub(super) contact_angle: Option<f64>,
     pub(super) hooke_stiffness: Option<f64>,
     pub(super) hooke_stiffness_ratio: Option<f64>,
     pub(super) normal_model: Option<String>,

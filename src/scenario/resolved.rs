@@ -74,6 +74,12 @@ impl Scenario {
             if m.surface_energy > 0.0 {
                 let _ = writeln!(o, "surface_energy = {}", num(m.surface_energy));
             }
+            if m.liquid.wet() {
+                let l = &m.liquid;
+                let _ = writeln!(o, "liquid_volume = {}", num(l.volume));
+                let _ = writeln!(o, "surface_tension = {}", num(l.surface_tension));
+                let _ = writeln!(o, "contact_angle = {}", num(l.contact_angle));
+            }
             if m.models.normal == NormalModel::Hooke {
                 let _ = writeln!(o, "hooke_stiffness = {}", num(m.hooke_stiffness));
                 let _ = writeln!(

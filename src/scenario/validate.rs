@@ -7,7 +7,7 @@ use anyhow::{Context, Result, bail};
 use glam::DVec3;
 
 use super::meshes::meshes;
-use super::models::Hooke;
+use super::models::{GivenLiquid, Hooke};
 use super::raw::*;
 use super::spawn::spawn;
 use super::*;
@@ -95,6 +95,8 @@ fn material(table: &str, m: RawMaterial, viscosity: f64) -> Result<Material> {
         m.surface_energy.unwrap_or(0.0),
         Range::NonNegative,
     )?;
+    let liquid = GivenLiquid::read(table, [m.liquid_volume, m.surface_tension, m.contact_angle])?
+        .of_material(table)?;
     let thermal = super::heat::thermal(table, &m)?;
     let names = [
         m.normal_model,
@@ -142,6 +144,7 @@ fn material(table: &str, m: RawMaterial, viscosity: f64) -> Result<Material> {
         viscosity,
         cohesion,
         surface_energy,
+        liquid,
         hooke_stiffness: hooke.stiffness.unwrap_or(0.0),
         hooke_stiffness_ratio: hooke.ratio.unwrap_or(super::models::HOOKE_RATIO),
         models: given.of_material(table, cohesion, surface_energy)?,
@@ -455,6 +458,10 @@ fn interactions(
             ],
         )?;
         let hooke = Hooke::read(&table, [i.hooke_stiffness, i.hooke_stiffness_ratio])?;
+        let liquid = GivenLiquid::read(
+            &table,
+            [i.liquid_volume, i.surface_tension, i.contact_angle],
+        )?;
         hooke.choose(&table, &mut models.normal)?;
         if models.adhesion == Some(AdhesionModel::None) && cohesion.is_some_and(|k_c| k_c > 0.0) {
             bail!(
@@ -470,6 +477,7 @@ fn interactions(
             friction_twisting: opt("friction_twisting", i.friction_twisting, Range::NonNegative)?,
             cohesion,
             surface_energy,
+            liquid,
             hooke_stiffness: hooke.stiffness,
             hooke_stiffness_ratio: hooke.ratio,
             models,

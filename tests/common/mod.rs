@@ -26,6 +26,53 @@ pub fn scenario_at(text: &str, path: &Path) -> Scenario {
     Scenario::parse(text, path).expect("valid test scenario")
 }
 
+/// A simulation of `particles`, all of radius `radius`, with the `[material]` lines
+/// `material`, gravity `g` along -z, the mesh `off` (OFF text; none if empty) and the time
+/// step `dt`; no spawning.
+pub fn single_grains(
+    radius: f64,
+    material: &str,
+    (g, off): (f64, &str),
+    dt: f64,
+    particles: Vec<Particle>,
+) -> Simulation {
+    let s = scenario(&format!(
+        "[geometry]\nradius_min = {radius}\nradius_max = {radius}\nmesh_radii = [0.0]\n\
+         [material]\n{material}\n\
+         [kinetics]\ngravity = [0.0, 0.0, {}]\n\
+         [simulation]\ntimestep = {dt:e}\nmax_particles = 0\nspawn_attempts = 0\n",
+        -g
+    ));
+    let mesh = if off.is_empty() {
+        tinydem::geometry::mesh::Mesh::default()
+    } else {
+        tinydem::geometry::mesh::Mesh::parse_off(off, "mesh", &s.geometry.mesh_radii).unwrap()
+    };
+    let particles = particles.into_iter().collect();
+    Simulation::from_parts(s, mesh, particles).unwrap()
+}
+
+/// 200 grains poured into the silo for 3000 steps with the `[material]` lines `models`
+/// (restitution 0.3, μ_s 0.5 before them) on `threads` threads with the skin `skin`: the
+/// grains in id order and the number of contacts at the end.
+pub fn silo_pour(models: &str, threads: usize, skin: f64) -> (Vec<Particle>, usize) {
+    let text = format!(
+        "[geometry]\nradius_min = 0.002\nradius_max = 0.003\nmesh = \"stages/silo.off\"\nmesh_radii = [0.0]\n\
+         spawn_min = [-0.03, -0.03, 0.02]\nspawn_max = [0.03, 0.03, 0.1]\n\
+         [material]\nrestitution = 0.3\nfriction_sliding = 0.5\n{models}\n\
+         [simulation]\nmax_particles = 200\nskin = {skin}\n"
+    );
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    pool.install(move || {
+        let s = simulate(&text, 3000);
+        let by_id = s.particles.iter_by_id().map(|e| e.1).collect();
+        (by_id, s.held_contacts().len())
+    })
+}
+
 /// A sphere of radius `radius` at `x` with velocity `v` and spin `w`, unrotated, tag and
 /// material 0.
 pub fn sphere(radius: f64, x: DVec3, v: DVec3, w: DVec3) -> Particle {

@@ -157,6 +157,9 @@ fn materials_text(s: &Scenario) -> String {
         if p.surface_energy > 0.0 {
             text += &format!("|surface energy of material {k}: {:?}", p.surface_energy);
         }
+        if p.liquid.wet() {
+            text += &format!("|liquid of material {k}: {:?}", p.liquid);
+        }
         if p.models.normal == NormalModel::Hooke {
             let (k_n, ratio) = (p.hooke_stiffness, p.hooke_stiffness_ratio);
             text += &format!("|hooke of material {k}: {k_n:?} {ratio:?}");
@@ -169,6 +172,9 @@ fn materials_text(s: &Scenario) -> String {
         }
         if let Some(gamma) = i.surface_energy {
             text += &format!("|surface energy of {:?}: {gamma:?}", i.materials);
+        }
+        if i.liquid != Default::default() {
+            text += &format!("|liquid of {:?}: {:?}", i.materials, i.liquid);
         }
         if i.hooke_stiffness.is_some() || i.hooke_stiffness_ratio.is_some() {
             let (k_n, ratio) = (i.hooke_stiffness, i.hooke_stiffness_ratio);

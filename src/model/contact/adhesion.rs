@@ -1,71 +1,156 @@
-//! The adhesion sub-model: none, or a pull along -n̂ while the bodies overlap:
+//! The adhesion sub-model: none, or a pull along -n̂:
 //!
 //! - the simplified JKR cohesion (SJKR): k_c A over the area A = π a² of the contact circle
-//!   (of the two spheres' lens, or of the sphere cut by the wall's plane);
+//!   (of the two spheres' lens, or of the sphere cut by the wall's plane), while touching;
 //! - DMT (Derjaguin, Muller & Toporov 1975, J. Colloid Interface Sci. 53:314): 2 π γ R*, γ the
 //!   work of adhesion (`surface_energy`), the pull-off force of two spheres in DMT's theory,
-//!   acting while they touch (as LAMMPS's `dmt`; the attraction beyond contact is left out).
+//!   acting while they touch (as LAMMPS's `dmt`; the attraction beyond contact is left out);
+//! - JKR (Johnson, Kendall & Roberts 1971, Proc. R. Soc. A 324:301): the contact radius a
+//!   follows from the overlap by δ = a²/R* - sqrt(2 π γ a / E*), the elastic force is
+//!   F = 4 E* a³ / (3 R*) - sqrt(8 π γ E* a³), and the contact, once made at δ = 0, holds
+//!   until δ falls to -δ_c = -(3/4) (π² γ² R* / E*²)^(1/3) (the neck's end under a
+//!   prescribed separation): a hysteresis of approach and pull-off;
+//! - liquid bridges: once two bodies touch, a bridge of volume V pulls them by Willett et
+//!   al. 2000's closed form (Langmuir 16:9396, Eqs. 12-13),
+//!   F = 2 π R γ_l cos θ / (1 + 2.1 S⁺ + 10 S⁺²) with S⁺ = (s/2) sqrt(R/V) at the gap s
+//!   (R = 2 R*, Derjaguin's mean, 2 R_i on a wall), until the gap passes (1 + θ/2) V^(1/3)
+//!   (Lian et al. 1993, J. Colloid Interface Sci. 161:138); no force after that until they
+//!   touch again.
 //!
-//! A pair's coefficients hold k_c or 2 π γ (the other zero), so both run in one loop. The
-//! pull adds to the force only: the Coulomb limits rest on the repulsive load |f_n|, which at
-//! rest carries the outer load and the pull together.
+//! A pair's coefficients hold each model's constants (zero where the pair has not the model),
+//! so pairs of several kinds share one loop. The pull adds to the force only: the Coulomb
+//! limits rest on the repulsive load |f_n|, which at rest carries the outer load and the pull
+//! together; JKR's on |F + 2 F_c| (Thornton & Yin 1991), F_c = 3/2 π γ R* its pull-off force.
 
 use crate::model::lanes::Lanes;
+use crate::model::materials::PairCoefficients;
+use crate::model::registry::AdhesionModel;
 
 use super::kinematics::Other;
 
 coefficients! {
-    /// k_c of the pair [J/m³] and 2 π γ [J/m²] (zero: no pull).
+    /// The pair's constants of each adhesion model (zero: not that model).
     pub struct Cohesion {
+        /// k_c \[J/m³\] of SJKR.
         k_c,
+        /// 2 π γ \[J/m²\] of DMT.
         dmt,
+        /// JKR's c = sqrt(2 π γ / E*) \[m^½\] and c E* = sqrt(2 π γ E*) \[N/m^(3/2)\].
+        jkr,
+        jkr_e,
+        /// 4 π γ_l cos θ \[N/m\]: a bridge's pull at touch is this times R*.
+        bridge,
+        /// 1/V \[1/m³\] of a bridge (0: dry).
+        per_volume,
+        /// The bridge's rupture distance (1 + θ/2) V^(1/3) \[m\].
+        rupture,
+    }
+}
+
+impl Cohesion {
+    /// The constants of the pair's adhesion `pair` (with E* `e_star`, for JKR).
+    pub fn of(pair: &PairCoefficients, e_star: f64) -> Cohesion {
+        use std::f64::consts::PI;
+        let (gamma, liquid) = (pair.surface_energy, &pair.liquid);
+        let jkr = pair.models.adhesion == AdhesionModel::Jkr && gamma > 0.0;
+        let theta = liquid.contact_angle.to_radians();
+        Cohesion {
+            k_c: pair.cohesion,
+            dmt: if pair.models.adhesion == AdhesionModel::Dmt {
+                2.0 * PI * gamma
+            } else {
+                0.0
+            },
+            jkr: if jkr {
+                (2.0 * PI * gamma / e_star).sqrt()
+            } else {
+                0.0
+            },
+            jkr_e: if jkr {
+                (2.0 * PI * gamma * e_star).sqrt()
+            } else {
+                0.0
+            },
+            bridge: if liquid.wet() {
+                4.0 * PI * liquid.surface_tension * theta.cos()
+            } else {
+                0.0
+            },
+            per_volume: if liquid.wet() {
+                1.0 / liquid.volume
+            } else {
+                0.0
+            },
+            rupture: if liquid.wet() {
+                liquid.rupture_distance()
+            } else {
+                0.0
+            },
+        }
     }
 }
 
 /// An adhesion sub-model, chosen once per run.
 pub trait Adhesion {
-    /// The force `f` of a contact of body i (radius `radius_i`) with `other` at overlap
-    /// `delta` along `n` (effective radius `r_star`), with the pull added.
-    fn add_pull<T: Lanes>(
-        coef: &Cohesion<T>,
-        f: T::Vec,
-        n: T::Vec,
-        radii: (T, T),
-        other: Other<T>,
-        delta: T,
-    ) -> T::Vec;
+    /// Whether a contact outlasts touch (JKR's neck, a liquid bridge): the contact stages
+    /// keep an open contact while its gap is within [`Adhesion::reach`].
+    const BEYOND_TOUCH: bool = false;
+    /// Whether apart the bodies still touch through a solid neck (JKR): otherwise a contact
+    /// apart has no solid part (no elastic force, damping or friction; springs forgotten).
+    const NECK: bool = false;
+
+    /// a, the radius of the contact area at overlap `delta`: Hertz's sqrt(R* δ) (Eq. 14).
+    #[inline(always)]
+    fn contact_radius<T: Lanes>(_: &Cohesion<T>, r_star: T, delta: T) -> T {
+        (r_star * delta).sqrt()
+    }
+
+    /// The pull along -n̂ of a contact of body i (radius `radius_i`) with `other` at
+    /// overlap `delta`, effective radius `r_star` and contact radius `a`.
+    fn pull<T: Lanes>(coef: &Cohesion<T>, radii: (T, T), other: Other<T>, delta: T, a: T) -> T;
+
+    /// The load of the Coulomb limits, from the normal force without the pull
+    /// (`f_n_scalar`, positive pushing) and the `pull`.
+    #[inline(always)]
+    fn coulomb_load<T: Lanes>(_: &Cohesion<T>, f_n_scalar: T, _pull: T, _r_star: T) -> T {
+        f_n_scalar.abs()
+    }
+
+    /// The gap at which an open contact of effective radius `r_star` ends (0: at touch).
+    #[inline(always)]
+    fn reach(_: &Cohesion, _r_star: f64) -> f64 {
+        0.0
+    }
 }
 
 /// No adhesion (no pair of the run pulls).
 pub struct NoAdhesion;
 
-/// A pull: the simplified JKR cohesion and DMT.
+/// A pull while touching: the simplified JKR cohesion and DMT.
 pub struct Pull;
+
+/// JKR's contact (and the pulls of [`Pull`] for the run's other pairs).
+pub struct Jkr;
+
+/// Liquid bridges (and the pulls of [`Pull`] while touching).
+pub struct Bridge;
 
 impl Adhesion for NoAdhesion {
     #[inline(always)]
-    fn add_pull<T: Lanes>(
-        _: &Cohesion<T>,
-        f: T::Vec,
-        _: T::Vec,
-        _: (T, T),
-        _: Other<T>,
-        _: T,
-    ) -> T::Vec {
-        f
+    fn pull<T: Lanes>(_: &Cohesion<T>, _: (T, T), _: Other<T>, _: T, _: T) -> T {
+        T::splat(0.0)
     }
 }
 
 impl Adhesion for Pull {
     #[inline(always)]
-    fn add_pull<T: Lanes>(
+    fn pull<T: Lanes>(
         coef: &Cohesion<T>,
-        f: T::Vec,
-        n: T::Vec,
         (radius_i, r_star): (T, T),
         other: Other<T>,
         delta: T,
-    ) -> T::Vec {
+        _: T,
+    ) -> T {
         let c = T::splat;
         // a², the squared radius of the contact circle.
         let a2 = match other {
@@ -76,6 +161,124 @@ impl Adhesion for Pull {
             }
             Other::Wall => delta * (c(2.0) * radius_i - delta),
         };
-        f - n * (coef.k_c * c(std::f64::consts::PI) * a2 + coef.dmt * r_star)
+        coef.k_c * c(std::f64::consts::PI) * a2 + coef.dmt * r_star
+    }
+}
+
+impl Adhesion for Jkr {
+    const BEYOND_TOUCH: bool = true;
+    const NECK: bool = true;
+
+    /// JKR's a at δ: with the length l = (c R*)^(2/3), x = sqrt(a / l) is the largest root of
+    /// x⁴ - x = δ R* / l² ([`jkr_root`]). Hertz's for a pair without JKR.
+    #[inline(always)]
+    fn contact_radius<T: Lanes>(coef: &Cohesion<T>, r_star: T, delta: T) -> T {
+        T::pick(
+            coef.jkr.is_zero(),
+            || (r_star * delta).sqrt(),
+            || {
+                let l = (coef.jkr * r_star).each(f64::cbrt);
+                let l = l * l;
+                let x = (delta * r_star / (l * l)).each(jkr_root);
+                l * x * x
+            },
+        )
+    }
+
+    /// F = 4/3 E* a δ - pull: with δ = a²/R* - sqrt(2 π γ a / E*), the pull is
+    /// (2/3) sqrt(2 π γ E* a³).
+    #[inline(always)]
+    fn pull<T: Lanes>(coef: &Cohesion<T>, radii: (T, T), other: Other<T>, delta: T, a: T) -> T {
+        let jkr = T::splat(2.0 / 3.0) * coef.jkr_e * a * a.sqrt();
+        jkr + Pull::pull(coef, radii, other, delta, a)
+    }
+
+    /// |F + 2 F_c| with F_c = 3/2 π γ R* = 3/4 c (c E*) R*.
+    #[inline(always)]
+    fn coulomb_load<T: Lanes>(coef: &Cohesion<T>, f_n_scalar: T, pull: T, r_star: T) -> T {
+        let f_c = T::splat(0.75) * coef.jkr * coef.jkr_e * r_star;
+        (f_n_scalar - pull + T::splat(2.0) * f_c).abs()
+    }
+
+    /// δ_c = (3/4) (π² γ² R* / E*²)^(1/3) = (3/4) (c⁴ R* / 4)^(1/3).
+    #[inline(always)]
+    fn reach(coef: &Cohesion, r_star: f64) -> f64 {
+        0.75 * (coef.jkr.powi(4) * r_star / 4.0).cbrt()
+    }
+}
+
+impl Adhesion for Bridge {
+    const BEYOND_TOUCH: bool = true;
+
+    #[inline(always)]
+    fn contact_radius<T: Lanes>(_: &Cohesion<T>, r_star: T, delta: T) -> T {
+        T::pick(
+            delta.positive(),
+            || (r_star * delta).sqrt(),
+            || T::splat(0.0),
+        )
+    }
+
+    /// Willett's force at the gap s = -δ (its value at s = 0 while touching), with the pulls
+    /// of [`Pull`] while touching.
+    #[inline(always)]
+    fn pull<T: Lanes>(coef: &Cohesion<T>, radii: (T, T), other: Other<T>, delta: T, a: T) -> T {
+        let at_touch = coef.bridge * radii.1;
+        T::pick(
+            delta.positive(),
+            || at_touch + Pull::pull(coef, radii, other, delta, a),
+            || {
+                let c = T::splat;
+                // S⁺ = (s/2) sqrt(R/V) with R = 2 R*.
+                let s = c(-0.5) * delta * (c(2.0) * radii.1 * coef.per_volume).sqrt();
+                at_touch / (c(1.0) + s * (c(2.1) + c(10.0) * s)) // Willett Eq. (12)
+            },
+        )
+    }
+
+    #[inline(always)]
+    fn reach(coef: &Cohesion, _: f64) -> f64 {
+        coef.rupture
+    }
+}
+
+/// The least D = x⁴ - x on the branch x ≥ 4^(-1/3), at the pull-off separation of JKR.
+pub const JKR_D_MIN: f64 = -0.472_470_393_710_577_4; // -(3/4) 4^(-1/3)
+
+/// The largest real root x of x⁴ - x = D (for D ≥ [`JKR_D_MIN`]; D below is taken as it),
+/// in closed form: Ferrari's resolvent m³ + D m = 1/8 has one real root for D ≥ D_min,
+/// m = u - w (Cardano, u = cbrt(1/16 + sqrt(1/256 + D³/27)), w = D / (3u)), written as
+/// (1/8) / (u² + u w + w²) for D ≥ 0 where u - w cancels; then x = (sqrt(2m) +
+/// sqrt(2/sqrt(2m) - 2m)) / 2.
+pub fn jkr_root(d: f64) -> f64 {
+    let d = d.max(JKR_D_MIN);
+    let root = (1.0 / 256.0 + d * d * d / 27.0).max(0.0).sqrt();
+    let u = (1.0 / 16.0 + root).cbrt();
+    let w = d / (3.0 * u);
+    let m = if d >= 0.0 {
+        0.125 / (u * u + u * w + w * w)
+    } else {
+        u - w
+    };
+    let s = (2.0 * m).sqrt();
+    0.5 * (s + (2.0 / s - 2.0 * m).max(0.0).sqrt())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn jkr_root_solves_its_quartic_on_the_stable_branch() {
+        for d in [
+            JKR_D_MIN, -0.47, -0.3, -1e-3, 0.0, 1e-6, 0.5, 3.0, 1e3, 1e8, 1e14,
+        ] {
+            let x = jkr_root(d);
+            let residual = (x.powi(4) - x - d) / (x.powi(4) + x);
+            assert!(residual.abs() < 1e-12, "D {d}: x {x}, residual {residual}");
+            assert!(x >= 0.25f64.cbrt() * (1.0 - 1e-7), "the stable branch: {x}");
+        }
+        assert_eq!(jkr_root(0.0), 1.0);
+        assert!((JKR_D_MIN + 0.75 * 0.25f64.cbrt()).abs() < 1e-15);
     }
 }

@@ -17,6 +17,8 @@ pub trait Models {
     /// are read (`Dynamic`), or are the paper's (`Papers`), so that a run of the paper's law
     /// is compiled without their branches.
     const DYNAMIC: bool;
+    /// Whether contacts outlast touch (see [`Adhesion::BEYOND_TOUCH`]).
+    const BEYOND_TOUCH: bool;
 }
 
 /// The rolling model and Coulomb test are the paper's: compiled in.
@@ -45,6 +47,7 @@ impl<A: Adhesion, O: Order, D: Constants> Models for Composition<A, O, D> {
     type Adhesion = A;
     type Order = O;
     const DYNAMIC: bool = D::DYNAMIC;
+    const BEYOND_TOUCH: bool = A::BEYOND_TOUCH;
 }
 
 /// Which composition a run uses, found once from its pairs of materials.
@@ -52,6 +55,8 @@ impl<A: Adhesion, O: Order, D: Constants> Models for Composition<A, O, D> {
 pub struct Choice {
     /// Not `None` if any pair pulls (k_c > 0 or γ > 0).
     pub adhesion: AdhesionModel,
+    /// Whether any pair makes liquid bridges.
+    pub bridges: bool,
     pub springs: FrictionSprings,
     /// The rolling sub-model and what the tangential Coulomb limit clips: one each per run,
     /// read by the law as constants (a branch that always goes the same way), not types.
@@ -83,26 +88,35 @@ macro_rules! with_models {
         }
     }};
     (@order $choice:ident, $D:ty, $M:ident => $body:expr) => {{
-        use $crate::model::contact::adhesion::{NoAdhesion, Pull};
-        use $crate::model::contact::composition::Composition;
+        use $crate::model::contact::adhesion::{Bridge, Jkr, NoAdhesion, Pull};
         use $crate::model::contact::friction::{AdvanceFirst, PaperOrder};
         use $crate::model::materials::FrictionSprings;
         use $crate::model::registry::AdhesionModel;
-        match ($choice.adhesion, $choice.springs) {
-            (AdhesionModel::None, FrictionSprings::AdvanceFirst) => {
-                type $M = Composition<NoAdhesion, AdvanceFirst, $D>;
+        match ($choice.adhesion, $choice.bridges) {
+            (AdhesionModel::None, false) => {
+                $crate::model::contact::composition::with_models!(@springs $choice, NoAdhesion, $D, $M => $body)
+            }
+            // A run with JKR makes no bridges (the scenario refuses both).
+            (AdhesionModel::Jkr, _) => {
+                $crate::model::contact::composition::with_models!(@springs $choice, Jkr, $D, $M => $body)
+            }
+            (_, true) => {
+                $crate::model::contact::composition::with_models!(@springs $choice, Bridge, $D, $M => $body)
+            }
+            (_, false) => {
+                $crate::model::contact::composition::with_models!(@springs $choice, Pull, $D, $M => $body)
+            }
+        }
+    }};
+    (@springs $choice:ident, $A:ty, $D:ty, $M:ident => $body:expr) => {{
+        use $crate::model::contact::composition::Composition;
+        match $choice.springs {
+            FrictionSprings::AdvanceFirst => {
+                type $M = Composition<$A, AdvanceFirst, $D>;
                 $body
             }
-            (AdhesionModel::None, FrictionSprings::Paper) => {
-                type $M = Composition<NoAdhesion, PaperOrder, $D>;
-                $body
-            }
-            (_, FrictionSprings::AdvanceFirst) => {
-                type $M = Composition<Pull, AdvanceFirst, $D>;
-                $body
-            }
-            (_, FrictionSprings::Paper) => {
-                type $M = Composition<Pull, PaperOrder, $D>;
+            FrictionSprings::Paper => {
+                type $M = Composition<$A, PaperOrder, $D>;
                 $body
             }
         }

@@ -30,7 +30,8 @@ pub struct Body<T: Lanes = f64> {
 pub struct Kinematics<T: Lanes = f64> {
     /// Unit normal n̂ pointing from j to i, Eq. (9).
     pub n: T::Vec,
-    /// Overlap δ > 0, Eq. (7).
+    /// Overlap δ, Eq. (7): positive while touching, negative across the gap of a contact
+    /// beyond touch (JKR's neck, a liquid bridge).
     pub delta: T,
     /// Distances of the contact point from the centres, Eqs. (29), (30); r_j = ∞ for a wall.
     pub r_i: T,
@@ -80,10 +81,17 @@ impl Kinematics {
     /// The contact of particles `i` and `j`, or `None` if they do not overlap.
     #[inline]
     pub fn between_particles(i: &Body, j: &Body) -> Option<Kinematics> {
+        Self::between_particles_within(i, j, 0.0)
+    }
+
+    /// The contact of particles `i` and `j`, or `None` if their gap is `gap` or more (a
+    /// contact beyond touch, δ > -gap).
+    #[inline]
+    pub fn between_particles_within(i: &Body, j: &Body, gap: f64) -> Option<Kinematics> {
         let d = i.x - j.x; // Eq. (8)
-        let reach = i.radius + j.radius;
+        let within = i.radius + j.radius + gap;
         let dist2 = d.length_squared();
-        if dist2 >= reach * reach {
+        if dist2 >= within * within {
             return None;
         }
         Some(Kinematics::of_touching_particles(i, j, d, dist2))
@@ -99,9 +107,22 @@ impl Kinematics {
         face_radius: f64,
         wall: &RigidVelocity,
     ) -> Option<Kinematics> {
+        Self::with_wall_within(i, d, face_radius, wall, 0.0)
+    }
+
+    /// [`Kinematics::with_wall`] for a contact that lasts while the gap is less than `gap`.
+    #[inline]
+    pub fn with_wall_within(
+        i: &Body,
+        d: DVec3,
+        face_radius: f64,
+        wall: &RigidVelocity,
+        gap: f64,
+    ) -> Option<Kinematics> {
         let reach = i.radius + face_radius;
         let dist2 = d.length_squared();
-        if dist2 >= reach * reach {
+        let within = reach + gap;
+        if dist2 >= within * within {
             return None;
         }
         let dist = dist2.sqrt();

@@ -97,7 +97,7 @@ impl Coefficients {
         Coefficients {
             damping: Viscoelastic::of_particles(m, n, &normal, e_n),
             normal,
-            ..Self::friction_and_adhesion(pair)
+            ..Self::friction_and_adhesion(pair, normal.e_star)
         }
     }
 
@@ -109,12 +109,13 @@ impl Coefficients {
         Coefficients {
             damping: Viscoelastic::against_wall(m, &normal, e_n),
             normal,
-            ..Self::friction_and_adhesion(pair)
+            ..Self::friction_and_adhesion(pair, normal.e_star)
         }
     }
 
-    /// The pair's friction and adhesion, with the elastic parts left zero.
-    fn friction_and_adhesion(pair: &PairCoefficients) -> Coefficients {
+    /// The pair's friction and adhesion (JKR's with the pair's E*), with the elastic parts
+    /// left zero.
+    fn friction_and_adhesion(pair: &PairCoefficients, e_star: f64) -> Coefficients {
         Coefficients {
             normal: Elastic {
                 e_star: 0.0,
@@ -135,10 +136,7 @@ impl Coefficients {
             twisting: Twisting {
                 mu_t: pair.friction_twisting,
             },
-            adhesion: Cohesion {
-                k_c: pair.cohesion,
-                dmt: 2.0 * std::f64::consts::PI * pair.surface_energy,
-            },
+            adhesion: Cohesion::of(pair, e_star),
         }
     }
 
@@ -231,6 +229,7 @@ impl ContactLaw {
             friction_twisting: material.friction_twisting,
             cohesion: material.cohesion,
             surface_energy: material.surface_energy,
+            liquid: material.liquid,
             hooke_stiffness: material.hooke_stiffness,
             hooke_stiffness_ratio: material.hooke_stiffness_ratio,
             models: material.models,
@@ -257,6 +256,7 @@ impl ContactLaw {
             dt,
             choice: Choice {
                 adhesion: AdhesionModel::None,
+                bridges: false,
                 springs,
                 rolling: RollingModel::default(),
                 tangential: TangentialCoulomb::default(),
@@ -271,6 +271,7 @@ impl ContactLaw {
                 if pair.cohesion > 0.0 || pair.surface_energy > 0.0 {
                     law.choice.adhesion = pair.models.adhesion;
                 }
+                law.choice.bridges |= pair.liquid.wet();
                 // One rolling model and one Coulomb test per run (the scenario refuses
                 // pairs that differ).
                 law.choice.rolling = pair.models.rolling;
@@ -284,6 +285,34 @@ impl ContactLaw {
     #[inline]
     pub fn choice(&self) -> Choice {
         self.choice
+    }
+
+    /// The largest gap at which a contact of the run's law ends (its adhesion's reach) for
+    /// particles up to the radius `r_max`: the lists' skin must cover it.
+    pub fn largest_reach(&self, r_max: f64) -> f64 {
+        with_models!(self.choice, M => {
+            let pairs = self.pairs.iter().map(|c| Self::reach::<M>(c, 0.5 * r_max));
+            let walls = self.walls.iter().map(|c| Self::reach::<M>(c, r_max));
+            pairs.chain(walls).fold(0.0, f64::max)
+        })
+    }
+
+    /// Whether the run's contacts may outlast touch (JKR, liquid bridges).
+    pub fn beyond_touch(&self) -> bool {
+        with_models!(self.choice, M => M::BEYOND_TOUCH)
+    }
+
+    /// The gap at which an open contact with the coefficients `coef` and the effective
+    /// radius `r_star` ends under the run's sub-models (off the hot loops: reports).
+    pub fn reach_of(&self, coef: &Coefficients, r_star: f64) -> f64 {
+        with_models!(self.choice, M => Self::reach::<M>(coef, r_star))
+    }
+
+    /// The gap at which an open contact with the coefficients `coef` and the effective
+    /// radius `r_star` ends under the sub-models `M` (0: at touch).
+    #[inline(always)]
+    pub fn reach<M: Models>(coef: &Coefficients, r_star: f64) -> f64 {
+        M::Adhesion::reach(&coef.adhesion, r_star)
     }
 
     /// Whether every contact has the same coefficients (one material).
@@ -365,14 +394,16 @@ impl ContactLaw {
             omega,
         } = *kin;
         let (r_star, m_star, r_roll, r_j_per_r_i) = effective(radius_i, m_i, other, r_i, r_j);
-        let stiffness = coef.normal.stiffness(r_star, delta); // Eqs. (12)-(14)
+        let a = M::Adhesion::contact_radius(&coef.adhesion, r_star, delta); // Eq. (14)
+        let stiffness = coef.normal.stiffness_at(a); // Eqs. (12), (13)
         let (c_n, c_s) = coef.damping.dampers(m_star, stiffness.k_n); // Eqs. (18), (19)
 
         // Normal force, along n̂: f_n = -k_n u_n - c_n v_n with u_n = -δ n̂ (Eqs. 5, 10).
         let v_dot_n = T::dot(v, n);
         let v_n = n * v_dot_n; // Eq. (27)
         let f_n_scalar = stiffness.k_n * delta - c_n * v_dot_n;
-        let f_n = n * f_n_scalar; // Eq. (5)
+        let radii = (radius_i, r_star);
+        let pull = M::Adhesion::pull(&coef.adhesion, radii, other, delta, a);
         let at = Shared {
             n,
             r_i,
@@ -383,7 +414,7 @@ impl ContactLaw {
             stiffness,
             c_n,
             c_s,
-            f_n_norm: f_n_scalar.abs(),
+            f_n_norm: M::Adhesion::coulomb_load(&coef.adhesion, f_n_scalar, pull, r_star),
             dt: T::splat(self.dt),
         };
 
@@ -399,18 +430,25 @@ impl ContactLaw {
             .rolling
             .torque::<M::Order>(rolling, &at, &mut springs.u_r);
         let tau_t = coef.twisting.torque::<M::Order>(&at, &mut springs.u_t);
-        let radii = (radius_i, r_star);
-        let f = M::Adhesion::add_pull(&coef.adhesion, f_n + f_s, n, radii, other, delta);
-
-        ContactForce {
-            f,
+        let mut force = ContactForce {
+            f: n * f_n_scalar + f_s - n * pull, // Eq. (5), f_s and the pull
             tau_i: tau_s + tau_r + tau_t,
             // A wall takes no reaction torque; avoid ∞ · 0 there.
             tau_j: match other {
                 Other::Particle { .. } => tau_s * r_j_per_r_i - tau_r - tau_t, // Eqs. (58)-(60)
                 Other::Wall => T::Vec::default(),
             },
+        };
+        if M::Adhesion::BEYOND_TOUCH && !M::Adhesion::NECK {
+            // Apart, a bridge alone: no solid contact, and its springs start afresh.
+            let apart = delta.le(T::splat(0.0));
+            let zero = T::splat_vec(glam::DVec3::ZERO);
+            force.f = T::pick_vec(apart, || n * -pull, || force.f);
+            force.tau_i = T::pick_vec(apart, || zero, || force.tau_i);
+            force.tau_j = T::pick_vec(apart, || zero, || force.tau_j);
+            springs.forget_where(apart);
         }
+        force
     }
 }
 

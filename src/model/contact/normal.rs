@@ -93,7 +93,12 @@ impl<T: Lanes> Elastic<T> {
     /// k_n and k_s at overlap `delta` of a contact of effective radius `r_star`.
     #[inline(always)]
     pub fn stiffness(&self, r_star: T, delta: T) -> Stiffness<T> {
-        let a = (r_star * delta).sqrt(); // Eq. (14)
+        self.stiffness_at((r_star * delta).sqrt()) // Eq. (14)
+    }
+
+    /// k_n and k_s of a contact whose contact area has the radius `a`.
+    #[inline(always)]
+    pub fn stiffness_at(&self, a: T) -> Stiffness<T> {
         Stiffness {
             k_n: self.k_n0 + T::splat(4.0 / 3.0) * self.e_star * a, // Eq. (12)
             k_s: self.k_s0 + T::splat(8.0) * self.g_star * a,       // Eq. (13)
