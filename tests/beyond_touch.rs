@@ -326,7 +326,7 @@ fn check_names_the_bridges_and_run_toml_keeps_them() {
     let dir = tempfile::tempdir().unwrap();
     let lines = tinydem::driver::check::describe(&s, dir.path()).unwrap();
     assert!(
-        lines.contains("liquid bridges") && lines.contains(&format!("rupture at {rupture:e} m")),
+        lines.contains("liquid bridges") && lines.contains(&format!("rupture at {rupture:.4e} m")),
         "{lines}"
     );
 }

@@ -66,7 +66,7 @@ fn adhesion_lines(s: &Scenario, pairs: &[(u16, u16)]) -> String {
         let l = s.pair(a, b).liquid;
         if l.wet() {
             out += &format!(
-                "{:<23}\"{}\" - \"{}\": volume {:e} m^3, surface tension {} N/m, contact angle {} deg, rupture at {:e} m\n",
+                "{:<23}\"{}\" - \"{}\": volume {:e} m^3, surface tension {} N/m, contact angle {} deg, rupture at {:.4e} m\n",
                 if first { "liquid bridges" } else { "" },
                 s.materials[a as usize].name,
                 s.materials[b as usize].name,

@@ -98,6 +98,8 @@ pub trait Adhesion {
     /// Whether apart the bodies still touch through a solid neck (JKR): otherwise a contact
     /// apart has no solid part (no elastic force, damping or friction; springs forgotten).
     const NECK: bool = false;
+    /// Whether any pair pulls (otherwise the pull is not even subtracted).
+    const PULLS: bool = true;
 
     /// a, the radius of the contact area at overlap `delta`: Hertz's sqrt(R* δ) (Eq. 14).
     #[inline(always)]
@@ -136,6 +138,8 @@ pub struct Jkr;
 pub struct Bridge;
 
 impl Adhesion for NoAdhesion {
+    const PULLS: bool = false;
+
     #[inline(always)]
     fn pull<T: Lanes>(_: &Cohesion<T>, _: (T, T), _: Other<T>, _: T, _: T) -> T {
         T::splat(0.0)

@@ -431,7 +431,11 @@ impl ContactLaw {
             .torque::<M::Order>(rolling, &at, &mut springs.u_r);
         let tau_t = coef.twisting.torque::<M::Order>(&at, &mut springs.u_t);
         let mut force = ContactForce {
-            f: n * f_n_scalar + f_s - n * pull, // Eq. (5), f_s and the pull
+            f: if M::Adhesion::PULLS {
+                n * f_n_scalar + f_s - n * pull // Eq. (5), f_s and the pull
+            } else {
+                n * f_n_scalar + f_s // Eq. (5) and f_s
+            },
             tau_i: tau_s + tau_r + tau_t,
             // A wall takes no reaction torque; avoid ∞ · 0 there.
             tau_j: match other {
