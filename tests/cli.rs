@@ -313,6 +313,8 @@ fn verify_runs_the_analytic_cases_and_writes_its_report() {
         "hooke_impact",
         "rolling_resistance",
         "dmt_contact",
+        "jkr_contact",
+        "liquid_bridge",
     ] {
         assert!(out.contains(case), "missing {case} in\n{out}");
     }

@@ -24,6 +24,8 @@
 //! - `hooke_impact`, `rolling_resistance`, `dmt_contact` (`models.rs`): the contact models
 //!   beyond the paper's: Hooke's impacts against the damped linear oscillator and LIGGGHTS's
 //!   figures, CDT's and EPSD2's stopping distance, DMT's resting overlap.
+//! - `jkr_contact`, `liquid_bridge` (`beyond.rs`): contacts beyond touch: JKR's pull-off
+//!   force and separation and its sticking speed; a bridge's force and rupture.
 //! - `heat_relaxation`, `heat_chain`, `heat_sources` (`heat.rs`): heat transfer against
 //!   its analytic limits: two grains relaxing, a chain at steady state between a hot and a
 //!   cold wall, cooling to the surroundings and a source.
@@ -33,6 +35,7 @@
 use anyhow::{Result, bail};
 use glam::{DQuat, DVec3};
 
+mod beyond;
 mod chung_ooi;
 mod contacts;
 mod heat;
@@ -189,6 +192,18 @@ pub const CASES: &[Case] = &[
         what: "two grains held by DMT's pull settle where Hertz balances it",
         quick: true,
         run: models::dmt_contact,
+    },
+    Case {
+        name: "jkr_contact",
+        what: "an elastic grain on a JKR floor: pull-off force and separation, the speed it leaves with past the sticking speed",
+        quick: true,
+        run: beyond::jkr_contact,
+    },
+    Case {
+        name: "liquid_bridge",
+        what: "a liquid bridge's force against Willett's closed form, and its rupture distance",
+        quick: true,
+        run: beyond::liquid_bridge,
     },
     Case {
         name: "heat_relaxation",
