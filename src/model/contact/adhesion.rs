@@ -173,18 +173,16 @@ impl Adhesion for Jkr {
     const BEYOND_TOUCH: bool = true;
     const NECK: bool = true;
 
-    /// JKR's a at δ: with the length l = (c R*)^(2/3), x = sqrt(a / l) is the largest root of
-    /// x⁴ - x = δ R* / l² ([`jkr_root`]). Hertz's for a pair without JKR.
+    /// JKR's a at δ: s = sqrt(a) is the largest root of s⁴ - c R* s - δ R* = 0
+    /// ([`jkr_root`]). Hertz's for a pair without JKR.
     #[inline(always)]
     fn contact_radius<T: Lanes>(coef: &Cohesion<T>, r_star: T, delta: T) -> T {
         T::pick(
             coef.jkr.is_zero(),
             || (r_star * delta).sqrt(),
             || {
-                let l = (coef.jkr * r_star).each(f64::cbrt);
-                let l = l * l;
-                let x = (delta * r_star / (l * l)).each(jkr_root);
-                l * x * x
+                let s = jkr_root(coef.jkr * r_star, delta * r_star);
+                s * s
             },
         )
     }
@@ -246,26 +244,29 @@ impl Adhesion for Bridge {
     }
 }
 
-/// The least D = x⁴ - x on the branch x ≥ 4^(-1/3), at the pull-off separation of JKR.
-pub const JKR_D_MIN: f64 = -0.472_470_393_710_577_4; // -(3/4) 4^(-1/3)
-
-/// The largest real root x of x⁴ - x = D (for D ≥ [`JKR_D_MIN`]; D below is taken as it),
-/// in closed form: Ferrari's resolvent m³ + D m = 1/8 has one real root for D ≥ D_min,
-/// m = u - w (Cardano, u = cbrt(1/16 + sqrt(1/256 + D³/27)), w = D / (3u)), written as
-/// (1/8) / (u² + u w + w²) for D ≥ 0 where u - w cancels; then x = (sqrt(2m) +
-/// sqrt(2/sqrt(2m) - 2m)) / 2.
-pub fn jkr_root(d: f64) -> f64 {
-    let d = d.max(JKR_D_MIN);
-    let root = (1.0 / 256.0 + d * d * d / 27.0).max(0.0).sqrt();
-    let u = (1.0 / 16.0 + root).cbrt();
-    let w = d / (3.0 * u);
-    let m = if d >= 0.0 {
-        0.125 / (u * u + u * w + w * w)
-    } else {
-        u - w
-    };
-    let s = (2.0 * m).sqrt();
-    0.5 * (s + (2.0 / s - 2.0 * m).max(0.0).sqrt())
+/// The largest real root s of s⁴ - p s - q = 0 (p > 0; q at least the least value of s⁴ -
+/// p s on the branch s ≥ (p/4)^(1/3), where the two largest roots meet: taken as that below
+/// it), in closed form: Ferrari's resolvent cubic m³ + q m = p²/8 has one real root there,
+/// m = u - w by Cardano (u = cbrt(p²/16 + sqrt(p⁴/256 + q³/27)), w = q / (3u)), written as
+/// (p²/8) / (u² + u w + w²) for q > 0 where u - w cancels; then s = (sqrt(2m) +
+/// sqrt(2p / sqrt(2m) - 2m)) / 2. One cube root, the rest in lanes.
+#[inline(always)]
+pub fn jkr_root<T: Lanes>(p: T, q: T) -> T {
+    let c = T::splat;
+    let zero = c(0.0);
+    let at_least_zero = |x: T| T::pick(x.le(zero), || zero, || x);
+    let p2 = p * p;
+    let root = at_least_zero(p2 * p2 * c(1.0 / 256.0) + q * q * q * c(1.0 / 27.0)).sqrt();
+    let u = (p2 * c(1.0 / 16.0) + root).each(f64::cbrt);
+    let w = q / (c(3.0) * u);
+    let m = T::pick(
+        q.le(zero),
+        || u - w,
+        || p2 * c(0.125) / (u * u + u * w + w * w),
+    );
+    let two_m = c(2.0) * m;
+    let s = two_m.sqrt();
+    c(0.5) * (s + at_least_zero(c(2.0) * p / s - two_m).sqrt())
 }
 
 #[cfg(test)]
@@ -274,15 +275,21 @@ mod tests {
 
     #[test]
     fn jkr_root_solves_its_quartic_on_the_stable_branch() {
-        for d in [
-            JKR_D_MIN, -0.47, -0.3, -1e-3, 0.0, 1e-6, 0.5, 3.0, 1e3, 1e8, 1e14,
-        ] {
-            let x = jkr_root(d);
-            let residual = (x.powi(4) - x - d) / (x.powi(4) + x);
-            assert!(residual.abs() < 1e-12, "D {d}: x {x}, residual {residual}");
-            assert!(x >= 0.25f64.cbrt() * (1.0 - 1e-7), "the stable branch: {x}");
+        for p in [1e-9, 1.0, 3e4] {
+            // The least q = s⁴ - p s of the branch, at s = (p/4)^(1/3).
+            let s_c = (p / 4.0f64).cbrt();
+            let q_min = s_c.powi(4) - p * s_c;
+            for share in [1.0, 0.99, 0.5, 1e-3, 0.0, -1e-6, -1.0, -10.0, -1e6, -1e12] {
+                let q = share * q_min;
+                let s: f64 = jkr_root(p, q);
+                let residual = (s.powi(4) - p * s - q) / (s.powi(4) + p * s);
+                assert!(
+                    residual.abs() < 1e-11,
+                    "p {p}, q {q}: s {s}, residual {residual}"
+                );
+                assert!(s >= s_c * (1.0 - 1e-7), "the stable branch: {s} < {s_c}");
+            }
         }
-        assert_eq!(jkr_root(0.0), 1.0);
-        assert!((JKR_D_MIN + 0.75 * 0.25f64.cbrt()).abs() < 1e-15);
+        assert_eq!(jkr_root(1.0, 0.0), 1.0);
     }
 }
