@@ -325,6 +325,18 @@ fn check_names_the_bridges_and_run_toml_keeps_them() {
     let rupture = (1.0 + 0.5 * f64::to_radians(20.0)) * f64::cbrt(2e-10);
     let dir = tempfile::tempdir().unwrap();
     let lines = tinydem::driver::check::describe(&s, dir.path()).unwrap();
+    assert!(!lines.contains("lists' skin"), "{lines}");
+    // A bridge that reaches past the skin raises it, and check says so.
+    let big = text.replace("2e-10", "1e-7");
+    let s = tinydem::scenario::Scenario::parse(&big, std::path::Path::new("s.toml")).unwrap();
+    let raised = tinydem::driver::check::describe(&s, dir.path()).unwrap();
+    let rupture_big = (1.0 + 0.5 * f64::to_radians(20.0)) * f64::cbrt(1e-7);
+    assert!(
+        raised.contains(&format!(
+            "lists' skin            {rupture_big:.4e} m, raised from"
+        )),
+        "{raised}"
+    );
     assert!(
         lines.contains("liquid bridges") && lines.contains(&format!("rupture at {rupture:.4e} m")),
         "{lines}"

@@ -51,6 +51,7 @@ fn describe_start(s: &Scenario, out: &Path, sim: Simulation) -> Result<String> {
     let materials = material_lines(s) + &clump_lines(s);
     let default_dt = s.eq50_timestep();
     let until = until_line(s) + &s.thermal_line();
+    let reach = super::materials::skin_line(s, sim.neighbours.skin);
     Ok(format!(
         "scenario is valid\n\
          {meshes}\
@@ -76,7 +77,7 @@ fn describe_start(s: &Scenario, out: &Path, sim: Simulation) -> Result<String> {
             FrictionSprings::Paper =>
                 "paper (the force of the previous step's spring, Eqs. 53-55; the original program's)",
         },
-        model_lines(s, m_min),
+        model_lines(s, m_min) + &reach,
         period / dt,
         s.total_time(),
         s.simulation.frames,

@@ -81,6 +81,19 @@ fn adhesion_lines(s: &Scenario, pairs: &[(u16, u16)]) -> String {
     out
 }
 
+/// The lists' skin, where the setup raised it to the reach of contacts beyond touch (JKR,
+/// liquid bridges).
+pub(super) fn skin_line(s: &Scenario, skin: f64) -> String {
+    let asked = s.simulation.skin * s.geometry.radius_max;
+    if skin > asked {
+        format!(
+            "lists' skin            {skin:.4e} m, raised from {asked:.4e} m to the largest gap a contact holds across\n"
+        )
+    } else {
+        String::new()
+    }
+}
+
 /// The materials and the coefficients of each pair of them (where named).
 pub(super) fn material_lines(s: &Scenario) -> String {
     let mut materials = String::new();
