@@ -342,3 +342,30 @@ fn check_names_the_bridges_and_run_toml_keeps_them() {
         "{lines}"
     );
 }
+
+/// A periodic period must hold the widest pair once with the skin raised to a bridge's reach.
+#[test]
+fn a_raised_skin_lengthens_the_shortest_period() {
+    // R 5 mm, skin 0.5 R: the shortest period is 6 R = 30 mm dry; a bridge of V 1e-7 m³
+    // reaches 5.4 mm, raising the skin by 2.9 mm and the shortest period by twice that.
+    let text = |liquid: &str| {
+        format!(
+            "[geometry]\nradius_min = {R}\nradius_max = {R}\nmesh_radii = [0.0]\n\
+             [domain]\nmin = [-0.016, -0.05, -0.05]\nmax = [0.016, 0.05, 0.05]\nperiodic = [true, false, false]\n\
+             [material]\n{liquid}\n[simulation]\nmax_particles = 0\nspawn_attempts = 0\n"
+        )
+    };
+    let dry = common::scenario(&text(""));
+    assert!(Simulation::new(dry).is_ok());
+    let wet = common::scenario(&text(
+        "liquid_volume = 1e-7\nsurface_tension = 0.07\ncontact_angle = 20.0",
+    ));
+    let e = format!(
+        "{:#}",
+        Simulation::new(wet).err().expect("too short a period")
+    );
+    assert!(
+        e.contains("is shorter than 6 times the largest radius and twice the skin's rise"),
+        "{e}"
+    );
+}

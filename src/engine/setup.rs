@@ -420,22 +420,29 @@ impl Simulation {
             bail!("too many particles: {}", particles.len());
         }
         check_materials(&particles, &scenario)?;
+        let law = contact_law(&scenario);
+        // The lists' skin covers the gap at which a contact beyond touch (JKR, a liquid
+        // bridge) ends, so that its pair stays listed while it lasts.
+        let asked = scenario.simulation.skin * g.radius_max;
+        let skin = asked.max(law.largest_reach(max_radius));
         if let Some(periodic) = scenario.periodicity() {
             let periods = scenario.simulation.shortest_period();
-            let shortest = periods * max_radius;
+            // With the skin raised, the widest pair's reach grows with it.
+            let shortest = periods * max_radius + 2.0 * (skin - asked);
+            let raised = if skin > asked {
+                " and twice the skin's rise to the reach of contacts beyond touch"
+            } else {
+                ""
+            };
             for a in 0..3 {
                 if periodic.axes[a] && periodic.length[a] < shortest {
                     bail!(
-                        "the period {} of the domain along axis {a} is shorter than {periods} times the largest radius ({shortest})",
+                        "the period {} of the domain along axis {a} is shorter than {periods} times the largest radius{raised} ({shortest})",
                         periodic.length[a]
                     );
                 }
             }
         }
-        let law = contact_law(&scenario);
-        // The lists' skin covers the gap at which a contact beyond touch (JKR, a liquid
-        // bridge) ends, so that its pair stays listed while it lasts.
-        let skin = (scenario.simulation.skin * g.radius_max).max(law.largest_reach(max_radius));
         let face_grid = FaceGrid::of(&mesh.faces, max_radius, skin);
         let mut sim = Simulation {
             model: Model {
