@@ -43,11 +43,11 @@ fn jkr_pull_off(gamma: f64, e_star: f64, r_star: f64) -> (f64, f64) {
 
 /// A grain pulled off its partner (a ceiling, or a fixed grain above it) by a weight of
 /// 1.2 F_c from touch: the strongest pull its contact gave, and its last overlap.
-fn pulled_off(gamma: f64, wall: bool) -> (f64, f64) {
+fn pulled_off(gamma: f64, wall: bool, model: &str) -> (f64, f64) {
     let r_star = if wall { R } else { 0.5 * R };
     let (f_c, _) = jkr_pull_off(gamma, if wall { E_WALL } else { 0.5 * E_WALL }, r_star);
     let m = Inertia::mass(R, RHO);
-    let material = format!("adhesion_model = \"jkr\"\nsurface_energy = {gamma}");
+    let material = format!("adhesion_model = \"{model}\"\nsurface_energy = {gamma}");
     let below = DVec3::new(0.0, 0.0, -(R - 1e-9));
     let (particles, off) = if wall {
         (vec![grain(below, DVec3::ZERO)], CEILING)
@@ -78,7 +78,7 @@ fn jkr_pulls_off_at_its_force_and_separation() {
     let gamma = 0.5;
     for (wall, e_star, r_star) in [(true, E_WALL, R), (false, 0.5 * E_WALL, 0.5 * R)] {
         let (f_c, delta_c) = jkr_pull_off(gamma, e_star, r_star);
-        let (strongest, last) = pulled_off(gamma, wall);
+        let (strongest, last) = pulled_off(gamma, wall, "jkr");
         eprintln!(
             "JKR wall {wall}: pull-off force {:+.2e}, separation {:+.2e}",
             strongest / f_c - 1.0,
@@ -367,5 +367,44 @@ fn a_raised_skin_lengthens_the_shortest_period() {
     assert!(
         e.contains("is shorter than 6 times the largest radius and twice the skin's rise"),
         "{e}"
+    );
+}
+
+/// `jkr_force` parts a contact at the pull-off force, as LAMMPS's `jkr`: at the overlap
+/// 3^(-2/3) δ_c, and an impact loses the work of parting from δ = 0 to there (x³ = 3/4).
+#[test]
+fn jkr_force_parts_at_the_pull_off_force() {
+    let gamma = 0.5;
+    let (f_c, delta_c) = jkr_pull_off(gamma, E_WALL, R);
+    let (strongest, last) = pulled_off(gamma, true, "jkr_force");
+    let parting = 3f64.powf(-2.0 / 3.0) * delta_c;
+    assert!((strongest / f_c - 1.0).abs() < 1e-2, "{strongest} vs {f_c}");
+    assert!(
+        (last / parting - 1.0).abs() < 1e-2,
+        "parted at {last}, not {parting}"
+    );
+    // The work lost is that share of the full hysteresis.
+    let a = |x: f64| 8.0 / 15.0 * x.powi(10) - 4.0 / 3.0 * x.powi(7) + 0.5 * x.powi(4);
+    let share = (a(1.0) - a(0.75f64.cbrt())) / (a(1.0) - a(0.25f64.cbrt()));
+    let v_s = sticking_speed(gamma, E_WALL, R, Inertia::mass(R, RHO));
+    let material = format!("adhesion_model = \"jkr_force\"\nsurface_energy = {gamma}");
+    let start = grain(
+        DVec3::new(0.0, 0.0, R + 1e-9),
+        DVec3::new(0.0, 0.0, -1.2 * v_s),
+    );
+    let mut s = sim(&material, 0.0, FLOOR, 2e-8, vec![start]);
+    for _ in 0..400_000 {
+        s.step().unwrap();
+    }
+    let leaving = (1.44 - share).sqrt() * v_s;
+    let v = s.particles.v[0].z;
+    eprintln!(
+        "jkr_force: parted at {:+.2e}, leaves {:+.2e}",
+        last / parting - 1.0,
+        v / leaving - 1.0
+    );
+    assert!(
+        s.held_contacts().is_empty() && (v / leaving - 1.0).abs() < 1e-3,
+        "{v} vs {leaving}"
     );
 }

@@ -66,6 +66,19 @@ registry! {
         Sjkr = "sjkr": "the simplified JKR cohesion, a pull cohesion x area",
         Dmt = "dmt": "the DMT pull 2 pi surface_energy R* while in contact",
         Jkr = "jkr": "JKR's elastic adhesion, the contact kept until the pull-off separation",
+        JkrForce = "jkr_force": "JKR parting at the pull-off force, as LAMMPS's jkr",
+    }
+}
+
+impl AdhesionModel {
+    /// Whether it is JKR's (either way of parting).
+    pub fn is_jkr(self) -> bool {
+        matches!(self, AdhesionModel::Jkr | AdhesionModel::JkrForce)
+    }
+
+    /// Whether its pull comes from `surface_energy` (DMT, JKR).
+    pub fn has_surface_energy(self) -> bool {
+        self == AdhesionModel::Dmt || self.is_jkr()
     }
 }
 
@@ -136,7 +149,8 @@ mod tests {
             "adhesion_model = \"capillary\" is not a known model: it must be \"none\" (no adhesion) \
              or \"sjkr\" (the simplified JKR cohesion, a pull cohesion x area) or \"dmt\" (the DMT \
              pull 2 pi surface_energy R* while in contact) or \"jkr\" (JKR's elastic adhesion, the \
-             contact kept until the pull-off separation)"
+             contact kept until the pull-off separation) or \"jkr_force\" (JKR parting at the \
+             pull-off force, as LAMMPS's jkr)"
         );
         assert!(NormalModel::parse("Hertz").is_err(), "names are exact");
     }

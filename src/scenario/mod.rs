@@ -584,10 +584,13 @@ impl Scenario {
             // A pair without adhesion (named so in its [[interactions]]) pulls not.
             cohesion: match models.adhesion {
                 AdhesionModel::Sjkr => cohesion,
-                AdhesionModel::None | AdhesionModel::Dmt | AdhesionModel::Jkr => 0.0,
+                AdhesionModel::None
+                | AdhesionModel::Dmt
+                | AdhesionModel::Jkr
+                | AdhesionModel::JkrForce => 0.0,
             },
             surface_energy: match models.adhesion {
-                AdhesionModel::Dmt | AdhesionModel::Jkr => {
+                AdhesionModel::Dmt | AdhesionModel::Jkr | AdhesionModel::JkrForce => {
                     given.and_then(|i| i.surface_energy).unwrap_or_else(|| {
                         models::mean_of([m, n], models::has_surface_energy, |m| m.surface_energy)
                     })

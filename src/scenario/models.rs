@@ -48,15 +48,13 @@ impl GivenModels {
         surface_energy: f64,
     ) -> Result<ContactModels> {
         let adhesion = match self.adhesion {
-            Some(AdhesionModel::None | AdhesionModel::Dmt | AdhesionModel::Jkr)
-                if cohesion > 0.0 =>
-            {
+            Some(m) if m != AdhesionModel::Sjkr && cohesion > 0.0 => {
                 bail!(
                     "{table} adhesion_model = \"{}\" contradicts cohesion = {cohesion}: drop one of them",
                     self.adhesion.unwrap_or_default().name()
                 )
             }
-            Some(model @ (AdhesionModel::Dmt | AdhesionModel::Jkr)) if surface_energy <= 0.0 => {
+            Some(model) if model.has_surface_energy() && surface_energy <= 0.0 => {
                 bail!(
                     "{table} adhesion_model = \"{}\" needs surface_energy > 0 (the work of \
                      adhesion gamma, J/m^2)",
@@ -65,13 +63,14 @@ impl GivenModels {
             }
             Some(AdhesionModel::None | AdhesionModel::Sjkr) | None if surface_energy > 0.0 => {
                 bail!(
-                    "{table} surface_energy = {surface_energy} needs adhesion_model = \"dmt\" \
-                     or \"jkr\""
+                    "{table} surface_energy = {surface_energy} needs adhesion_model = \"dmt\", \
+                     \"jkr\" or \"jkr_force\""
                 )
             }
-            Some(AdhesionModel::Jkr) if self.normal == Some(NormalModel::Hooke) => bail!(
-                "{table} adhesion_model = \"jkr\" needs Hertz's normal model: JKR's contact \
-                 area is Hertz's with adhesion"
+            Some(model) if model.is_jkr() && self.normal == Some(NormalModel::Hooke) => bail!(
+                "{table} adhesion_model = \"{}\" needs Hertz's normal model: JKR's contact \
+                 area is Hertz's with adhesion",
+                model.name()
             ),
             Some(model) => model,
             None if cohesion > 0.0 => AdhesionModel::Sjkr,
@@ -173,7 +172,7 @@ pub fn is_hooke(m: &Material) -> bool {
 
 /// Whether a material adheres by a surface energy (DMT or JKR).
 pub fn has_surface_energy(m: &Material) -> bool {
-    matches!(m.models.adhesion, AdhesionModel::Dmt | AdhesionModel::Jkr)
+    m.models.adhesion.has_surface_energy()
 }
 
 /// Whether a material's contacts make liquid bridges.
@@ -313,7 +312,7 @@ impl Scenario {
                     );
                 }
                 self.pair_models_hold(&pair, (name(a), name(b)))?;
-                jkr |= pair.models.adhesion == AdhesionModel::Jkr;
+                jkr |= pair.models.adhesion.is_jkr();
                 wet |= pair.liquid.wet();
                 rolling.push((pair.models.rolling, (a, b)));
                 tangential.push((pair.models.tangential, (a, b)));
@@ -333,15 +332,14 @@ impl Scenario {
     fn pair_models_hold(&self, pair: &PairCoefficients, names: (&String, &String)) -> Result<()> {
         let (a, b) = names;
         let adhesion = pair.models.adhesion;
-        if matches!(adhesion, AdhesionModel::Dmt | AdhesionModel::Jkr) && pair.surface_energy <= 0.0
-        {
+        if adhesion.has_surface_energy() && pair.surface_energy <= 0.0 {
             bail!(
                 "the contacts of \"{a}\" and \"{b}\" follow {} without a surface energy: \
                  give surface_energy in their [[interactions]]",
                 adhesion.name().to_uppercase()
             );
         }
-        if adhesion == AdhesionModel::Jkr && pair.models.normal == NormalModel::Hooke {
+        if adhesion.is_jkr() && pair.models.normal == NormalModel::Hooke {
             bail!(
                 "the contacts of \"{a}\" and \"{b}\" follow JKR and Hooke: JKR needs Hertz's \
                  normal model (name normal_model = \"hertz\" in their [[interactions]])"

@@ -38,6 +38,9 @@ coefficients! {
         /// JKR's c = sqrt(2 π γ / E*) \[m^½\] and c E* = sqrt(2 π γ E*) \[N/m^(3/2)\].
         jkr,
         jkr_e,
+        /// Where a JKR contact parts, as a share of δ_c: 1 (at the pull-off separation), or
+        /// 3^(-2/3) (at the pull-off force, `jkr_force`).
+        jkr_parting,
         /// 4 π γ_l cos θ \[N/m\]: a bridge's pull at touch is this times R*.
         bridge,
         /// 1/V \[1/m³\] of a bridge (0: dry).
@@ -52,7 +55,7 @@ impl Cohesion {
     pub fn of(pair: &PairCoefficients, e_star: f64) -> Cohesion {
         use std::f64::consts::PI;
         let (gamma, liquid) = (pair.surface_energy, &pair.liquid);
-        let jkr = pair.models.adhesion == AdhesionModel::Jkr && gamma > 0.0;
+        let jkr = pair.models.adhesion.is_jkr() && gamma > 0.0;
         let theta = liquid.contact_angle.to_radians();
         Cohesion {
             k_c: pair.cohesion,
@@ -70,6 +73,12 @@ impl Cohesion {
                 (2.0 * PI * gamma * e_star).sqrt()
             } else {
                 0.0
+            },
+            // At the pull-off force (x³ = 3/4 on the branch) the overlap is 3^(-2/3) of its
+            // least, -δ_c.
+            jkr_parting: match pair.models.adhesion {
+                AdhesionModel::JkrForce => 3f64.powf(-2.0 / 3.0),
+                _ => 1.0,
             },
             bridge: if liquid.wet() {
                 4.0 * PI * liquid.surface_tension * theta.cos()
@@ -202,10 +211,11 @@ impl Adhesion for Jkr {
         (f_n_scalar - pull + T::splat(2.0) * f_c).abs()
     }
 
-    /// δ_c = (3/4) (π² γ² R* / E*²)^(1/3) = (3/4) (c⁴ R* / 4)^(1/3).
+    /// δ_c = (3/4) (π² γ² R* / E*²)^(1/3) = (3/4) (c⁴ R* / 4)^(1/3), or the overlap at the
+    /// pull-off force, 3^(-2/3) δ_c (`jkr_force`).
     #[inline(always)]
     fn reach(coef: &Cohesion, r_star: f64) -> f64 {
-        0.75 * (coef.jkr.powi(4) * r_star / 4.0).cbrt()
+        coef.jkr_parting * 0.75 * (coef.jkr.powi(4) * r_star / 4.0).cbrt()
     }
 }
 

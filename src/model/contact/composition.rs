@@ -97,7 +97,7 @@ macro_rules! with_models {
                 $crate::model::contact::composition::with_models!(@springs $choice, NoAdhesion, $D, $M => $body)
             }
             // A run with JKR makes no bridges (the scenario refuses both).
-            (AdhesionModel::Jkr, _) => {
+            (AdhesionModel::Jkr | AdhesionModel::JkrForce, _) => {
                 $crate::model::contact::composition::with_models!(@springs $choice, Jkr, $D, $M => $body)
             }
             (_, true) => {
