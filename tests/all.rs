@@ -13,6 +13,7 @@ mod cohesion;
 mod contact_models;
 mod decomposition;
 mod domain;
+mod energy_ledger;
 mod examples;
 mod fields;
 mod fixed;

@@ -51,6 +51,8 @@ struct End {
     contacts: (usize, usize),
     /// The heat into each mesh file since the start, and the temperatures' numbers.
     heat: (Vec<u64>, Option<[u64; 4]>),
+    /// The energy ledger's columns, if it is kept.
+    energy: Option<[u64; 12]>,
 }
 
 fn end_of(sim: &mut Simulation) -> End {
@@ -88,6 +90,7 @@ fn end_of(sim: &mut Simulation) -> End {
                 .heat
                 .map(|t| [t.mean, t.min, t.max, t.content].map(f64::to_bits)),
         ),
+        energy: thermo.energy.map(|b| b.columns().map(f64::to_bits)),
     }
 }
 
@@ -770,13 +773,20 @@ fn the_contact_models_split_over_processes_give_the_bits_of_one_process() {
         "adhesion_model = \"jkr\"\nsurface_energy = 0.05\n",
         "liquid_volume = 1e-10\nsurface_tension = 0.07\ncontact_angle = 20.0\n",
     ] {
-        let text = silo(0.5).replace(
-            "friction_twisting = 0.1\n",
-            &format!("friction_twisting = 0.1\n{models}"),
-        );
+        // With the energy ledger, whose sums are exact as the loads.
+        let text = silo(0.5)
+            .replace(
+                "friction_twisting = 0.1\n",
+                &format!("friction_twisting = 0.1\n{models}"),
+            )
+            .replace(
+                "wall_forces = true\n",
+                "wall_forces = true\nenergy_ledger = true\n",
+            );
         assert!(text.contains(models));
         let mut single = common::simulate(&text, steps);
         let reference = end_of(&mut single);
+        assert!(reference.energy.is_some());
         for k in [2, 3] {
             let text = text.clone();
             let (end, _) = split_run(move || common::scenario(&text), steps, k);

@@ -389,6 +389,11 @@ impl Logs {
                 header += &format!(",mesh{k}_heat");
             }
         }
+        if s.energy_ledger {
+            for c in crate::model::ledger::COLUMNS {
+                header += &format!(",{c}");
+            }
+        }
         if until {
             header += ",until";
         }
@@ -460,6 +465,10 @@ impl Logs {
             row.extend([&t.mean as &dyn LogValue, &t.min, &t.max, &t.content]);
             row.extend(logs.heated.iter().map(|&k| &watts[k] as &dyn LogValue));
         }
+        let balance = th.energy.map(|b| b.columns());
+        if let Some(b) = &balance {
+            row.extend(b.iter().map(|v| v as &dyn LogValue));
+        }
         if logs.until {
             row.push(&ended);
         }
@@ -469,20 +478,35 @@ impl Logs {
                 log.row(&[&frame, &sim.time, &k, &o.count, &o.mass])?;
             }
         }
-        if let Some(log) = logs.walls.as_mut().filter(|_| frame > 0) {
-            // The mean over the steps since the last frame.
-            let steps = logs.steps_per_frame as f64;
-            for (k, w) in loads.iter().enumerate() {
-                let (f, t) = (w.f / steps, w.tau / steps);
-                let x = sim.walls.reference(k);
-                let mut row: Vec<&dyn LogValue> = vec![
-                    &frame, &sim.time, &k, &x.x, &x.y, &x.z, &f.x, &f.y, &f.z, &t.x, &t.y, &t.z,
-                ];
-                if th.heat.is_some() {
-                    row.push(&watts[k]);
-                }
-                log.row(&row)?;
+        if frame > 0 {
+            logs.wall_loads(sim, frame, &loads, th.heat.is_some().then_some(&watts[..]))?;
+        }
+        Ok(())
+    }
+
+    /// A frame's rows of `walls.csv` (if it is written): each mesh file's mean load over the
+    /// steps since the last frame of the sums `loads`, and its heat `watts` with heat.
+    fn wall_loads(
+        &mut self,
+        sim: &Simulation,
+        frame: u64,
+        loads: &[crate::engine::Wrench],
+        watts: Option<&[f64]>,
+    ) -> Result<()> {
+        let Some(log) = &mut self.walls else {
+            return Ok(());
+        };
+        let steps = self.steps_per_frame as f64;
+        for (k, w) in loads.iter().enumerate() {
+            let (f, t) = (w.f / steps, w.tau / steps);
+            let x = sim.walls.reference(k);
+            let mut row: Vec<&dyn LogValue> = vec![
+                &frame, &sim.time, &k, &x.x, &x.y, &x.z, &f.x, &f.y, &f.z, &t.x, &t.y, &t.z,
+            ];
+            if let Some(watts) = watts {
+                row.push(&watts[k]);
             }
+            log.row(&row)?;
         }
         Ok(())
     }

@@ -44,6 +44,7 @@ impl Simulation {
         let Findings {
             mut deep,
             beyond_range,
+            ..
         } = found;
         let p = &self.particles;
         let non_finite = |k: usize| self.broken(k);

@@ -78,7 +78,7 @@ fn run_with<M: Models>(
     list: &mut ContactList,
     loads: &mut [Load],
 ) -> (Findings, Vec<Sum6>) {
-    let found = Found::default();
+    let found = Found::new(model.ledger);
     let law = &model.law;
     let ContactList {
         start,
@@ -315,6 +315,30 @@ impl FaceStage<'_> {
         }
     }
 
+    /// The energy ledger's entries of the contacts of particles `i` with the faces `faces`
+    /// in a group's lanes, with the walls' motion at the contact points the law took (Eq. 26).
+    fn entries(
+        &self,
+        i: &[usize],
+        faces: &[usize; WIDTH],
+        (kin, parts): (&Kinematics<Group>, &ContactParts<Group>),
+    ) -> Vec<LedgerEntry> {
+        let entry = super::pairs::entries(kin, parts);
+        (0..i.len())
+            .map(|l| {
+                let e = entry(l);
+                let wall = self.walls.velocity(faces[l]);
+                let point = self.p.x[i[l]] - e.n * e.r_i;
+                LedgerEntry {
+                    i: i[l] as u32,
+                    frame_v: wall.at(point),
+                    frame_w: wall.omega,
+                    ..e
+                }
+            })
+            .collect()
+    }
+
     /// The law for one group of `WIDTH` contacts (indices of `near`), added to the loads of
     /// their particles (`loads` from owner `loads.1`) and their reactions to `wall`; whether
     /// the wall sums stayed in range.
@@ -362,10 +386,12 @@ impl FaceStage<'_> {
         };
         let mass = body_masses(self.p, &i, mass);
         let mut lanes = gather_springs(store, e);
-        let force = self
-            .law
-            .compose::<M, _>(&coef, radius, mass, Other::Wall, &kin, &mut lanes);
+        let (force, parts) =
+            self.law
+                .compose_parts::<M, _>(&coef, (radius, mass), Other::Wall, &kin, &mut lanes);
         scatter_springs(lanes, store, &e[..group.len()]);
+        let faces: [usize; WIDTH] = c.map(|c| self.partner[first + c.slot] as usize);
+        found.enter(|| self.entries(&i[..group.len()], &faces, (&kin, &parts)));
         let (f, tau) = (Group::scatter_vec(force.f), Group::scatter_vec(force.tau_i));
         let mut fine = true;
         for l in 0..group.len() {
@@ -380,7 +406,7 @@ impl FaceStage<'_> {
             // force and for the torque about the file's reference point).
             for l in (0..group.len()).filter(|&l| self.owned.is_none_or(|o| o[i[l]])) {
                 let w = self.walls;
-                let k = w.face_file[self.partner[first + c[l].slot] as usize] as usize;
+                let k = w.face_file[faces[l]] as usize;
                 let arm = self.p.x[i[l]] - w.files[k].torque_about;
                 let reaction = pack(-f[l], -(arm.cross(f[l]) + tau[l]));
                 wall_fine &= wall[k].add(reaction, &w.scales);

@@ -16,12 +16,13 @@ use rayon::prelude::*;
 pub use crate::engine::records::{ContactRecord, Outflow, Partner, Removed, Snapshot, Wrench};
 use crate::geometry::mesh::{Contacts, Face, Mesh};
 use crate::model::contact::{
-    Body, Coefficients, ContactLaw, Kinematics, Models, Other, with_models,
+    Body, Coefficients, ContactLaw, ContactParts, Kinematics, Models, Other, with_models,
 };
 use crate::model::exact::{Scale, Scales8, Sum6, pack};
 use crate::model::heat::HeatModel;
 use crate::model::integrate::{Density, Inertia, Response, State, advance};
 use crate::model::lanes::{Gather, Lanes};
+use crate::model::ledger::{Entry as LedgerEntry, WALL};
 use crate::model::motion::{Motion, Pose, RigidVelocity};
 use crate::model::particles::{Id, Particles};
 use crate::model::servo;
@@ -38,6 +39,7 @@ mod edit;
 pub use edit::{DEEPEST_ADDED, Overlap};
 mod faces;
 mod heat;
+mod ledger;
 mod loads;
 #[cfg(test)]
 mod open_core_tests;
@@ -80,6 +82,8 @@ pub(crate) struct Model {
     /// Heat transfer, if the scenario's materials conduct, make or exchange heat; with
     /// the walls' temperatures and conductivities.
     pub(crate) heat: Option<(HeatModel, heat::WallHeat)>,
+    /// Whether the contact stages leave their entries for the energy ledger.
+    pub(crate) ledger: bool,
 }
 
 impl Model {
@@ -119,12 +123,15 @@ fn body_masses(p: &Particles, idx: &[usize; WIDTH], m: Group) -> Group {
 pub(super) struct Findings {
     deep: Vec<Deep>,
     beyond_range: bool,
+    /// With the energy ledger, each contact's force and torques by mode.
+    entries: Vec<LedgerEntry>,
 }
 
 impl Findings {
     fn merge(&mut self, other: Findings) {
         self.deep.extend(other.deep);
         self.beyond_range |= other.beyond_range;
+        self.entries.extend(other.entries);
     }
 }
 
@@ -133,13 +140,35 @@ impl Findings {
 struct Found {
     deep: Mutex<Vec<Deep>>,
     beyond: AtomicBool,
+    /// The ledger's entries, if it is kept.
+    entries: Option<Mutex<Vec<LedgerEntry>>>,
 }
 
 impl Found {
+    /// Findings to collect, with the ledger's entries if `ledger`.
+    fn new(ledger: bool) -> Found {
+        Found {
+            entries: ledger.then(Default::default),
+            ..Found::default()
+        }
+    }
+
+    /// Keeps the ledger's entries `e` (if it is kept).
+    fn enter(&self, e: impl FnOnce() -> Vec<LedgerEntry>) {
+        if let Some(entries) = &self.entries {
+            let e = e();
+            entries.lock().expect("not poisoned").extend(e);
+        }
+    }
+
     fn into_inner(self) -> Findings {
         Findings {
             deep: self.deep.into_inner().expect("not poisoned"),
             beyond_range: self.beyond.into_inner(),
+            entries: self
+                .entries
+                .map(|e| e.into_inner().expect("not poisoned"))
+                .unwrap_or_default(),
         }
     }
 }
@@ -228,12 +257,13 @@ pub enum Stage {
     Integrate,
     Tag,
     Exchange,
+    Ledger,
     Stability,
     Remove,
 }
 
 impl Stage {
-    pub const ALL: [Stage; 12] = [
+    pub const ALL: [Stage; 13] = [
         Stage::MoveMeshes,
         Stage::Spawn,
         Stage::Neighbours,
@@ -244,6 +274,7 @@ impl Stage {
         Stage::Integrate,
         Stage::Tag,
         Stage::Exchange,
+        Stage::Ledger,
         Stage::Stability,
         Stage::Remove,
     ];
@@ -260,6 +291,7 @@ impl Stage {
             Stage::Integrate => "integrate",
             Stage::Tag => "tag",
             Stage::Exchange => "exchange",
+            Stage::Ledger => "energy ledger",
             Stage::Stability => "stability check",
             Stage::Remove => "remove",
         }
@@ -453,6 +485,8 @@ pub struct Thermo {
     pub removed: u64,
     /// The temperatures, if heat is transferred.
     pub heat: Option<Temperatures>,
+    /// The energy ledger's balance, if it is kept.
+    pub energy: Option<crate::model::ledger::Balance>,
 }
 
 /// The particles' temperatures in numbers, for `log.csv`.
@@ -503,6 +537,8 @@ pub struct Simulation {
     pub removed: Removed,
     /// The largest radius the faces are binned for.
     pub(crate) face_grid_radius: f64,
+    /// The energy ledger, if the scenario keeps it.
+    pub(crate) books: Option<ledger::Books>,
     /// This process's share of a run split over several (`decomposition.rs`).
     pub(crate) share: Option<Share>,
 }
@@ -572,7 +608,14 @@ impl Simulation {
         self.slide_images();
         self.walls.move_to(self.time);
         let t = self.stage_times.add(Stage::MoveMeshes, t);
+        self.open_books();
+        let first_new = self.particles.next_id;
         self.spawn();
+        if self.books.is_some() && self.particles.next_id > first_new {
+            let p = &self.particles;
+            let new: Vec<usize> = (0..p.len()).filter(|&k| p.id[k] >= first_new).collect();
+            self.book_kinetic(new.into_iter(), true);
+        }
         let t = self.stage_times.add(Stage::Spawn, t);
         self.update_neighbours();
         let t = self.stage_times.add(Stage::Neighbours, t);
@@ -595,6 +638,7 @@ impl Simulation {
             self.add_wall_heat(walls);
         }
         let t = self.stage_times.add(Stage::Heat, t);
+        self.remember_velocities();
         let (dt, g) = (
             self.scenario.simulation.timestep,
             self.scenario.kinetics.gravity,
@@ -621,6 +665,9 @@ impl Simulation {
             split::refresh_ghosts(d, &mut self.particles);
         }
         let t = self.stage_times.add(Stage::Exchange, t);
+        let entries = std::mem::take(&mut found.entries);
+        found.beyond_range |= !self.keep_books(&entries);
+        let t = self.stage_times.add(Stage::Ledger, t);
         self.steps += 1;
         self.time = self.steps as f64 * self.scenario.simulation.timestep;
         self.check_stability(found, non_finite)?;

@@ -66,7 +66,7 @@ fn run_with<M: Models>(
     lists: &mut Neighbours,
     loads: &mut [Load],
 ) -> Findings {
-    let found = Found::default();
+    let found = Found::new(model.ledger);
     let law = &model.law;
     let ContactList {
         start,
@@ -170,7 +170,20 @@ fn wrapped<M: Models>(
                 };
                 let coef = law.pair(p.material[i], p.material[j]);
                 let (r_i, m_i) = (p.radius[i], model.mass(p, i));
-                let force = law.compose::<M, _>(coef, r_i, m_i, other, &kin, springs);
+                let (force, parts) =
+                    law.compose_parts::<M, _>(coef, (r_i, m_i), other, &kin, springs);
+                if model.ledger {
+                    found.entries.push(LedgerEntry {
+                        i: i as u32,
+                        j: j as u32,
+                        n: kin.n,
+                        r_i: kin.r_i,
+                        r_j: kin.r_j,
+                        frame_v: dv,
+                        frame_w: DVec3::ZERO,
+                        parts,
+                    });
+                }
                 let lanes = &model.scales.lanes;
                 let (load_i, load_j) = pair_mut(loads, i, j);
                 let fine = load_i.add(pack(force.f, force.tau_i), lanes)
@@ -325,10 +338,22 @@ impl PairStage<'_> {
                 self.law.pair(self.p.material[i[l]], self.p.material[j[l]])
             }))
         };
-        let force = self
-            .law
-            .compose::<M, _>(&coef, body_i.radius, m_i, other, &kin, &mut lanes);
+        let (force, parts) =
+            self.law
+                .compose_parts::<M, _>(&coef, (body_i.radius, m_i), other, &kin, &mut lanes);
         scatter_springs(lanes, store, &c[..group.len()]);
+        found.enter(|| {
+            let entry = entries(&kin, &parts);
+            (0..group.len())
+                .map(|l| LedgerEntry {
+                    i: i[l] as u32,
+                    j: j[l] as u32,
+                    frame_v: DVec3::ZERO,
+                    frame_w: DVec3::ZERO,
+                    ..entry(l)
+                })
+                .collect()
+        });
         let (f, tau_i, tau_j) = (
             Group::scatter_vec(force.f),
             Group::scatter_vec(force.tau_i),
@@ -358,6 +383,41 @@ impl PairStage<'_> {
                 }
             }
         }
+    }
+}
+
+/// The ledger's entry of lane `l` of a group's kinematics `kin` and parts `parts` (its
+/// bodies and frame left to fill in).
+pub(super) fn entries(
+    kin: &Kinematics<Group>,
+    parts: &ContactParts<Group>,
+) -> impl Fn(usize) -> LedgerEntry {
+    let (n, r_i, r_j) = (
+        Group::scatter_vec(kin.n),
+        kin.r_i.scatter(),
+        kin.r_j.scatter(),
+    );
+    let (f_normal, pull) = (parts.f_normal.scatter(), parts.pull.scatter());
+    let (f_s, tau_r, tau_t) = (
+        Group::scatter_vec(parts.f_s),
+        Group::scatter_vec(parts.tau_r),
+        Group::scatter_vec(parts.tau_t),
+    );
+    move |l| LedgerEntry {
+        i: 0,
+        j: WALL,
+        n: n[l],
+        r_i: r_i[l],
+        r_j: if r_j[l].is_finite() { r_j[l] } else { 0.0 },
+        frame_v: DVec3::ZERO,
+        frame_w: DVec3::ZERO,
+        parts: ContactParts {
+            f_normal: f_normal[l],
+            pull: pull[l],
+            f_s: f_s[l],
+            tau_r: tau_r[l],
+            tau_t: tau_t[l],
+        },
     }
 }
 

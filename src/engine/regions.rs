@@ -44,6 +44,7 @@ impl Simulation {
         if gone.is_empty() {
             return;
         }
+        self.book_kinetic(mine.iter().map(|&k| k as usize), false);
         // Counted in id order (over all processes), so the masses sum in an order of their
         // own.
         for g in &gone {

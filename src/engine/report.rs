@@ -43,15 +43,24 @@ impl Simulation {
 
     /// The contact network of the particles this process holds (own and ghosts).
     pub(super) fn held_contact_network(&self) -> Vec<ContactRecord> {
-        let mut out = self.held_pair_records();
-        out.extend(self.held_face_records());
+        let mut out = Vec::new();
+        self.each_held_contact(|i, other, kin, coef, springs, with| {
+            out.push(self.record(i, other, kin, coef, springs, with));
+        });
         out.sort_by_key(ContactRecord::network_order);
         out
     }
 
-    /// The open pair contacts: within the box, and across periodic sides with the partner
-    /// at its image, each as (lower id, higher id).
-    fn held_pair_records(&self) -> Vec<ContactRecord> {
+    /// `each` open contact of the particles this process holds, at the current state
+    /// (particle i, the other body, the kinematics, the pair's coefficients, the springs
+    /// and the partner): the pairs within the box, and across periodic sides with the
+    /// partner at its image, each from the lower id; then the contacts with mesh faces,
+    /// the face moving as its part does. An open contact may lie beyond touch (JKR, a
+    /// liquid bridge), within its reach.
+    pub(super) fn each_held_contact(
+        &self,
+        mut each: impl FnMut(usize, Other, &Kinematics, &Coefficients, Springs, Partner),
+    ) {
         let p = &self.particles;
         let nb = &self.neighbours;
         let within = open_contacts(&nb.pairs).into_iter().map(|(a, b, s, _)| {
@@ -62,14 +71,12 @@ impl Simulation {
             let (i, j, shift, dv) = nb.across(&p.id, a, b, k);
             (i, j, s, shift, dv)
         });
-        let mut out = Vec::new();
         for (i, j, springs, shift, dv) in within.chain(across) {
             let bj = Body {
                 x: p.x[j] + shift,
                 v: p.v[j] + dv,
                 ..self.body_of(j)
             };
-            // An open contact may lie beyond touch (JKR, a liquid bridge), within its reach.
             let coef = self.model.law.pair(p.material[i], p.material[j]);
             let r_star = p.radius[i] * p.radius[j] / (p.radius[i] + p.radius[j]);
             let gap = self.model.law.reach_of(coef, r_star);
@@ -80,16 +87,8 @@ impl Simulation {
                 r: p.radius[j],
                 m: self.mass_of(j),
             };
-            let with = Partner::Particle(p.id[j]);
-            out.push(self.record(i, other, &kin, coef, springs, with));
+            each(i, other, &kin, coef, springs, Partner::Particle(p.id[j]));
         }
-        out
-    }
-
-    /// The open contacts of particles with mesh faces, the face moving as its part does.
-    fn held_face_records(&self) -> Vec<ContactRecord> {
-        let p = &self.particles;
-        let mut out = Vec::new();
         for (i, f, springs, _) in open_contacts(&self.neighbours.faces) {
             let face = &self.walls.mesh.faces[f];
             let wall = self.walls.velocity(f);
@@ -104,12 +103,11 @@ impl Simulation {
             let Some(kin) = Kinematics::with_wall_within(&b, d, face.radius, &wall, gap) else {
                 continue;
             };
-            out.push(self.record(i, Other::Wall, &kin, coef, springs, Partner::Face(f)));
+            each(i, Other::Wall, &kin, coef, springs, Partner::Face(f));
         }
-        out
     }
 
-    fn mass_of(&self, k: usize) -> f64 {
+    pub(super) fn mass_of(&self, k: usize) -> f64 {
         self.model.mass(&self.particles, k)
     }
 
@@ -157,7 +155,7 @@ impl Simulation {
 
     /// Each grain's id with its kinetic energies of translation and rotation, in id order:
     /// a plain sphere, or a rigid body (once, by its first sphere); of all processes.
-    fn grain_energies(&self) -> Vec<(Id, f64, f64)> {
+    pub(super) fn grain_energies(&self) -> Vec<(Id, f64, f64)> {
         let p = &self.particles;
         let mut energies: Vec<(Id, f64, f64)> = (0..p.len())
             .filter(|&k| self.own(k) && p.body[k].is_none())
@@ -244,6 +242,7 @@ impl Simulation {
             thermo.max_overlap = d.comm.max(thermo.max_overlap);
         }
         thermo.heat = self.temperatures();
+        thermo.energy = self.balance(thermo.kinetic_energy);
         thermo
     }
 }

@@ -454,6 +454,7 @@ impl Simulation {
                     .collect(),
                 scales: LoadScales::of(&scenario),
                 heat: None,
+                ledger: scenario.energy_ledger,
             },
             neighbours: Neighbours::with_periodic(skin, scenario.periodicity()),
             face_grid,
@@ -470,6 +471,10 @@ impl Simulation {
                 domain: Outflow::default(),
             },
             face_grid_radius: max_radius,
+            books: scenario.energy_ledger.then(|| {
+                let r_max = LoadScales::largest_radius(&scenario).max(max_radius);
+                super::ledger::Books::new(&LoadScales::of(&scenario), r_max)
+            }),
             share: None,
             scenario,
             particles,

@@ -10,6 +10,7 @@ pub mod heat;
 pub mod id;
 pub mod integrate;
 pub mod lanes;
+pub mod ledger;
 pub mod materials;
 pub mod motion;
 pub mod particles;

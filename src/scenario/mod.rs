@@ -34,7 +34,8 @@
 //! [[materials]] name, density, youngs_modulus, poisson_ratio, restitution, friction_*
 //! [[interactions]] materials = [a, b], restitution, friction_*
 //! [input]      particles
-//! [output]     dir, checkpoint_every, checkpoint_minutes, formats, wall_forces, contacts, forces,
+//! [output]     dir, checkpoint_every, checkpoint_minutes, formats, wall_forces, energy_ledger,
+//!              contacts, forces,
 //!              gather = "auto" | "always" | "never"
 //! ```
 //! Paths are relative to the scenario file. Unknown keys and values outside Table 2's
@@ -453,6 +454,8 @@ pub struct Scenario {
     pub formats: Formats,
     /// Write `walls.csv`: the force and torque the particles exert on each mesh file.
     pub wall_forces: bool,
+    /// Keep the energy ledger (`model/ledger.rs`): `log.csv` says where the energy went.
+    pub energy_ledger: bool,
     /// Write the contact network with every frame (`contactsNNNNNN.csv`, and `.vtp` with VTK).
     pub contact_network: bool,
     /// Write each row's contact force and torque in the frames (`fx,fy,fz,tx,ty,tz`; VTK's

@@ -418,6 +418,7 @@ pub(super) struct RawOutput {
     pub(super) checkpoint_minutes: Option<f64>,
     pub(super) formats: Option<Vec<String>>,
     pub(super) wall_forces: Option<bool>,
+    pub(super) energy_ledger: Option<bool>,
     pub(super) contacts: Option<bool>,
     pub(super) forces: Option<bool>,
     pub(super) gather: Option<String>,

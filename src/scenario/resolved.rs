@@ -329,6 +329,7 @@ impl Scenario {
         }
         let _ = writeln!(o, "formats = [{}]", formats.join(", "));
         let _ = writeln!(o, "wall_forces = {}", self.wall_forces);
+        let _ = writeln!(o, "energy_ledger = {}", self.energy_ledger);
         let _ = writeln!(o, "contacts = {}", self.contact_network);
         let _ = writeln!(o, "forces = {}", self.forces);
         let _ = writeln!(o, "gather = \"{}\"", self.gather.name());

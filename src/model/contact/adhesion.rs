@@ -27,6 +27,7 @@ use crate::model::materials::PairCoefficients;
 use crate::model::registry::AdhesionModel;
 
 use super::kinematics::Other;
+use super::normal::Elastic;
 
 coefficients! {
     /// The pair's constants of each adhesion model (zero: not that model).
@@ -132,6 +133,18 @@ pub trait Adhesion {
     fn reach(_: &Cohesion, _r_star: f64) -> f64 {
         0.0
     }
+
+    /// The elastic energy ∫ f_n dδ at overlap `delta` (the energy ledger's): Hertz's or
+    /// Hooke's, unless the model sets the contact radius.
+    fn elastic_energy(_: &Cohesion, elastic: &Elastic, r_star: f64, delta: f64) -> f64 {
+        elastic.energy(r_star, delta)
+    }
+
+    /// The energy of the pull, -∫ pull dδ from touch (the energy ledger's), of a contact
+    /// of body i (radius and R* in `radii`) with `other` at overlap `delta`.
+    fn energy(_: &Cohesion, _radii: (f64, f64), _other: Other, _delta: f64) -> f64 {
+        0.0
+    }
 }
 
 /// No adhesion (no pair of the run pulls).
@@ -176,6 +189,28 @@ impl Adhesion for Pull {
         };
         coef.k_c * c(std::f64::consts::PI) * a2 + coef.dmt * r_star
     }
+
+    /// SJKR's -k_c π ∫ a² dδ (a² as in `pull`, integrated in closed form) and DMT's
+    /// -2 π γ R* δ, while touching.
+    fn energy(coef: &Cohesion, (radius_i, r_star): (f64, f64), other: Other, delta: f64) -> f64 {
+        if delta <= 0.0 {
+            return 0.0;
+        }
+        let area = match other {
+            Other::Particle { r: radius_j, .. } => {
+                // a² = (R_i² + R_j²)/2 - d²/4 - (R_i² - R_j²)²/(4 d²) at the distance
+                // d = R_i + R_j - δ, whose antiderivative in d is `g`.
+                let (ri2, rj2) = (radius_i * radius_i, radius_j * radius_j);
+                let g = |d: f64| {
+                    0.5 * (ri2 + rj2) * d - d * d * d / 12.0 + (ri2 - rj2).powi(2) / (4.0 * d)
+                };
+                let d0 = radius_i + radius_j;
+                g(d0) - g(d0 - delta)
+            }
+            Other::Wall => radius_i * delta * delta - delta * delta * delta / 3.0,
+        };
+        -(coef.k_c * std::f64::consts::PI * area + coef.dmt * r_star * delta)
+    }
 }
 
 impl Adhesion for Jkr {
@@ -217,6 +252,42 @@ impl Adhesion for Jkr {
     fn reach(coef: &Cohesion, r_star: f64) -> f64 {
         coef.jkr_parting * 0.75 * (coef.jkr.powi(4) * r_star / 4.0).cbrt()
     }
+
+    /// ∫ 4/3 E* a δ dδ along JKR's branch from touch (a₀ = (c R*)^(2/3) at δ = 0), with
+    /// δ = a²/R* - c √a: 4/3 E* [2/5 a⁵/R*² - 5c/(7R*) a^(7/2) + c²/4 a²] from a₀ to a.
+    fn elastic_energy(coef: &Cohesion, elastic: &Elastic, r_star: f64, delta: f64) -> f64 {
+        let c = coef.jkr;
+        if c == 0.0 {
+            return elastic.energy(r_star, delta);
+        }
+        let e = |a: f64| {
+            0.4 * a.powi(5) / (r_star * r_star) - 5.0 * c / (7.0 * r_star) * a.powf(3.5)
+                + 0.25 * c * c * a * a
+        };
+        let (a, a0) = Self::radii(c, r_star, delta);
+        4.0 / 3.0 * elastic.e_star * (e(a) - e(a0))
+    }
+
+    /// -∫ 2/3 sqrt(2π γ E*) a^(3/2) dδ along the branch from touch:
+    /// -2/3 sqrt(2π γ E*) [4/7 a^(7/2)/R* - c/4 a²] from a₀ to a; and SJKR's and DMT's.
+    fn energy(coef: &Cohesion, radii: (f64, f64), other: Other, delta: f64) -> f64 {
+        let (c, r_star) = (coef.jkr, radii.1);
+        let others = Pull::energy(coef, radii, other, delta);
+        if c == 0.0 {
+            return others;
+        }
+        let p = |a: f64| 4.0 / 7.0 * a.powf(3.5) / r_star - 0.25 * c * a * a;
+        let (a, a0) = Self::radii(c, r_star, delta);
+        others - 2.0 / 3.0 * coef.jkr_e * (p(a) - p(a0))
+    }
+}
+
+impl Jkr {
+    /// JKR's contact radius at overlap `delta` and at touch, for c = sqrt(2π γ / E*).
+    fn radii(c: f64, r_star: f64, delta: f64) -> (f64, f64) {
+        let s = jkr_root(c * r_star, delta * r_star);
+        (s * s, (c * r_star).powf(2.0 / 3.0))
+    }
 }
 
 impl Adhesion for Bridge {
@@ -251,6 +322,23 @@ impl Adhesion for Bridge {
     #[inline(always)]
     fn reach(coef: &Cohesion, _: f64) -> f64 {
         coef.rupture
+    }
+
+    /// Touching, -F(0) δ (and SJKR's, DMT's); apart, the work of stretching the bridge
+    /// from touch to the gap s = -δ, Willett's force integrated in closed form:
+    /// F(0)/κ · 2/√D [atan((20 κ s + 2.1)/√D) - atan(2.1/√D)], S⁺ = κ s, D = 40 - 2.1².
+    fn energy(coef: &Cohesion, radii: (f64, f64), other: Other, delta: f64) -> f64 {
+        let at_touch = coef.bridge * radii.1;
+        if delta > 0.0 {
+            return -at_touch * delta + Pull::energy(coef, radii, other, delta);
+        }
+        if at_touch == 0.0 {
+            return 0.0;
+        }
+        let kappa = 0.5 * (2.0 * radii.1 * coef.per_volume).sqrt();
+        let root = (40.0f64 - 2.1 * 2.1).sqrt();
+        let s = -delta * kappa;
+        at_touch / kappa * 2.0 / root * (((20.0 * s + 2.1) / root).atan() - (2.1 / root).atan())
     }
 }
 

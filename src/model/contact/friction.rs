@@ -35,6 +35,11 @@ pub(super) fn project_onto_tangent_plane<T: Lanes>(u: T::Vec, n: T::Vec) -> T::V
     tangential * stretch
 }
 
+/// The energy k |u|²/2 of a spring of stiffness `k` stretched by |u|² = `u2`.
+pub(super) fn spring_energy(k: f64, u2: f64) -> f64 {
+    0.5 * k * u2
+}
+
 /// One friction mode m ∈ {s, r, t}: the Kelvin-Voigt force -k u - c v, clipped by Coulomb's
 /// law to `f_max` = μ_m |f_n|. Static: the spring grows by Δt v (Eq. 53). Kinetic: the force
 /// is scaled to the Coulomb limit (Eq. 54) and the spring set to match it (Eq. 55), so the

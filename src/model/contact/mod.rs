@@ -57,6 +57,7 @@ macro_rules! coefficients {
 pub mod adhesion;
 pub mod composition;
 pub mod damping;
+mod energy;
 pub mod friction;
 pub mod kinematics;
 pub mod normal;
@@ -193,6 +194,20 @@ pub struct ContactForce<T: Lanes = f64> {
     pub tau_i: T::Vec,
     /// Torque on body j: (r_j / r_i) τ_s - τ_r - τ_t, Eqs. (58)-(60).
     pub tau_j: T::Vec,
+}
+
+/// A contact's force and torques by mode, for the energy ledger: the work each does.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ContactParts<T: Lanes = f64> {
+    /// k_n δ - c_n v_n along n̂, the elastic and damped normal force on body i.
+    pub f_normal: T,
+    /// The adhesion's pull along -n̂.
+    pub pull: T,
+    /// f_s, the sliding force on body i (its torques follow from the arms).
+    pub f_s: T::Vec,
+    /// τ_r and τ_t on body i.
+    pub tau_r: T::Vec,
+    pub tau_t: T::Vec,
 }
 
 /// What the sub-models of one contact share, computed once: its geometry, effective
@@ -385,6 +400,25 @@ impl ContactLaw {
         T: Lanes + Displacement<T>,
         T::Vec: Displacement<T>,
     {
+        self.compose_parts::<M, T>(coef, (radius_i, m_i), other, kin, springs)
+            .0
+    }
+
+    /// [`ContactLaw::compose`] with the force and torques by mode (the energy ledger's);
+    /// body i's radius and mass in `body_i`.
+    #[inline(always)]
+    pub fn compose_parts<M: Models, T>(
+        &self,
+        coef: &Coefficients<T>,
+        (radius_i, m_i): (T, T),
+        other: Other<T>,
+        kin: &Kinematics<T>,
+        springs: &mut Springs<T>,
+    ) -> (ContactForce<T>, ContactParts<T>)
+    where
+        T: Lanes + Displacement<T>,
+        T::Vec: Displacement<T>,
+    {
         let Kinematics {
             n,
             delta,
@@ -443,6 +477,13 @@ impl ContactLaw {
                 Other::Wall => T::Vec::default(),
             },
         };
+        let mut parts = ContactParts {
+            f_normal: f_n_scalar,
+            pull,
+            f_s,
+            tau_r,
+            tau_t,
+        };
         if M::Adhesion::BEYOND_TOUCH && !M::Adhesion::NECK {
             // Apart, a bridge alone: no solid contact, and its springs start afresh.
             let apart = delta.le(T::splat(0.0));
@@ -451,8 +492,12 @@ impl ContactLaw {
             force.tau_i = T::pick_vec(apart, || zero, || force.tau_i);
             force.tau_j = T::pick_vec(apart, || zero, || force.tau_j);
             springs.forget_where(apart);
+            parts.f_normal = <T as Lanes>::pick(apart, || T::splat(0.0), || f_n_scalar);
+            parts.f_s = T::pick_vec(apart, || zero, || f_s);
+            parts.tau_r = T::pick_vec(apart, || zero, || tau_r);
+            parts.tau_t = T::pick_vec(apart, || zero, || tau_t);
         }
-        force
+        (force, parts)
     }
 }
 

@@ -89,6 +89,18 @@ impl Elastic {
     }
 }
 
+impl Elastic {
+    /// The elastic energy ∫ f_n dδ of a contact of effective radius `r_star` at overlap
+    /// `delta` (the energy ledger's): Hooke's k_n δ²/2, Hertz's 2/5 k_n δ² (f_n ∝ δ^(3/2)).
+    pub fn energy(&self, r_star: f64, delta: f64) -> f64 {
+        if delta <= 0.0 {
+            return 0.0;
+        }
+        let a = (r_star * delta).sqrt(); // Eq. (14)
+        (0.5 * self.k_n0 + 8.0 / 15.0 * self.e_star * a) * delta * delta
+    }
+}
+
 impl<T: Lanes> Elastic<T> {
     /// k_n and k_s at overlap `delta` of a contact of effective radius `r_star`.
     #[inline(always)]

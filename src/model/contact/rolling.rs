@@ -28,6 +28,26 @@ coefficients! {
     }
 }
 
+impl Rolling {
+    /// The energy its state holds (the energy ledger's), at normal stiffness `k_n`: the
+    /// spring's k_r |u_r|²/2, EPSD2's |M_r|²/(2 k_r), none in CDT.
+    pub fn energy(&self, model: RollingModel, k_n: f64, r_star: f64, u_r: glam::DVec3) -> f64 {
+        let mu_r = self.mu_r;
+        match model {
+            RollingModel::Spring => 0.5 * k_n * u_r.length_squared(),
+            RollingModel::Cdt => 0.0,
+            RollingModel::Epsd2 => {
+                let k_r = 2.25 * k_n * (mu_r * r_star).powi(2);
+                if k_r > 0.0 {
+                    u_r.length_squared() / (2.0 * k_r)
+                } else {
+                    0.0
+                }
+            }
+        }
+    }
+}
+
 impl<T> Rolling<T>
 where
     T: Lanes + Displacement<T>,

@@ -1,0 +1,200 @@
+//! The energy ledger's stage (`[output] energy_ledger`, `model/ledger.rs`): once the
+//! particles have moved, the work of each contact's modes at the mean velocities of the
+//! step, of gravity and of the fluid's drag; the kinetic energy spawned and removed; and,
+//! at a frame, the energy the contacts hold.
+
+use super::*;
+use crate::model::ledger::{Balance, CHUNK, Entry, Ledger, Mean, WALL};
+use wide::f64x8;
+
+/// The ledger of a run and the stage's scratch.
+pub(crate) struct Books {
+    ledger: Ledger,
+    /// Each particle's velocities before this step moved it.
+    before: Vec<(DVec3, DVec3)>,
+}
+
+impl Books {
+    /// The books of a run whose contact forces are at most `scales.force` and radii at
+    /// most `r_max`: a term is the work of a step, which no contact can make larger than
+    /// its force over a radius; the sums hold 2^41 times that.
+    pub(super) fn new(scales: &LoadScales, r_max: f64) -> Books {
+        Books {
+            ledger: Ledger::new(scales.force.largest() * r_max * 2f64.powi(30)),
+            before: Vec::new(),
+        }
+    }
+}
+
+impl Simulation {
+    /// Before stage 5: the velocities the particles move from (with the ledger).
+    pub(super) fn remember_velocities(&mut self) {
+        if let Some(books) = &mut self.books {
+            let p = &self.particles;
+            books.before.clear();
+            books
+                .before
+                .extend(p.v.iter().copied().zip(p.w.iter().copied()));
+        }
+    }
+
+    /// The ledger's stage, after stages 5-5c: the step's work of the modes of the
+    /// contacts `entries` (those of own particles, of a pair the lower id's) and of the
+    /// walls; of gravity and drag on own particles. Whether every term was in range.
+    pub(super) fn keep_books(&mut self, entries: &[Entry]) -> bool {
+        let Some(books) = &mut self.books else {
+            return true;
+        };
+        let (p, model) = (&self.particles, &self.model);
+        let (dt, g) = (
+            self.scenario.simulation.timestep,
+            self.scenario.kinetics.gravity,
+        );
+        let own = |k: usize| self.share.as_ref().is_none_or(|d| d.owned[k]);
+        let before = &books.before;
+        let mean = |k: usize| {
+            let (v, w) = before[k];
+            Mean {
+                v: 0.5 * (v + p.v[k]),
+                w: 0.5 * (w + p.w[k]),
+            }
+        };
+        let ledger = &books.ledger;
+        let merge = |(mut a, fa): (Sum6, bool), (b, fb): (Sum6, bool)| {
+            a.merge(&b);
+            (a, fa & fb)
+        };
+        let (contacts, fine) = entries
+            .par_chunks(CHUNK)
+            .map(|chunk| {
+                let own = chunk.iter().filter(|e| own(e.i as usize));
+                ledger.sum(own.map(|e| {
+                    let j = match e.j {
+                        WALL => Mean::default(),
+                        j => mean(j as usize),
+                    };
+                    e.work(mean(e.i as usize), j, dt)
+                }))
+            })
+            .reduce(|| (Sum6::default(), true), merge);
+        let work = |k: usize| {
+            // Gravity's, and the drag's at the velocities it was taken at (Eqs. 42-44).
+            let m = model.mass(p, k);
+            let (v, w) = before[k];
+            let Mean { v: v_mid, w: w_mid } = mean(k);
+            let r = p.radius[k];
+            let c = model.densities[p.material[k] as usize].drag / (r * r); // Eq. (3)
+            let gravity = m * g.dot(v_mid) * dt;
+            let inertia = 0.4 * m * r * r;
+            let drag = -(m * c * v.dot(v_mid) + inertia * (10.0 / 3.0) * c * w.dot(w_mid)) * dt;
+            f64x8::from([gravity, drag, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+        };
+        let (particles, fine_p) = (0..p.len())
+            .into_par_iter()
+            .with_min_len(CHUNK)
+            .chunks(CHUNK)
+            .map(|ks| ledger.sum(ks.into_iter().filter(|&k| own(k)).map(work)))
+            .reduce(|| (Sum6::default(), true), merge);
+        books.ledger.add_contacts(&contacts);
+        books.ledger.add_particles(&particles);
+        fine & fine_p
+    }
+
+    /// The kinetic energy of the own particles `ks` brought in (spawned) or taken out
+    /// (removed), to the ledger.
+    pub(super) fn book_kinetic(&mut self, ks: impl Iterator<Item = usize>, spawned: bool) {
+        let Some(books) = &mut self.books else {
+            return;
+        };
+        let p = &self.particles;
+        let energy = |k: usize| {
+            let m = self.model.mass(p, k);
+            let r = p.radius[k];
+            0.5 * m * (p.v[k].length_squared() + 0.4 * r * r * p.w[k].length_squared())
+        };
+        let terms: Vec<f64> = ks
+            .filter(|&k| self.share.as_ref().is_none_or(|d| d.owned[k]))
+            .map(energy)
+            .collect();
+        let slot = if spawned { 2 } else { 3 };
+        for chunk in terms.chunks(CHUNK) {
+            let (sum, _) = books.ledger.sum(chunk.iter().map(|&e| {
+                let mut t = [0.0; 8];
+                t[slot] = e;
+                f64x8::from(t)
+            }));
+            books.ledger.add_particles(&sum);
+        }
+    }
+
+    /// At the first step: the energy the ledger starts from.
+    pub(super) fn open_books(&mut self) {
+        if self
+            .books
+            .as_ref()
+            .is_some_and(|b| b.ledger.start.is_none())
+        {
+            let (kinetic, stored) = (self.thermo_kinetic(), self.stored_energy());
+            let books = self.books.as_mut().expect("kept");
+            books.ledger.start = Some(kinetic + stored.iter().sum::<f64>());
+            books.ledger.stored_start = stored;
+        }
+    }
+
+    /// The kinetic energy of all grains (collective in a split run).
+    fn thermo_kinetic(&self) -> f64 {
+        let e = self.grain_energies();
+        e.iter().map(|e| e.1 + e.2).sum()
+    }
+
+    /// The energy the contacts of own particles hold now, by mode (over all processes,
+    /// collective in a split run; exact sums, so the same for any split).
+    pub(super) fn stored_energy(&self) -> [f64; 5] {
+        let Some(books) = &self.books else {
+            return [0.0; 5];
+        };
+        let p = &self.particles;
+        let mut terms = Vec::new();
+        self.each_held_contact(|i, other, kin, coef, springs, _| {
+            if self.own(i) {
+                let body = (p.radius[i], self.mass_of(i));
+                let e = self.model.law.stored(coef, body, other, kin, &springs);
+                terms.push(f64x8::from([e[0], e[1], e[2], e[3], e[4], 0.0, 0.0, 0.0]));
+            }
+        });
+        let mut sum = Sum6::default();
+        for chunk in terms.chunks(CHUNK) {
+            sum.merge(&books.ledger.sum(chunk.iter().copied()).0);
+        }
+        let stored = self.over_processes(&books.ledger, &sum);
+        std::array::from_fn(|m| stored[m])
+    }
+
+    /// The value of `sum` over all processes.
+    fn over_processes(&self, ledger: &Ledger, sum: &Sum6) -> [f64; 6] {
+        let words = match &self.share {
+            Some(d) => d.comm.sum_i64(&sum.words()),
+            None => sum.words().to_vec(),
+        };
+        ledger.value(&words)
+    }
+
+    /// The ledger's columns of `log.csv` now (collective in a split run), with the
+    /// kinetic energy `kinetic`; `None` without the ledger.
+    pub(super) fn balance(&self, kinetic: f64) -> Option<Balance> {
+        let books = self.books.as_ref()?;
+        let stored = self.stored_energy();
+        let mut ledger = books.ledger;
+        let words = ledger.words();
+        let all = match &self.share {
+            Some(d) => d.comm.sum_i64(&words),
+            None => words.to_vec(),
+        };
+        ledger = ledger.with_words(&all);
+        if ledger.start.is_none() {
+            ledger.start = Some(kinetic + stored.iter().sum::<f64>());
+            ledger.stored_start = stored;
+        }
+        Some(Balance::of(&ledger, kinetic, stored))
+    }
+}
