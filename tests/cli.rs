@@ -1276,3 +1276,51 @@ fn a_fifo_as_an_input_file_is_refused_without_blocking() {
         );
     }
 }
+
+/// `tinydem analyze --energy`: the ledger's breakdown at the last frame (the shares of the
+/// energy put in add up to one) and its plot; a log without the ledger is refused.
+#[test]
+fn analyze_energy_tells_where_the_energy_went() {
+    let t = tempfile::tempdir().unwrap();
+    hourglass_frames("2", t.path());
+    fails_with(
+        &tinydem(&["analyze", "out", "--energy"], t.path()),
+        &["log.csv has no energy ledger: run with [output] energy_ledger = true"],
+    );
+    let mesh = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/hourglass.off");
+    write(
+        t.path(),
+        "e.toml",
+        &format!(
+            "[geometry]\nmesh = \"{}\"\n[simulation]\nmax_particles = 500\nframes = 3\nsteps_per_frame = 600\n\
+             [output]\nenergy_ledger = true\n",
+            mesh.display()
+        ),
+    );
+    let o = tinydem(&["run", "e.toml", "-q", "--output", "ledger"], t.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = tinydem(
+        &["analyze", "ledger", "--energy", "--plot", "e.png"],
+        t.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    let share = |column: &str| -> f64 {
+        let line = out.lines().find(|l| l.starts_with(column)).expect(column);
+        let pct = line.split_whitespace().last().unwrap();
+        pct.trim_end_matches('%').parse::<f64>().unwrap() / 100.0
+    };
+    // What holds the energy and what took it: all but the work, the energy spawned and the
+    // residual.
+    let taken = tinydem::model::ledger::COLUMNS
+        .into_iter()
+        .filter(|c| c.starts_with("dissipated_") || *c == "energy_removed");
+    let columns: Vec<&str> = ["kinetic_energy", "stored_elastic"]
+        .into_iter()
+        .chain(taken)
+        .collect();
+    let total: f64 = columns.iter().map(|c| share(c)).sum();
+    assert!((total - 1.0).abs() < 1e-4, "{total}\n{out}");
+    assert!(share("dissipated_sliding") > 0.0, "{out}");
+    assert!(image::open(t.path().join("e.png")).is_ok());
+}

@@ -323,7 +323,11 @@ fn heat_split_over_processes_gives_the_bits_of_one_process_and_resumes_on_anothe
 
 #[test]
 fn a_checkpoint_of_two_processes_resumes_on_three_with_the_same_bits() {
-    let text = silo(0.5);
+    // With the energy ledger, which the checkpoint keeps (`End::energy`).
+    let text = silo(0.5).replace(
+        "wall_forces = true\n",
+        "wall_forces = true\nenergy_ledger = true\n",
+    );
     checkpoint_on_2_resumes_on_3(move || common::scenario(&text), 1200, 1300);
 }
 

@@ -4,7 +4,7 @@
 //! at a frame, the energy the contacts hold.
 
 use super::*;
-use crate::model::ledger::{Balance, CHUNK, Entry, Ledger, Mean, WALL};
+use crate::model::ledger::{Balance, CHUNK, Entry, Kept, Ledger, Mean, WALL};
 use wide::f64x8;
 
 /// The ledger of a run and the stage's scratch.
@@ -23,6 +23,16 @@ impl Books {
             ledger: Ledger::new(scales.force.largest() * r_max * 2f64.powi(30)),
             before: Vec::new(),
         }
+    }
+
+    /// What a checkpoint keeps of the ledger.
+    pub(super) fn kept(&self) -> Kept {
+        self.ledger.kept()
+    }
+
+    /// The ledger continued from a checkpoint's.
+    pub(super) fn resume(&mut self, kept: &Kept) {
+        self.ledger = self.ledger.with_kept(kept);
     }
 }
 
@@ -95,6 +105,17 @@ impl Simulation {
             .chunks(CHUNK)
             .map(|ks| ledger.sum(ks.into_iter().filter(|&k| own(k)).map(work)))
             .reduce(|| (Sum6::default(), true), merge);
+        let (contacts, particles) = match &self.share {
+            // Every process holds the sums of all (as the walls' heat): a checkpoint's parts
+            // agree.
+            Some(d) => {
+                let words = [contacts.words(), particles.words()].concat();
+                let all = d.comm.sum_i64(&words);
+                let sum = |k: usize| Sum6::from_words(all[k..k + 12].try_into().expect("12"));
+                (sum(0), sum(12))
+            }
+            None => (contacts, particles),
+        };
         books.ledger.add_contacts(&contacts);
         books.ledger.add_particles(&particles);
         fine & fine_p
@@ -117,14 +138,25 @@ impl Simulation {
             .map(energy)
             .collect();
         let slot = if spawned { 2 } else { 3 };
+        let mut sum = Sum6::default();
         for chunk in terms.chunks(CHUNK) {
-            let (sum, _) = books.ledger.sum(chunk.iter().map(|&e| {
-                let mut t = [0.0; 8];
-                t[slot] = e;
-                f64x8::from(t)
-            }));
-            books.ledger.add_particles(&sum);
+            sum.merge(
+                &books
+                    .ledger
+                    .sum(chunk.iter().map(|&e| {
+                        let mut t = [0.0; 8];
+                        t[slot] = e;
+                        f64x8::from(t)
+                    }))
+                    .0,
+            );
         }
+        // Over all processes (collective: each spawns and removes in step with the others).
+        if let Some(d) = &self.share {
+            let all = d.comm.sum_i64(&sum.words());
+            sum = Sum6::from_words(all.try_into().expect("12 words"));
+        }
+        books.ledger.add_particles(&sum);
     }
 
     /// At the first step: the energy the ledger starts from.
@@ -184,13 +216,8 @@ impl Simulation {
     pub(super) fn balance(&self, kinetic: f64) -> Option<Balance> {
         let books = self.books.as_ref()?;
         let stored = self.stored_energy();
+        // Each process holds the sums of all.
         let mut ledger = books.ledger;
-        let words = ledger.words();
-        let all = match &self.share {
-            Some(d) => d.comm.sum_i64(&words),
-            None => words.to_vec(),
-        };
-        ledger = ledger.with_words(&all);
         if ledger.start.is_none() {
             ledger.start = Some(kinetic + stored.iter().sum::<f64>());
             ledger.stored_start = stored;

@@ -118,6 +118,10 @@ impl Simulation {
         if sim.model.heat.is_some() && snapshot.wall_heat.len() == sim.walls.heat.len() {
             sim.walls.heat = snapshot.wall_heat;
         }
+        // The ledger goes on where it was (a run that did not keep it starts it here).
+        if let (Some(books), Some(kept)) = (&mut sim.books, &snapshot.ledger) {
+            books.resume(kept);
+        }
         let dt = sim.scenario.simulation.timestep;
         if snapshot.anchors.is_empty() {
             // Taken before the first step: the lists are made as that step would make them.

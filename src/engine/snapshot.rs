@@ -71,6 +71,7 @@ impl Simulation {
             scenario: self.scenario.to_toml(),
             mesh_files: self.walls.signatures(),
             servos: self.walls.servos(),
+            ledger: self.books.as_ref().map(|b| b.kept()),
         }
     }
 

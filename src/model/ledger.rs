@@ -180,6 +180,34 @@ impl Ledger {
     }
 }
 
+/// What a checkpoint keeps of a ledger: its sums' integers, and where it started.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Kept {
+    pub words: [i64; 24],
+    pub start: Option<f64>,
+    pub stored_start: [f64; 5],
+}
+
+impl Ledger {
+    /// What a checkpoint keeps of it.
+    pub fn kept(&self) -> Kept {
+        Kept {
+            words: self.words(),
+            start: self.start,
+            stored_start: self.stored_start,
+        }
+    }
+
+    /// The ledger continued from `kept`.
+    pub fn with_kept(self, kept: &Kept) -> Ledger {
+        Ledger {
+            start: kept.start,
+            stored_start: kept.stored_start,
+            ..self.with_words(&kept.words)
+        }
+    }
+}
+
 /// A ledger's columns of `log.csv` at one frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Balance {
@@ -219,9 +247,10 @@ impl Balance {
     pub fn of(ledger: &Ledger, kinetic: f64, stored: [f64; 5]) -> Balance {
         let start = ledger.start.unwrap_or_default();
         let t = ledger.totals();
-        // Energy a mode took from the bodies, less what it still holds.
+        // Energy a mode took from the bodies, less what it still holds (+ 0: no -0 in the
+        // logs).
         let dissipated: [f64; 5] =
-            std::array::from_fn(|m| -t[m] - (stored[m] - ledger.stored_start[m]));
+            std::array::from_fn(|m| -t[m] - (stored[m] - ledger.stored_start[m]) + 0.0);
         let stored_elastic = stored.iter().sum::<f64>();
         let [work_walls, work_gravity, drag, spawned, removed] = [t[5], t[6], t[7], t[8], t[9]];
         Balance {
@@ -229,7 +258,7 @@ impl Balance {
             work_walls,
             stored_elastic,
             dissipated,
-            dissipated_drag: -drag,
+            dissipated_drag: -drag + 0.0,
             spawned,
             removed,
             residual: kinetic + stored_elastic + dissipated.iter().sum::<f64>()

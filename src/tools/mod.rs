@@ -4,6 +4,7 @@ pub mod analyze;
 pub mod bench;
 pub mod fields;
 pub mod frames;
+pub mod ledger;
 pub mod plot;
 pub mod render;
 pub mod text;

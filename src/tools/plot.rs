@@ -88,6 +88,12 @@ pub fn unit(column: &str) -> Option<&'static str> {
         "density" => "kg/m^3",
         "max_overlap" => "of the smaller radius",
         _ if c.starts_with("repose_") => "°",
+        _ if ["work_", "stored_", "dissipated_", "energy_"]
+            .iter()
+            .any(|p| c.starts_with(p)) =>
+        {
+            "J"
+        }
         _ if c.starts_with("mesh") && c.ends_with("_position") => "m",
         _ if c.starts_with("mesh") && c.ends_with("_load") => "N",
         _ if ["stress_", "contact_", "kinetic_"]
@@ -290,11 +296,20 @@ where
     for (k, line) in lines.iter().enumerate() {
         let colour = COLOURS[k % COLOURS.len()];
         let style = colour.stroke_width(width);
-        chart
-            .draw_series(LineSeries::new(line.points.iter().copied(), style))
-            .map_err(|e| fail(&e))?
-            .label(line.label.as_str())
-            .legend(move |(x, y)| PathElement::new([(x, y), (x + 18, y)], style));
+        let points = line.points.iter().copied();
+        // The colours once more, dashed.
+        let (dash, gap) = (3 * width, 2 * width);
+        let drawn = match k < COLOURS.len() {
+            true => chart.draw_series(LineSeries::new(points, style)),
+            false => chart.draw_series(DashedLineSeries::new(points, dash, gap, style)),
+        };
+        let series = drawn.map_err(|e| fail(&e))?.label(line.label.as_str());
+        match k < COLOURS.len() {
+            true => series.legend(move |(x, y)| PathElement::new([(x, y), (x + 18, y)], style)),
+            false => series.legend(move |(x, y)| {
+                plotters::element::DashedPathElement::new([(x, y), (x + 18, y)], dash, gap, style)
+            }),
+        };
     }
     if lines.len() > 1 {
         chart

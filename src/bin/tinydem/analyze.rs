@@ -46,6 +46,11 @@ pub struct AnalyzeArgs {
     /// with cell arrays) and .csv beside the frames. Needs [output] contacts = true.
     #[arg(long, conflicts_with = "fields")]
     wall_stress: bool,
+    /// Instead of the table: where the energy went, from log.csv's energy ledger ([output]
+    /// energy_ledger = true): at the last frame, what holds it and what took it, each with
+    /// its share of the energy put in; with --plot, the ledger's columns against time.
+    #[arg(long, conflicts_with_all = ["fields", "wall_stress"])]
+    energy: bool,
     /// Report the mean height of the particles with at least this radius.
     #[arg(long)]
     large: Option<f64>,
@@ -173,10 +178,38 @@ impl FieldArgs {
 }
 
 impl AnalyzeArgs {
+    /// `--energy`: the ledger's breakdown at the last frame, and its plot.
+    fn energy_ledger(self) -> Result<()> {
+        let path = self.dir.join("log.csv");
+        let text = std::fs::read_to_string(&path)
+            .with_context(|| format!("reading {}", path.display()))?;
+        let table = tinydem::tools::plot::Table::parse(&text, "log.csv")?;
+        println!(
+            "{:<22} {:>14} {:>9}",
+            "at the last frame", "energy [J]", "of input"
+        );
+        for s in tinydem::tools::ledger::breakdown(&table)? {
+            println!(
+                "{:<22} {:>14.6e} {:>8.3}%",
+                s.column,
+                s.value,
+                100.0 * s.share
+            );
+        }
+        if let Some(plot) = &self.plot {
+            let y = tinydem::tools::ledger::plotted(&table);
+            crate::plot::draw(&table, "time", &y, self.style, plot)?;
+        }
+        Ok(())
+    }
+
     /// Measures every frame, printing a row each, then writes the CSV and the plot.
     pub fn execute(self) -> Result<()> {
         if self.fields.fields {
             return self.fields.execute(&self.dir, self.scenario.as_deref());
+        }
+        if self.energy {
+            return self.energy_ledger();
         }
         if self.wall_stress {
             let written = tinydem::tools::walls::of_directory(&self.dir, self.scenario.as_deref())?;

@@ -21,7 +21,9 @@
 //! `model/fields.rs`; without them, format 7) the optional fields: count (u32) and per field
 //! its name (length u8, bytes) and its values in storage order; from format 9 (written with
 //! heat transfer) the heat into each mesh file since the last frame (count u64, i128 each);
-//! last a CRC-32 of everything
+//! from format 10 (written with the energy ledger) the ledger: its sums' 24 integers (i64),
+//! whether it has started (u8), its starting energy and each mode's stored energy then (6
+//! f64); last a CRC-32 of everything
 //! before it. A particle's record is the table's (`model/particles.rs`, the core fields with
 //! a checkpoint format, from that format on, in the table's order).
 //!
@@ -41,13 +43,16 @@ use crate::model::servo::State;
 use crate::neighbours::Entry;
 
 const MAGIC: &[u8; 12] = b"TINYDEM CKPT";
-const VERSION: u32 = 9;
+const VERSION: u32 = 10;
 /// The format of a checkpoint without optional particle fields: 7, whose bytes format 8
 /// adds the section of the optional fields to.
 const WITHOUT_OPTIONAL: u32 = 7;
 /// The format of a checkpoint with optional fields and no heat transfer: 8, whose bytes
 /// format 9 adds the heat into the walls to.
 const WITHOUT_HEAT: u32 = 8;
+/// The format of a checkpoint without the energy ledger: 9, whose bytes format 10 adds the
+/// ledger to.
+const WITHOUT_LEDGER: u32 = 9;
 /// The oldest version this program reads.
 const OLDEST: u32 = 2;
 
@@ -111,7 +116,8 @@ pub fn encode_into(out: &mut Vec<u8>, snapshot: &Snapshot, fingerprint: u64) {
     let optional = !snapshot.particles.active.fields().is_empty()
         || !snapshot.contact_state.fields().is_empty();
     let version = match (optional, snapshot.wall_heat.is_empty()) {
-        (_, false) => VERSION,
+        _ if snapshot.ledger.is_some() => VERSION,
+        (_, false) => WITHOUT_LEDGER,
         (true, true) => WITHOUT_HEAT,
         (false, true) => WITHOUT_OPTIONAL,
     };
@@ -192,14 +198,28 @@ fn encode_as(out: &mut Vec<u8>, snapshot: &Snapshot, fingerprint: u64, version: 
         put_optional(out, p);
         put_optional_state(out, snapshot);
     }
+    put_heat_and_ledger(out, snapshot, version);
+    let crc = crc32fast::hash(&out[start..]);
+    out.extend_from_slice(&crc.to_le_bytes());
+}
+
+/// The heat into the walls (format 9) and the energy ledger (format 10).
+fn put_heat_and_ledger(out: &mut Vec<u8>, snapshot: &Snapshot, version: u32) {
     if version >= 9 {
         out.extend_from_slice(&(snapshot.wall_heat.len() as u64).to_le_bytes());
         for q in &snapshot.wall_heat {
             out.extend_from_slice(&q.to_le_bytes());
         }
     }
-    let crc = crc32fast::hash(&out[start..]);
-    out.extend_from_slice(&crc.to_le_bytes());
+    if version >= 10 {
+        let kept = snapshot.ledger.unwrap_or_default();
+        for w in kept.words {
+            out.extend_from_slice(&w.to_le_bytes());
+        }
+        out.push(kept.start.is_some() as u8);
+        put_f64s(out, &[kept.start.unwrap_or(0.0)]);
+        put_f64s(out, &kept.stored_start);
+    }
 }
 
 /// A field's name: its length (u8) and bytes.
@@ -429,7 +449,8 @@ pub fn decode(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<Snapsho
     let mut wall_heat = Vec::new();
     if version >= 9 {
         let files = r.count(16)?;
-        if files != rest.mesh_files.len() {
+        // None without heat transfer (format 10 has the section either way).
+        if files != 0 && files != rest.mesh_files.len() {
             bail!(
                 "corrupt checkpoint: the heat of {files} mesh files, for {} files",
                 rest.mesh_files.len()
@@ -439,6 +460,10 @@ pub fn decode(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<Snapsho
             wall_heat.push(i128::from_le_bytes(r.take(16)?.try_into()?));
         }
     }
+    let ledger = match version >= 10 {
+        true => Some(r.ledger()?),
+        false => None,
+    };
     if r.at != r.bytes.len() {
         bail!(
             "corrupt checkpoint: {} unexpected bytes at the end",
@@ -466,6 +491,7 @@ pub fn decode(bytes: &[u8], expected_fingerprint: Option<u64>) -> Result<Snapsho
         scenario: rest.scenario,
         mesh_files: rest.mesh_files,
         servos: rest.servos,
+        ledger,
     })
 }
 
@@ -638,6 +664,25 @@ impl Cursor<'_> {
             bail!("corrupt checkpoint: lonely particles out of order or range");
         }
         Ok(lonely)
+    }
+
+    /// The energy ledger (format 10): its sums' integers, its start.
+    fn ledger(&mut self) -> Result<crate::model::ledger::Kept> {
+        let mut words = [0i64; 24];
+        for w in &mut words {
+            *w = self.u64()? as i64;
+        }
+        let started = self.u8()? != 0;
+        let start = self.f64()?;
+        let mut stored_start = [0.0; 5];
+        for e in &mut stored_start {
+            *e = self.f64()?;
+        }
+        Ok(crate::model::ledger::Kept {
+            words,
+            start: started.then_some(start),
+            stored_start,
+        })
     }
 
     /// The servos' states with their mesh files (below `files`, ascending), finite (format

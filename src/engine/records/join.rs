@@ -39,7 +39,8 @@ pub fn join(pieces: Vec<Snapshot>) -> Result<Snapshot> {
                 && p.wall_heat == first.wall_heat
                 && p.scenario == first.scenario
                 && p.mesh_files == first.mesh_files
-                && p.servos == first.servos,
+                && p.servos == first.servos
+                && p.ledger == first.ledger,
             "corrupt: part {k} is not of the state of part 0 (another step or run)"
         );
         ensure!(
@@ -95,6 +96,7 @@ pub fn join(pieces: Vec<Snapshot>) -> Result<Snapshot> {
         scenario: first.scenario.clone(),
         mesh_files: first.mesh_files.clone(),
         servos: first.servos.clone(),
+        ledger: first.ledger,
     })
 }
 

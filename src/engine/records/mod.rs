@@ -46,6 +46,8 @@ pub struct Snapshot {
     pub servos: Vec<(u32, crate::model::servo::State)>,
     /// The optional members of a contact's state the histories hold (format 8).
     pub contact_state: crate::model::contact_state::ActiveState,
+    /// The energy ledger, if the run keeps it (format 10).
+    pub ledger: Option<crate::model::ledger::Kept>,
 }
 
 /// The partner of a particle in a contact.

@@ -322,6 +322,7 @@ mod tests {
                     load: 2.5,
                 },
             )],
+            ledger: None,
         }
     }
 
@@ -414,6 +415,20 @@ mod tests {
             format!("{e:#}").contains("the heat of 3 mesh files, for 2 files"),
             "{e:#}"
         );
+        // With the energy ledger (format 10), with and without heat transfer.
+        s.wall_heat.pop();
+        let mut words = [0i64; 24];
+        (words[0], words[7], words[23]) = (-3, 1 << 60, 42);
+        s.ledger = Some(crate::model::ledger::Kept {
+            words,
+            start: Some(1.25),
+            stored_start: [1e-3, 2e-4, 0.0, -5e-6, 7.0],
+        });
+        let bytes = encode(&s, 7);
+        assert_eq!(u32::from_le_bytes(bytes[12..16].try_into().unwrap()), 10);
+        assert_eq!(decode(&bytes, Some(7)).unwrap(), s);
+        s.wall_heat.clear();
+        assert_eq!(decode(&encode(&s, 7), Some(7)).unwrap(), s);
     }
 
     /// A snapshot's bytes with format `version` for `bytes` of the newest format whose
@@ -481,8 +496,8 @@ mod tests {
         flipped[40] ^= 1;
         assert!(msg(&flipped, 7).contains("checksum"));
         let mut version = bytes.clone();
-        version[12] = 10;
-        assert!(msg(&version, 7).contains("version 10"));
+        version[12] = 11;
+        assert!(msg(&version, 7).contains("version 11"));
         version[12] = 1;
         assert!(msg(&version, 7).contains("version 1"));
         assert!(msg(b"hello world, not a checkpoint", 7).contains("not a tinydem checkpoint"));
