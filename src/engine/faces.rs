@@ -60,12 +60,11 @@ struct FaceStage<'a> {
 pub(super) fn run(
     model: &Model,
     p: &Particles,
-    walls: &Walls,
-    owned: Option<&[bool]>,
+    (walls, owned): (&Walls, Option<&[bool]>),
     list: &mut ContactList,
-    loads: &mut [Load],
+    (loads, ledger): (&mut [Load], Option<&mut Vec<LedgerEntry>>),
 ) -> (Findings, Vec<Sum6>) {
-    with_models!(model.law.choice(), M => run_with::<M>(model, p, walls, owned, list, loads))
+    with_models!(model.law.choice(), M => run_with::<M>(model, p, (walls, owned), list, (loads, ledger)))
 }
 
 /// [`run`] with the sub-models `M`.
@@ -73,12 +72,11 @@ pub(super) fn run(
 fn run_with<M: Models>(
     model: &Model,
     p: &Particles,
-    walls: &Walls,
-    owned: Option<&[bool]>,
+    (walls, owned): (&Walls, Option<&[bool]>),
     list: &mut ContactList,
-    loads: &mut [Load],
+    (loads, mut ledger): (&mut [Load], Option<&mut Vec<LedgerEntry>>),
 ) -> (Findings, Vec<Sum6>) {
-    let found = Found::new(model.ledger);
+    let found = Found::new(ledger.as_deref_mut());
     let law = &model.law;
     let ContactList {
         start,
@@ -109,7 +107,7 @@ fn run_with<M: Models>(
         .with_min_len(MIN_PARALLEL_LEN.div_ceil(FACE_BLOCK))
         .map(|block| SCRATCH.with_borrow_mut(|scratch| stage.block::<M>(block, scratch, &found)))
         .collect();
-    let mut found = found.into_inner();
+    let mut found = found.into_inner(ledger);
     // The blocks' sums of the loads on the mesh files, in order.
     let mut step = vec![Sum6::default(); walls.sums.len()];
     if !step.is_empty() {
@@ -316,27 +314,26 @@ impl FaceStage<'_> {
     }
 
     /// The energy ledger's entries of the contacts of particles `i` with the faces `faces`
-    /// in a group's lanes, with the walls' motion at the contact points the law took (Eq. 26).
+    /// in a group's lanes, with the walls' motion at the contact points the law took
+    /// (Eq. 26); the first `i.len()` are of the group.
     fn entries(
         &self,
-        i: &[usize],
+        i: &[usize; WIDTH],
         faces: &[usize; WIDTH],
         (kin, parts): (&Kinematics<Group>, &ContactParts<Group>),
-    ) -> Vec<LedgerEntry> {
+    ) -> [LedgerEntry; WIDTH] {
         let entry = super::pairs::entries(kin, parts);
-        (0..i.len())
-            .map(|l| {
-                let e = entry(l);
-                let wall = self.walls.velocity(faces[l]);
-                let point = self.p.x[i[l]] - e.n * e.r_i;
-                LedgerEntry {
-                    i: i[l] as u32,
-                    frame_v: wall.at(point),
-                    frame_w: wall.omega,
-                    ..e
-                }
-            })
-            .collect()
+        std::array::from_fn(|l| {
+            let e = entry(l);
+            let wall = self.walls.velocity(faces[l]);
+            let point = self.p.x[i[l]] - e.n * e.r_i;
+            LedgerEntry {
+                i: i[l] as u32,
+                frame_v: wall.at(point),
+                frame_w: wall.omega,
+                ..e
+            }
+        })
     }
 
     /// The law for one group of `WIDTH` contacts (indices of `near`), added to the loads of
@@ -391,7 +388,7 @@ impl FaceStage<'_> {
                 .compose_parts::<M, _>(&coef, (radius, mass), Other::Wall, &kin, &mut lanes);
         scatter_springs(lanes, store, &e[..group.len()]);
         let faces: [usize; WIDTH] = c.map(|c| self.partner[first + c.slot] as usize);
-        found.enter(|| self.entries(&i[..group.len()], &faces, (&kin, &parts)));
+        found.enter(|| (self.entries(&i, &faces, (&kin, &parts)), group.len()));
         let (f, tau) = (Group::scatter_vec(force.f), Group::scatter_vec(force.tau_i));
         let mut fine = true;
         for l in 0..group.len() {

@@ -12,6 +12,8 @@ pub(crate) struct Books {
     ledger: Ledger,
     /// Each particle's velocities before this step moved it.
     before: Vec<(DVec3, DVec3)>,
+    /// The contact stages' entries of the step (kept for their room).
+    entries: Vec<Entry>,
 }
 
 impl Books {
@@ -22,7 +24,15 @@ impl Books {
         Books {
             ledger: Ledger::new(scales.force.largest() * r_max * 2f64.powi(30)),
             before: Vec::new(),
+            entries: Vec::new(),
         }
+    }
+
+    /// The entries' buffer, empty, for the contact stages to fill.
+    pub(super) fn take_entries(&mut self) -> Vec<Entry> {
+        let mut e = std::mem::take(&mut self.entries);
+        e.clear();
+        e
     }
 
     /// What a checkpoint keeps of the ledger.
@@ -51,28 +61,59 @@ impl Simulation {
     /// The ledger's stage, after stages 5-5c: the step's work of the modes of the
     /// contacts `entries` (those of own particles, of a pair the lower id's) and of the
     /// walls; of gravity and drag on own particles. Whether every term was in range.
-    pub(super) fn keep_books(&mut self, entries: &[Entry]) -> bool {
-        let Some(books) = &mut self.books else {
+    pub(super) fn keep_books(&mut self, entries: Vec<Entry>) -> bool {
+        let Some(mut books) = self.books.take() else {
             return true;
         };
+        let fine = self.book_step(&mut books, &entries);
+        books.entries = entries;
+        self.books = Some(books);
+        fine
+    }
+
+    /// [`Simulation::keep_books`] into `books`.
+    fn book_step(&self, books: &mut Books, entries: &[Entry]) -> bool {
         let (p, model) = (&self.particles, &self.model);
         let (dt, g) = (
             self.scenario.simulation.timestep,
             self.scenario.kinetics.gravity,
         );
         let own = |k: usize| self.share.as_ref().is_none_or(|d| d.owned[k]);
-        let before = &books.before;
-        let mean = |k: usize| {
-            let (v, w) = before[k];
-            Mean {
-                v: 0.5 * (v + p.v[k]),
-                w: 0.5 * (w + p.w[k]),
-            }
-        };
-        let ledger = &books.ledger;
+        let Books { ledger, before, .. } = books;
+        let ledger = &*ledger;
         let merge = |(mut a, fa): (Sum6, bool), (b, fb): (Sum6, bool)| {
             a.merge(&b);
             (a, fa & fb)
+        };
+        // Gravity's work and the drag's (at the velocities it was taken at, Eqs. 42-44); the
+        // velocities before the step become the means of the step in their place.
+        let work = |k: usize, motion: &mut (DVec3, DVec3)| {
+            let (v, w) = *motion;
+            let (v_mid, w_mid) = (0.5 * (v + p.v[k]), 0.5 * (w + p.w[k]));
+            *motion = (v_mid, w_mid);
+            let m = model.mass(p, k);
+            let r = p.radius[k];
+            let c = model.densities[p.material[k] as usize].drag / (r * r); // Eq. (3)
+            let gravity = m * g.dot(v_mid) * dt;
+            let inertia = 0.4 * m * r * r;
+            let drag = -(m * c * v.dot(v_mid) + inertia * (10.0 / 3.0) * c * w.dot(w_mid)) * dt;
+            f64x8::from([gravity, drag, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+        };
+        let (particles, fine_p) = before
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .map(|(c, chunk)| {
+                let each = chunk
+                    .iter_mut()
+                    .enumerate()
+                    .map(|(l, b)| (c * CHUNK + l, b));
+                let terms = each.map(|(k, b)| (k, work(k, b))).filter(|&(k, _)| own(k));
+                ledger.sum(terms.map(|t| t.1))
+            })
+            .reduce(|| (Sum6::default(), true), merge);
+        let mean = |k: usize| {
+            let (v, w) = before[k];
+            Mean { v, w }
         };
         let (contacts, fine) = entries
             .par_chunks(CHUNK)
@@ -86,24 +127,6 @@ impl Simulation {
                     e.work(mean(e.i as usize), j, dt)
                 }))
             })
-            .reduce(|| (Sum6::default(), true), merge);
-        let work = |k: usize| {
-            // Gravity's, and the drag's at the velocities it was taken at (Eqs. 42-44).
-            let m = model.mass(p, k);
-            let (v, w) = before[k];
-            let Mean { v: v_mid, w: w_mid } = mean(k);
-            let r = p.radius[k];
-            let c = model.densities[p.material[k] as usize].drag / (r * r); // Eq. (3)
-            let gravity = m * g.dot(v_mid) * dt;
-            let inertia = 0.4 * m * r * r;
-            let drag = -(m * c * v.dot(v_mid) + inertia * (10.0 / 3.0) * c * w.dot(w_mid)) * dt;
-            f64x8::from([gravity, drag, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
-        };
-        let (particles, fine_p) = (0..p.len())
-            .into_par_iter()
-            .with_min_len(CHUNK)
-            .chunks(CHUNK)
-            .map(|ks| ledger.sum(ks.into_iter().filter(|&k| own(k)).map(work)))
             .reduce(|| (Sum6::default(), true), merge);
         let (contacts, particles) = match &self.share {
             // Every process holds the sums of all (as the walls' heat): a checkpoint's parts

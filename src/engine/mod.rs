@@ -82,8 +82,6 @@ pub(crate) struct Model {
     /// Heat transfer, if the scenario's materials conduct, make or exchange heat; with
     /// the walls' temperatures and conductivities.
     pub(crate) heat: Option<(HeatModel, heat::WallHeat)>,
-    /// Whether the contact stages leave their entries for the energy ledger.
-    pub(crate) ledger: bool,
 }
 
 impl Model {
@@ -123,15 +121,12 @@ fn body_masses(p: &Particles, idx: &[usize; WIDTH], m: Group) -> Group {
 pub(super) struct Findings {
     deep: Vec<Deep>,
     beyond_range: bool,
-    /// With the energy ledger, each contact's force and torques by mode.
-    entries: Vec<LedgerEntry>,
 }
 
 impl Findings {
     fn merge(&mut self, other: Findings) {
         self.deep.extend(other.deep);
         self.beyond_range |= other.beyond_range;
-        self.entries.extend(other.entries);
     }
 }
 
@@ -145,30 +140,34 @@ struct Found {
 }
 
 impl Found {
-    /// Findings to collect, with the ledger's entries if `ledger`.
-    fn new(ledger: bool) -> Found {
+    /// Findings to collect, with the ledger's entries after those of `ledger` if it is
+    /// kept (taken, to be given back by [`Found::into_inner`]: its room stays).
+    fn new(ledger: Option<&mut Vec<LedgerEntry>>) -> Found {
         Found {
-            entries: ledger.then(Default::default),
+            entries: ledger.map(|e| Mutex::new(std::mem::take(e))),
             ..Found::default()
         }
     }
 
     /// Keeps the ledger's entries `e` (if it is kept).
-    fn enter(&self, e: impl FnOnce() -> Vec<LedgerEntry>) {
+    fn enter(&self, e: impl FnOnce() -> ([LedgerEntry; WIDTH], usize)) {
         if let Some(entries) = &self.entries {
-            let e = e();
-            entries.lock().expect("not poisoned").extend(e);
+            let (e, n) = e();
+            entries
+                .lock()
+                .expect("not poisoned")
+                .extend_from_slice(&e[..n]);
         }
     }
 
-    fn into_inner(self) -> Findings {
+    /// What was found, and the ledger's entries back into `ledger`.
+    fn into_inner(self, ledger: Option<&mut Vec<LedgerEntry>>) -> Findings {
+        if let (Some(entries), Some(ledger)) = (self.entries, ledger) {
+            *ledger = entries.into_inner().expect("not poisoned");
+        }
         Findings {
             deep: self.deep.into_inner().expect("not poisoned"),
             beyond_range: self.beyond.into_inner(),
-            entries: self
-                .entries
-                .map(|e| e.into_inner().expect("not poisoned"))
-                .unwrap_or_default(),
         }
     }
 }
@@ -619,13 +618,21 @@ impl Simulation {
         let t = self.stage_times.add(Stage::Spawn, t);
         self.update_neighbours();
         let t = self.stage_times.add(Stage::Neighbours, t);
+        // The ledger's entries of this step, in the room of the last step's.
+        let mut entries = self.books.as_mut().map(|b| b.take_entries());
         let p = &self.particles;
-        let mut found = pairs::run(&self.model, p, &mut self.neighbours, &mut self.loads);
+        let lists = &mut self.neighbours;
+        let mut found = pairs::run(&self.model, p, lists, &mut self.loads, entries.as_mut());
         let t = self.stage_times.add(Stage::ParticleContacts, t);
         let owned = self.share.as_ref().map(|d| &d.owned[..]);
         let list = &mut self.neighbours.faces;
-        let (on_faces, walls) =
-            faces::run(&self.model, p, &self.walls, owned, list, &mut self.loads);
+        let (on_faces, walls) = faces::run(
+            &self.model,
+            p,
+            (&self.walls, owned),
+            list,
+            (&mut self.loads, entries.as_mut()),
+        );
         found.merge(on_faces);
         self.add_wall_loads(walls);
         let t = self.stage_times.add(Stage::MeshContacts, t);
@@ -665,8 +672,9 @@ impl Simulation {
             split::refresh_ghosts(d, &mut self.particles);
         }
         let t = self.stage_times.add(Stage::Exchange, t);
-        let entries = std::mem::take(&mut found.entries);
-        found.beyond_range |= !self.keep_books(&entries);
+        if let Some(entries) = entries {
+            found.beyond_range |= !self.keep_books(entries);
+        }
         let t = self.stage_times.add(Stage::Ledger, t);
         self.steps += 1;
         self.time = self.steps as f64 * self.scenario.simulation.timestep;

@@ -48,14 +48,16 @@ type SlabLoads<'s, 'l> = (
 /// number of threads. Each slab first sorts out its touching pairs (a pair that has just
 /// parted forgets its springs), then evaluates them `WIDTH` at a time in SIMD lanes; a
 /// lane gives the bits the pair would give alone. Body i of a pair is the particle of
-/// the lower id, so a pair's force and springs do not depend on the storage order.
+/// the lower id, so a pair's force and springs do not depend on the storage order. With
+/// the energy ledger, each contact's parts to `ledger`.
 pub(super) fn run(
     model: &Model,
     p: &Particles,
     lists: &mut Neighbours,
     loads: &mut [Load],
+    ledger: Option<&mut Vec<LedgerEntry>>,
 ) -> Findings {
-    with_models!(model.law.choice(), M => run_with::<M>(model, p, lists, loads))
+    with_models!(model.law.choice(), M => run_with::<M>(model, p, lists, loads, ledger))
 }
 
 /// [`run`] with the sub-models `M`.
@@ -65,8 +67,9 @@ fn run_with<M: Models>(
     p: &Particles,
     lists: &mut Neighbours,
     loads: &mut [Load],
+    mut ledger: Option<&mut Vec<LedgerEntry>>,
 ) -> Findings {
-    let found = Found::new(model.ledger);
+    let found = Found::new(ledger.as_deref_mut());
     let law = &model.law;
     let ContactList {
         start,
@@ -106,8 +109,8 @@ fn run_with<M: Models>(
             TOUCHING.with_borrow_mut(|touching| stage.slab::<M>(slab, next, touching, &found));
         });
     }
-    let mut found = found.into_inner();
-    wrapped::<M>(model, p, lists, loads, &mut found);
+    let mut found = found.into_inner(ledger.as_deref_mut());
+    wrapped::<M>(model, p, lists, loads, (&mut found, ledger));
     found
 }
 
@@ -119,7 +122,7 @@ fn wrapped<M: Models>(
     p: &Particles,
     nb: &mut Neighbours,
     loads: &mut [Load],
-    found: &mut Findings,
+    (found, mut ledger): (&mut Findings, Option<&mut Vec<LedgerEntry>>),
 ) {
     let law = &model.law;
     let images: Vec<(DVec3, DVec3)> = (0..nb.shift.len()).map(|k| nb.image(k)).collect();
@@ -172,8 +175,8 @@ fn wrapped<M: Models>(
                 let (r_i, m_i) = (p.radius[i], model.mass(p, i));
                 let (force, parts) =
                     law.compose_parts::<M, _>(coef, (r_i, m_i), other, &kin, springs);
-                if model.ledger {
-                    found.entries.push(LedgerEntry {
+                if let Some(ledger) = ledger.as_deref_mut() {
+                    ledger.push(LedgerEntry {
                         i: i as u32,
                         j: j as u32,
                         n: kin.n,
@@ -344,15 +347,12 @@ impl PairStage<'_> {
         scatter_springs(lanes, store, &c[..group.len()]);
         found.enter(|| {
             let entry = entries(&kin, &parts);
-            (0..group.len())
-                .map(|l| LedgerEntry {
-                    i: i[l] as u32,
-                    j: j[l] as u32,
-                    frame_v: DVec3::ZERO,
-                    frame_w: DVec3::ZERO,
-                    ..entry(l)
-                })
-                .collect()
+            let e = std::array::from_fn(|l| LedgerEntry {
+                i: i[l] as u32,
+                j: j[l] as u32,
+                ..entry(l)
+            });
+            (e, group.len())
         });
         let (f, tau_i, tau_j) = (
             Group::scatter_vec(force.f),

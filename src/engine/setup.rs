@@ -458,7 +458,6 @@ impl Simulation {
                     .collect(),
                 scales: LoadScales::of(&scenario),
                 heat: None,
-                ledger: scenario.energy_ledger,
             },
             neighbours: Neighbours::with_periodic(skin, scenario.periodicity()),
             face_grid,

@@ -211,11 +211,13 @@ pub fn default_steps(n: usize) -> u64 {
     (10_000_000 / n as u64).clamp(100, 5000)
 }
 
-/// The bed with `lines` added to its `[material]` (a contact model's keys, heat's).
-fn with_material(sim: Simulation, lines: &str) -> Result<Simulation> {
+/// The bed with `lines` added to its `[material]` (a contact model's keys, heat's), keeping
+/// the energy ledger if `ledger`.
+fn with_material(sim: Simulation, lines: &str, ledger: bool) -> Result<Simulation> {
     let text =
         (sim.scenario.to_toml()).replace("viscosity = 0", &format!("{lines}\nviscosity = 0"));
-    let scenario = Scenario::parse(&text, Path::new("bench"))?;
+    let mut scenario = Scenario::parse(&text, Path::new("bench"))?;
+    scenario.energy_ledger = ledger;
     let mesh = Mesh {
         faces: sim.walls.mesh.faces.clone(),
         ..Mesh::default()
@@ -239,9 +241,11 @@ pub fn heated(mut sim: Simulation) -> Result<Simulation> {
     for (t, x) in p.temperature.iter_mut().zip(&p.x) {
         *t = 300.0 + 100.0 * (x.z / top).clamp(0.0, 1.0);
     }
+    let ledger = sim.scenario.energy_ledger;
     let sim = with_material(
         sim,
         "thermal_conductivity = 1.0\nheat_capacity = 800.0\ninitial_temperature = 300.0",
+        ledger,
     )?;
     anyhow::ensure!(
         sim.scenario.heat(),
@@ -251,13 +255,15 @@ pub fn heated(mut sim: Simulation) -> Result<Simulation> {
 }
 
 /// A benchmark bed: `n` particles (grains: clumps of `clumps` spheres each, if given),
-/// conducting heat if `heat`, with the lines `material` added to its `[material]`.
+/// conducting heat if `heat`, with the lines `material` added to its `[material]`, keeping
+/// the energy ledger if `ledger`.
 #[derive(Clone, Debug, Default)]
 pub struct Bed {
     pub n: usize,
     pub clumps: Option<usize>,
     pub heat: bool,
     pub material: Vec<String>,
+    pub ledger: bool,
 }
 
 /// Runs the benchmark `bed` on the current thread pool, split over the processes of
@@ -274,8 +280,8 @@ pub fn measure(
         None => setup(n)?,
         Some(k) => setup_clumps(n, k)?,
     };
-    if !bed.material.is_empty() {
-        sim = with_material(sim, &bed.material.join("\n"))?;
+    if !bed.material.is_empty() || bed.ledger {
+        sim = with_material(sim, &bed.material.join("\n"), bed.ledger)?;
     }
     if bed.heat {
         sim = heated(sim)?;

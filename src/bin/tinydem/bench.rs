@@ -40,6 +40,9 @@ pub struct BenchArgs {
     /// 'rolling_model = "cdt"'`: to measure what a contact model costs.
     #[arg(long = "material")]
     material: Vec<String>,
+    /// Keep the energy ledger ([output] energy_ledger), to measure what it costs.
+    #[arg(long)]
+    ledger: bool,
     /// Run one configuration in this process (used by the benchmark itself).
     #[arg(long, hide = true)]
     pub single: bool,
@@ -63,6 +66,7 @@ impl BenchArgs {
                 clumps: self.clumps,
                 heat: self.heat,
                 material: self.material.clone(),
+                ledger: self.ledger,
             };
             let m = tinydem::tools::bench::measure(&bed, steps, self.repeats, world)?;
             if first {
@@ -113,6 +117,9 @@ impl BenchArgs {
                 }
                 if self.heat {
                     cmd.arg("--heat");
+                }
+                if self.ledger {
+                    cmd.arg("--ledger");
                 }
                 for line in &self.material {
                     cmd.args(["--material", line]);
