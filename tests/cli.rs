@@ -315,6 +315,7 @@ fn verify_runs_the_analytic_cases_and_writes_its_report() {
         "dmt_contact",
         "jkr_contact",
         "liquid_bridge",
+        "energy_ledger",
     ] {
         assert!(out.contains(case), "missing {case} in\n{out}");
     }

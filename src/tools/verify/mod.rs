@@ -39,6 +39,7 @@ mod beyond;
 mod chung_ooi;
 mod contacts;
 mod heat;
+mod ledger;
 mod models;
 
 use crate::engine::Simulation;
@@ -204,6 +205,12 @@ pub const CASES: &[Case] = &[
         what: "a liquid bridge's force against Willett's closed form, and its rupture distance",
         quick: true,
         run: beyond::liquid_bridge,
+    },
+    Case {
+        name: "energy_ledger",
+        what: "where the energy goes: an impact's loss in the normal mode alone, a sliding sphere's 2/7 in sliding",
+        quick: true,
+        run: ledger::energy_ledger,
     },
     Case {
         name: "heat_relaxation",
