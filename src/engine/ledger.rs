@@ -78,7 +78,7 @@ impl Simulation {
             self.scenario.simulation.timestep,
             self.scenario.kinetics.gravity,
         );
-        let own = |k: usize| self.share.as_ref().is_none_or(|d| d.owned[k]);
+        let own = |k: usize| self.own(k);
         let Books { ledger, before, .. } = books;
         let ledger = &*ledger;
         let merge = |(mut a, fa): (Sum6, bool), (b, fb): (Sum6, bool)| {
@@ -128,17 +128,8 @@ impl Simulation {
                 }))
             })
             .reduce(|| (Sum6::default(), true), merge);
-        let (contacts, particles) = match &self.share {
-            // Every process holds the sums of all (as the walls' heat): a checkpoint's parts
-            // agree.
-            Some(d) => {
-                let words = [contacts.words(), particles.words()].concat();
-                let all = d.comm.sum_i64(&words);
-                let sum = |k: usize| Sum6::from_words(all[k..k + 12].try_into().expect("12"));
-                (sum(0), sum(12))
-            }
-            None => (contacts, particles),
-        };
+        // Every process holds the sums of all (as the walls' heat): a checkpoint's parts agree.
+        let [contacts, particles] = self.over_processes([contacts, particles]);
         books.ledger.add_contacts(&contacts);
         books.ledger.add_particles(&particles);
         fine & fine_p
@@ -147,7 +138,7 @@ impl Simulation {
     /// The kinetic energy of the own particles `ks` brought in (spawned) or taken out
     /// (removed), to the ledger.
     pub(super) fn book_kinetic(&mut self, ks: impl Iterator<Item = usize>, spawned: bool) {
-        let Some(books) = &mut self.books else {
+        let Some(books) = &self.books else {
             return;
         };
         let p = &self.particles;
@@ -156,10 +147,7 @@ impl Simulation {
             let r = p.radius[k];
             0.5 * m * (p.v[k].length_squared() + 0.4 * r * r * p.w[k].length_squared())
         };
-        let terms: Vec<f64> = ks
-            .filter(|&k| self.share.as_ref().is_none_or(|d| d.owned[k]))
-            .map(energy)
-            .collect();
+        let terms: Vec<f64> = ks.filter(|&k| self.own(k)).map(energy).collect();
         let slot = if spawned { 2 } else { 3 };
         let mut sum = Sum6::default();
         for chunk in terms.chunks(CHUNK) {
@@ -175,10 +163,8 @@ impl Simulation {
             );
         }
         // Over all processes (collective: each spawns and removes in step with the others).
-        if let Some(d) = &self.share {
-            let all = d.comm.sum_i64(&sum.words());
-            sum = Sum6::from_words(all.try_into().expect("12 words"));
-        }
+        let [sum] = self.over_processes([sum]);
+        let books = self.books.as_mut().expect("kept");
         books.ledger.add_particles(&sum);
     }
 
@@ -221,17 +207,23 @@ impl Simulation {
         for chunk in terms.chunks(CHUNK) {
             sum.merge(&books.ledger.sum(chunk.iter().copied()).0);
         }
-        let stored = self.over_processes(&books.ledger, &sum);
+        let [sum] = self.over_processes([sum]);
+        let stored = books.ledger.value(&sum.words());
         std::array::from_fn(|m| stored[m])
     }
 
-    /// The value of `sum` over all processes.
-    fn over_processes(&self, ledger: &Ledger, sum: &Sum6) -> [f64; 6] {
-        let words = match &self.share {
-            Some(d) => d.comm.sum_i64(&sum.words()),
-            None => sum.words().to_vec(),
+    /// `sums` added over all processes (collective in a split run, one message).
+    fn over_processes<const N: usize>(&self, sums: [Sum6; N]) -> [Sum6; N] {
+        let Some(d) = &self.share else {
+            return sums;
         };
-        ledger.value(&words)
+        let words: Vec<i64> = sums.iter().flat_map(|s| s.words()).collect();
+        let all = d.comm.sum_i64(&words);
+        std::array::from_fn(|k| {
+            let mut sum = Sum6::from_words(all[12 * k..12 * k + 12].try_into().expect("12"));
+            sum.carry();
+            sum
+        })
     }
 
     /// The ledger's columns of `log.csv` now (collective in a split run), with the
